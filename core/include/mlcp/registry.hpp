@@ -1,0 +1,25 @@
+// mlcp/registry.hpp: solvers by name, for the CLI, the adapters and the tests.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mlcp/solver.hpp"
+
+namespace mlcp {
+
+struct SolverInfo {
+  const char* name;         // "pgs"
+  const char* description;  // one line for --help
+  std::unique_ptr<Solver> (*make)();
+};
+
+// Every registered solver, in a fixed order.
+const std::vector<SolverInfo>& solvers();
+// A new solver of that name, or nullptr (with a message listing the valid names in *error).
+std::unique_ptr<Solver> makeSolver(const std::string& name, std::string* error = nullptr);
+// "gs, pgs, ..." for messages and help texts.
+std::string solverNames();
+
+}  // namespace mlcp

@@ -1,0 +1,72 @@
+// mlcp/result.hpp: what every solver takes (Options) and gives back (Result).
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace mlcp {
+
+enum class Status {
+  Converged,       // residual <= Options::tolerance, checked by residual() (never self-reported)
+  MaxIterations,   // the iteration (or pivot) limit was reached before the tolerance
+  TimeLimit,       // Options::timeBudget ran out before the tolerance
+  Failed,          // the method broke down: ray termination, pivot failure, cycling,
+                   // divergence, a zero diagonal, or it finished above the tolerance
+  Unsupported,     // the method does not apply to this class of problem
+  InvalidInput,    // Problem::validate() or the guess rejected the input; x is untouched
+  NumericalIssue,  // NaN or Inf appeared during the solve
+};
+const char* toString(Status s);
+
+// How friction-coupled (findex) rows take their bounds.
+enum class FrictionBounds {
+  // The returned x satisfies |x_i| <= mu_i * |x_findex[i]| exactly: the bounds move with the
+  // normal values (pgs recomputes them at each visit; pivoting methods iterate to a fixed point).
+  Exact,
+  // ODE/Bullet compatibility: bounds fixed once from an intermediate normal value, as stock
+  // dSolveLCP does. The answer may violate the final bounds; only for diffing against stock.
+  FixedOnce,
+};
+
+struct Options {
+  // Target of the scaled natural-map residual (see residual.hpp); dimensionless. Default 1e-10.
+  double tolerance = 1e-10;
+  // Iterative methods: sweeps. Pivoting methods: outer iterations (friction fixed-point steps);
+  // their pivot count is bounded separately by maxPivots. Default 1000.
+  int maxIterations = 1000;
+  // Pivot limit of pivoting methods; 0 means "automatic" (50 * n + 100). Default 0.
+  int maxPivots = 0;
+  // SOR relaxation factor omega of gs/pgs, in (0, 2). 1 is plain Gauss-Seidel. Default 1.
+  double relaxation = 1.0;
+  // Start from the x passed to solve() instead of from zero (methods that can use it). Default
+  // false.
+  bool warmStart = false;
+  // Wall-clock budget in seconds; 0 means none. Checked between iterations. Default 0.
+  double timeBudget = 0.0;
+  // Record the residual after every iteration in Result::history (costs one residual
+  // evaluation, O(nnz A), per iteration). Default false.
+  bool recordHistory = false;
+  // Check the residual only every this many sweeps in iterative methods (the check costs about
+  // one sweep). 1 checks every sweep. Default 1.
+  int checkEvery = 1;
+  // Friction bound handling; see FrictionBounds. Default Exact.
+  FrictionBounds frictionBounds = FrictionBounds::Exact;
+  // Pivot magnitude below which a pivoting method treats a pivot as zero. Default 1e-12
+  // (relative to the largest entry of A's diagonal).
+  double pivotTolerance = 1e-12;
+};
+
+struct Result {
+  Status status = Status::InvalidInput;
+  int iterations = 0;           // sweeps, or pivots for pivoting methods
+  double residual = 0;          // scaled natural-map residual at the returned x
+  double complementarity = 0;   // max_i of the complementarity gap at the returned x
+  double boundViolation = 0;    // max_i distance of x_i outside its effective bounds
+  double seconds = 0;           // wall time of the solve, including the final residual check
+  std::string message;          // why it stopped, in words
+  std::vector<double> history;  // residual per iteration when Options::recordHistory
+
+  bool converged() const { return status == Status::Converged; }
+};
+
+}  // namespace mlcp

@@ -1,0 +1,75 @@
+// mlcp/rows.hpp: constraint rows in the factored form physics engines hand over.
+//
+// Engines do not build A. They give, per constraint row i, two 6-wide Jacobian blocks
+// J_iA, J_iB (linear part first, then angular) on two bodies A and B, and per body its
+// inverse mass and world-frame inverse inertia. With M^-1 the block-diagonal inverse mass
+// matrix, the MLCP is
+//
+//     w = (J M^-1 J^T + diag(cfm)) x + b,   lo <= x <= hi,   findex as in problem.hpp,
+//
+// in the canonical form of problem.hpp (engines' rhs is -b: the adapters convert). Keeping
+// this form lets PGS run on rows and body velocities with O(nnz J) work per sweep and no A at
+// all (RowPgs below); pivoting methods get A from assemble(), sparse by the body graph (only
+// rows sharing a body couple), dense only when asked.
+//
+// Bodies with invMass == 0 and a zero invInertia are static; a row's body index -1 means "the
+// world" (its block is ignored).
+#pragma once
+
+#include <Eigen/Dense>
+#include <string>
+#include <vector>
+
+#include "mlcp/problem.hpp"
+#include "mlcp/result.hpp"
+
+namespace mlcp {
+
+using Vector6 = Eigen::Matrix<double, 6, 1>;
+
+struct BodyInverseMass {
+  double invMass = 0;                                    // 1 / mass, 0 for static bodies
+  Eigen::Matrix3d invInertia = Eigen::Matrix3d::Zero();  // world frame
+};
+
+struct ConstraintRow {
+  int bodyA = -1, bodyB = -1;    // indices into RowSystem::bodies, -1 = world
+  Vector6 jA = Vector6::Zero();  // [linear; angular] Jacobian on body A
+  Vector6 jB = Vector6::Zero();  // [linear; angular] Jacobian on body B
+};
+
+class RowSystem {
+ public:
+  std::vector<BodyInverseMass> bodies;
+  std::vector<ConstraintRow> rows;
+  Vector b, lo, hi, cfm;    // per row; cfm >= 0 is added to A's diagonal
+  std::vector<int> findex;  // per row or empty
+
+  int size() const { return static_cast<int>(rows.size()); }
+  // "" when well formed, otherwise the first thing wrong (sizes, body indices, NaN/Inf, and
+  // every rule of Problem::validate for b, lo, hi, findex).
+  std::string validate() const;
+
+  // A = J M^-1 J^T + diag(cfm) with the bounds copied: the same MLCP as a Problem.
+  Problem assemble(bool sparse) const;
+  // w = A x + b computed through body velocities, O(nnz J).
+  Vector slack(const Vector& x) const;
+  // Body velocity changes M^-1 J^T x, 6 per body ([linear; angular]).
+  std::vector<Vector6> bodyVelocities(const Vector& x) const;
+};
+
+// Projected Gauss-Seidel on the rows themselves (what engines' sequential impulse does), with
+// the same update rule, options and status semantics as PgsSolver (pgs.hpp). It keeps one
+// 6-vector per body, v = M^-1 J^T x, and visits each row in O(12).
+class RowPgs {
+ public:
+  Options& options() { return options_; }
+  const Options& options() const { return options_; }
+  // Solve from x (used when options().warmStart and x has the right size, else from zero).
+  Result solve(const RowSystem& system, Vector& x);
+
+ private:
+  Options options_;
+};
+
+}  // namespace mlcp

@@ -1,0 +1,65 @@
+// mlcp/solver.hpp: the interface every algorithm implements, shaped like Eigen's solvers.
+//
+//     mlcp::PgsSolver pgs;                 // or mlcp::makeSolver("pgs")
+//     pgs.options().tolerance = 1e-9;
+//     mlcp::Vector x;
+//     mlcp::Result r = pgs.solve(problem, x);           // starts from zero
+//     mlcp::Result r = pgs.solveWithGuess(problem, g, x);  // starts from g
+//
+// The base class does what every solver shares, so no algorithm can skip it: it validates the
+// problem (InvalidInput leaves x untouched), times the solve, and recomputes the accuracy of
+// the returned x with residual.hpp. A solver that reports Converged with a residual above the
+// tolerance is downgraded to Failed; a non-finite x becomes NumericalIssue.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "mlcp/problem.hpp"
+#include "mlcp/result.hpp"
+
+namespace mlcp {
+
+class Solver {
+ public:
+  virtual ~Solver() = default;
+
+  // Registry name, e.g. "pgs".
+  virtual const char* name() const = 0;
+
+  Options& options() { return options_; }
+  const Options& options() const { return options_; }
+  Solver& setOptions(const Options& o) {
+    options_ = o;
+    return *this;
+  }
+
+  // Solve from x = 0, or from the incoming x when options().warmStart and x has the right size.
+  Result solve(const Problem& problem, Vector& x);
+  // Solve from the given guess (size n), whatever options().warmStart says.
+  Result solveWithGuess(const Problem& problem, const Vector& guess, Vector& x);
+
+ protected:
+  // The algorithm. x arrives sized n holding the start point; leave the answer in it. Set
+  // status, iterations, message (and history). Validation, timing and the final accuracy
+  // check are done by the caller.
+  virtual void run(const Problem& problem, Vector& x, Result& result) = 0;
+
+  // For iterative methods: true when the time budget started at `start` is spent.
+  bool outOfTime(double startSeconds) const;
+
+ private:
+  Result runChecked(const Problem& problem, Vector start, Vector& x);
+  Options options_;
+};
+
+struct Accuracy;
+// The final say on a result, shared by every entry point: copies the accuracy into r; NaN/Inf
+// makes it NumericalIssue; a residual within tolerance upgrades MaxIterations/TimeLimit to
+// Converged; a Converged claim above the tolerance becomes Failed.
+void applyAccuracy(Result& r, const Accuracy& a, double tolerance);
+
+// Seconds on a monotonic clock (for timing and time budgets).
+double nowSeconds();
+
+}  // namespace mlcp

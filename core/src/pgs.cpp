@@ -1,0 +1,67 @@
+#include "mlcp/pgs.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "mlcp/residual.hpp"
+#include "sweep_monitor.hpp"
+
+namespace mlcp {
+
+std::string PgsSolver::refuse(const Problem& problem) const {
+  const double omega = options().relaxation;
+  if (!(omega > 0 && omega < 2)) {
+    std::ostringstream os;
+    os << "relaxation " << omega << " is outside (0, 2)";
+    return os.str();
+  }
+  (void)problem;
+  return "";
+}
+
+std::string GaussSeidelSolver::refuse(const Problem& problem) const {
+  if (problem.classify() != ProblemClass::Linear && problem.size() > 0)
+    return "gs solves problems without bounds (every row -inf..inf); use pgs for bounded rows";
+  return PgsSolver::refuse(problem);
+}
+
+void PgsSolver::run(const Problem& problem, Vector& x, Result& result) {
+  const Options& opt = options();
+  const int n = problem.size();
+  if (std::string why = refuse(problem); !why.empty()) {
+    result.status = Status::Unsupported;
+    result.message = why;
+    return;
+  }
+  Vector invDiag(n);
+  for (int i = 0; i < n; ++i) {
+    const double d = problem.diagonal(i);
+    if (!(d > 0)) {
+      std::ostringstream os;
+      os << "A(" << i << "," << i << ") = " << d << ": " << name()
+         << " needs a positive diagonal (use lemke or dantzig)";
+      result.status = Status::Failed;
+      result.message = os.str();
+      return;
+    }
+    invDiag[i] = 1.0 / d;
+  }
+  if (n == 0) {
+    result.status = Status::Converged;
+    result.message = "empty problem";
+    return;
+  }
+  const double omega = opt.relaxation;
+  detail::SweepMonitor monitor(opt, result);
+  for (int sweep = 1; sweep <= opt.maxIterations; ++sweep) {
+    for (int i = 0; i < n; ++i) {
+      const double wi = problem.rowDot(i, x) + problem.b[i];
+      const double xi = x[i] - omega * wi * invDiag[i];
+      x[i] = std::clamp(xi, problem.effectiveLo(i, x), problem.effectiveHi(i, x));
+    }
+    if (monitor.wantsCheck(sweep) && monitor.stop(sweep, accuracy(problem, x))) return;
+  }
+}
+
+}  // namespace mlcp

@@ -1,0 +1,200 @@
+#include "mlcp/rows.hpp"
+
+#include <algorithm>
+#include <sstream>
+
+#include "mlcp/residual.hpp"
+#include "mlcp/solver.hpp"
+#include "sweep_monitor.hpp"
+
+namespace mlcp {
+
+namespace {
+
+// M^-1 j for one body: [invMass * linear; invInertia * angular].
+Vector6 applyInverseMass(const BodyInverseMass& body, const Vector6& j) {
+  Vector6 out;
+  out.head<3>() = body.invMass * j.head<3>();
+  out.tail<3>() = body.invInertia * j.tail<3>();
+  return out;
+}
+
+// A problem with the same b, bounds and findex and no matrix yet: validation of those fields is
+// Problem's job, so rows reuse it instead of repeating the rules.
+Problem boundsOnly(const RowSystem& s) {
+  Problem p;
+  p.b = s.b;
+  p.lo = s.lo;
+  p.hi = s.hi;
+  p.findex = s.findex;
+  return p;
+}
+
+}  // namespace
+
+std::string RowSystem::validate() const {
+  std::ostringstream os;
+  const int n = size();
+  if (b.size() != n || lo.size() != n || hi.size() != n || cfm.size() != n) {
+    os << "row arrays disagree: " << n << " rows, b " << b.size() << ", lo " << lo.size() << ", hi "
+       << hi.size() << ", cfm " << cfm.size();
+    return os.str();
+  }
+  const int nb = static_cast<int>(bodies.size());
+  for (int k = 0; k < nb; ++k) {
+    const BodyInverseMass& body = bodies[k];
+    if (!std::isfinite(body.invMass) || body.invMass < 0 || !body.invInertia.allFinite()) {
+      os << "body " << k << " has an invalid inverse mass or inertia";
+      return os.str();
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    const ConstraintRow& r = rows[i];
+    if (r.bodyA < -1 || r.bodyA >= nb || r.bodyB < -1 || r.bodyB >= nb) {
+      os << "row " << i << " names body " << r.bodyA << "/" << r.bodyB << " of " << nb;
+      return os.str();
+    }
+    if (!r.jA.allFinite() || !r.jB.allFinite()) {
+      os << "row " << i << " has a non-finite Jacobian";
+      return os.str();
+    }
+    if (!std::isfinite(cfm[i]) || cfm[i] < 0) {
+      os << "row " << i << " has cfm " << cfm[i] << " (must be finite and >= 0)";
+      return os.str();
+    }
+  }
+  // Problem::validate checks b, bounds and findex; give it a matching identity-sized shell.
+  Problem shell = boundsOnly(*this);
+  shell.setA(SparseMatrix(n, n));
+  return shell.validate();
+}
+
+std::vector<Vector6> RowSystem::bodyVelocities(const Vector& x) const {
+  std::vector<Vector6> v(bodies.size(), Vector6::Zero());
+  for (int i = 0; i < size(); ++i) {
+    const ConstraintRow& r = rows[i];
+    if (r.bodyA >= 0) v[r.bodyA] += applyInverseMass(bodies[r.bodyA], r.jA) * x[i];
+    if (r.bodyB >= 0) v[r.bodyB] += applyInverseMass(bodies[r.bodyB], r.jB) * x[i];
+  }
+  return v;
+}
+
+Vector RowSystem::slack(const Vector& x) const {
+  const std::vector<Vector6> v = bodyVelocities(x);
+  Vector w(size());
+  for (int i = 0; i < size(); ++i) {
+    const ConstraintRow& r = rows[i];
+    double wi = cfm[i] * x[i] + b[i];
+    if (r.bodyA >= 0) wi += r.jA.dot(v[r.bodyA]);
+    if (r.bodyB >= 0) wi += r.jB.dot(v[r.bodyB]);
+    w[i] = wi;
+  }
+  return w;
+}
+
+Problem RowSystem::assemble(bool sparse) const {
+  const int n = size();
+  // Rows touching each body: only rows sharing a body couple in J M^-1 J^T.
+  std::vector<std::vector<std::pair<int, const Vector6*>>> touching(bodies.size());
+  for (int i = 0; i < n; ++i) {
+    if (rows[i].bodyA >= 0) touching[rows[i].bodyA].push_back({i, &rows[i].jA});
+    if (rows[i].bodyB >= 0) touching[rows[i].bodyB].push_back({i, &rows[i].jB});
+  }
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (int i = 0; i < n; ++i) triplets.emplace_back(i, i, cfm[i]);
+  for (std::size_t k = 0; k < bodies.size(); ++k) {
+    for (const auto& [i, ji] : touching[k]) {
+      const Vector6 mji = applyInverseMass(bodies[k], *ji);
+      for (const auto& [j, jj] : touching[k]) triplets.emplace_back(i, j, jj->dot(mji));
+    }
+  }
+  Problem p = boundsOnly(*this);
+  if (sparse) {
+    SparseMatrix A(n, n);
+    A.setFromTriplets(triplets.begin(), triplets.end());
+    p.setA(std::move(A));
+  } else {
+    DenseMatrix A = DenseMatrix::Zero(n, n);
+    for (const auto& t : triplets) A(t.row(), t.col()) += t.value();
+    p.setA(std::move(A));
+  }
+  return p;
+}
+
+Result RowPgs::solve(const RowSystem& s, Vector& x) {
+  const double t0 = nowSeconds();
+  const Options& opt = options_;
+  Result result;
+  if (std::string why = s.validate(); !why.empty()) {
+    result.status = Status::InvalidInput;
+    result.message = why;
+    return result;
+  }
+  if (!(opt.relaxation > 0 && opt.relaxation < 2)) {
+    result.status = Status::InvalidInput;
+    result.message = "relaxation outside (0, 2)";
+    return result;
+  }
+  const int n = s.size();
+  Vector xs = (opt.warmStart && x.size() == n && x.allFinite()) ? x : Vector::Zero(n);
+
+  // Per row: M^-1 J^T blocks and 1 / A_ii.
+  std::vector<Vector6> mA(n), mB(n);
+  Vector invDiag(n);
+  for (int i = 0; i < n; ++i) {
+    const ConstraintRow& r = s.rows[i];
+    mA[i] = r.bodyA >= 0 ? applyInverseMass(s.bodies[r.bodyA], r.jA) : Vector6::Zero();
+    mB[i] = r.bodyB >= 0 ? applyInverseMass(s.bodies[r.bodyB], r.jB) : Vector6::Zero();
+    const double d = r.jA.dot(mA[i]) + r.jB.dot(mB[i]) + s.cfm[i];
+    if (!(d > 0)) {
+      std::ostringstream os;
+      os << "row " << i << " has A_ii = " << d << ": pgs needs a positive diagonal";
+      result.status = Status::Failed;
+      result.message = os.str();
+      x = xs;
+      applyAccuracy(result,
+                    accuracy(xs, s.slack(xs), s.lo, s.hi, s.findex, s.b.lpNorm<Eigen::Infinity>()),
+                    opt.tolerance);
+      result.seconds = nowSeconds() - t0;
+      return result;
+    }
+    invDiag[i] = 1.0 / d;
+  }
+
+  std::vector<Vector6> v = s.bodyVelocities(xs);
+  const double bNorm = n ? s.b.lpNorm<Eigen::Infinity>() : 0.0;
+  const double omega = opt.relaxation;
+  auto effective = [&](int i, const Vector& lim) {
+    if (s.findex.empty() || s.findex[i] < 0) return lim[i];
+    return lim[i] * std::abs(xs[s.findex[i]]);
+  };
+  detail::SweepMonitor monitor(opt, result);
+  if (n == 0) {
+    result.status = Status::Converged;
+    result.message = "empty problem";
+  }
+  for (int sweep = 1; n > 0 && sweep <= opt.maxIterations; ++sweep) {
+    for (int i = 0; i < n; ++i) {
+      const ConstraintRow& r = s.rows[i];
+      double wi = s.cfm[i] * xs[i] + s.b[i];
+      if (r.bodyA >= 0) wi += r.jA.dot(v[r.bodyA]);
+      if (r.bodyB >= 0) wi += r.jB.dot(v[r.bodyB]);
+      const double xi =
+          std::clamp(xs[i] - omega * wi * invDiag[i], effective(i, s.lo), effective(i, s.hi));
+      const double dx = xi - xs[i];
+      if (dx == 0) continue;
+      xs[i] = xi;
+      if (r.bodyA >= 0) v[r.bodyA] += mA[i] * dx;
+      if (r.bodyB >= 0) v[r.bodyB] += mB[i] * dx;
+    }
+    if (monitor.wantsCheck(sweep) &&
+        monitor.stop(sweep, accuracy(xs, s.slack(xs), s.lo, s.hi, s.findex, bNorm)))
+      break;
+  }
+  applyAccuracy(result, accuracy(xs, s.slack(xs), s.lo, s.hi, s.findex, bNorm), opt.tolerance);
+  x = std::move(xs);
+  result.seconds = nowSeconds() - t0;
+  return result;
+}
+
+}  // namespace mlcp

@@ -1,0 +1,99 @@
+#include "mlcp/solver.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <sstream>
+
+#include "mlcp/residual.hpp"
+
+namespace mlcp {
+
+const char* toString(Status s) {
+  switch (s) {
+    case Status::Converged: return "converged";
+    case Status::MaxIterations: return "max-iterations";
+    case Status::TimeLimit: return "time-limit";
+    case Status::Failed: return "failed";
+    case Status::Unsupported: return "unsupported";
+    case Status::InvalidInput: return "invalid-input";
+    case Status::NumericalIssue: return "numerical-issue";
+  }
+  return "unknown";
+}
+
+double nowSeconds() {
+  using Clock = std::chrono::steady_clock;
+  return std::chrono::duration<double>(Clock::now().time_since_epoch()).count();
+}
+
+bool Solver::outOfTime(double startSeconds) const {
+  return options_.timeBudget > 0 && nowSeconds() - startSeconds > options_.timeBudget;
+}
+
+void applyAccuracy(Result& r, const Accuracy& a, double tolerance) {
+  r.residual = a.residual;
+  r.complementarity = a.complementarity;
+  r.boundViolation = a.boundViolation;
+  if (!a.finite) {
+    r.status = Status::NumericalIssue;
+    if (r.message.empty()) r.message = "the iterate holds NaN or Inf";
+  } else if (a.residual <= tolerance) {
+    // An iterative method may stop on its own criterion; the checked residual decides.
+    if (r.status == Status::MaxIterations || r.status == Status::TimeLimit) {
+      r.status = Status::Converged;
+      r.message = "residual within tolerance";
+    }
+  } else if (r.status == Status::Converged) {
+    std::ostringstream os;
+    os << "finished with residual " << a.residual << " above tolerance " << tolerance;
+    if (!r.message.empty()) os << " (" << r.message << ")";
+    r.status = Status::Failed;
+    r.message = os.str();
+  }
+}
+
+Result Solver::solve(const Problem& problem, Vector& x) {
+  const bool useGuess = options_.warmStart && x.size() == problem.b.size() && x.allFinite();
+  return runChecked(problem, useGuess ? x : Vector::Zero(problem.b.size()), x);
+}
+
+Result Solver::solveWithGuess(const Problem& problem, const Vector& guess, Vector& x) {
+  if (guess.size() != problem.b.size()) {
+    Result r;
+    r.status = Status::InvalidInput;
+    std::ostringstream os;
+    os << "guess has " << guess.size() << " entries, expected " << problem.b.size();
+    r.message = os.str();
+    return r;
+  }
+  if (!guess.allFinite()) {
+    Result r;
+    r.status = Status::InvalidInput;
+    r.message = "guess holds NaN or Inf";
+    return r;
+  }
+  return runChecked(problem, guess, x);
+}
+
+Result Solver::runChecked(const Problem& problem, Vector start, Vector& x) {
+  const double t0 = nowSeconds();
+  Result r;
+  if (std::string why = problem.validate(); !why.empty()) {
+    r.status = Status::InvalidInput;
+    r.message = why;
+    r.seconds = nowSeconds() - t0;
+    return r;
+  }
+  r.status = Status::Failed;
+  run(problem, start, r);
+  if (r.status == Status::InvalidInput || r.status == Status::Unsupported) {
+    r.seconds = nowSeconds() - t0;
+    return r;  // x untouched: nothing was solved
+  }
+  applyAccuracy(r, accuracy(problem, start), options_.tolerance);
+  x = std::move(start);
+  r.seconds = nowSeconds() - t0;
+  return r;
+}
+
+}  // namespace mlcp
