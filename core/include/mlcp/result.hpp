@@ -1,6 +1,7 @@
 // mlcp/result.hpp: what every solver takes (Options) and gives back (Result).
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -56,12 +57,15 @@ struct Options {
   double pivotTolerance = 1e-12;
 };
 
+inline constexpr double kNotComputed = std::numeric_limits<double>::quiet_NaN();
+
 struct Result {
   Status status = Status::InvalidInput;
-  int iterations = 0;           // sweeps, or pivots for pivoting methods
-  double residual = 0;          // scaled natural-map residual at the returned x
-  double complementarity = 0;   // max_i of the complementarity gap at the returned x
-  double boundViolation = 0;    // max_i distance of x_i outside its effective bounds
+  // The accuracy fields are NaN when nothing was solved (InvalidInput, Unsupported).
+  int iterations = 0;                     // sweeps, or pivots for pivoting methods
+  double residual = kNotComputed;         // scaled natural-map residual at the returned x
+  double complementarity = kNotComputed;  // max_i of the complementarity gap at the returned x
+  double boundViolation = kNotComputed;   // max_i distance of x_i outside its effective bounds
   double seconds = 0;           // wall time of the solve, including the final residual check
   std::string message;          // why it stopped, in words
   std::vector<double> history;  // residual per iteration when Options::recordHistory

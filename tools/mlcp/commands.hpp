@@ -1,0 +1,25 @@
+// The `mlcp` program's subcommands. Each registers itself on the CLI11 app and runs after
+// parsing; exit codes: 0 solved to tolerance, 1 not solved (or failed), 2 invalid input.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <functional>
+
+namespace mlcp::cli {
+
+enum ExitCode { kSolved = 0, kNotSolved = 1, kInvalidInput = 2 };
+
+// Adds the subcommand; the returned function runs it (call it only if the subcommand parsed).
+using Runner = std::function<int()>;
+Runner addSolveCommand(CLI::App& app);
+Runner addTableCommand(CLI::App& app);
+
+// Shared by subcommands that take solver settings.
+struct SolverSettings {
+  double tolerance = 1e-10;
+  int maxIterations = 1000;
+  double relaxation = 1.0;
+};
+void addSolverSettings(CLI::App& cmd, SolverSettings& s);
+
+}  // namespace mlcp::cli

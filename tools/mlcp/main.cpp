@@ -1,0 +1,29 @@
+// mlcp: solve problem files, compare solvers. `mlcp --help` lists the subcommands.
+#include <iostream>
+#include <vector>
+
+#include "commands.hpp"
+#include "mlcp/registry.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"mlcp: mixed linear complementarity solvers for physics engines.\nSolvers: " +
+               mlcp::solverNames()};
+  app.require_subcommand(1);
+  std::vector<std::pair<CLI::App*, mlcp::cli::Runner>> commands;
+  auto add = [&](mlcp::cli::Runner (*adder)(CLI::App&)) {
+    const std::size_t before = app.get_subcommands({}).size();
+    mlcp::cli::Runner run = adder(app);
+    commands.emplace_back(app.get_subcommands({}).at(before), std::move(run));
+  };
+  add(&mlcp::cli::addSolveCommand);
+  add(&mlcp::cli::addTableCommand);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : mlcp::cli::kInvalidInput;
+  }
+  for (auto& [cmd, run] : commands)
+    if (cmd->parsed()) return run();
+  return mlcp::cli::kInvalidInput;
+}
