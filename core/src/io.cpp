@@ -114,7 +114,7 @@ Problem parseProblemJson(const std::string& text, const std::string& source) {
   json doc;
   try {
     doc = json::parse(text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {
     fail(source, std::string("not valid JSON: ") + e.what());
   }
   if (!doc.is_object()) fail(source, "top level must be a JSON object");
@@ -252,9 +252,11 @@ DenseMatrix readSiconosDense(Tokens& t, int n) {
   if (rows != n || cols != n || rows2 != n || cols2 != n)
     fail(t.source(), "dense matrix is " + std::to_string(rows) + "x" + std::to_string(cols) +
                          ", expected " + std::to_string(n) + "x" + std::to_string(n));
+  // Siconos writes its column-major storage in sequence (NM_write_in_file), so each printed
+  // line is a column; the block files agree only when read this way.
   DenseMatrix M(n, n);
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j) M(i, j) = t.real("a matrix entry");
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) M(i, j) = t.real("a matrix entry");
   return M;
 }
 
@@ -342,7 +344,7 @@ Vector readVectorJson(const std::string& path) {
   json doc;
   try {
     doc = json::parse(slurp(path));
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {
     fail(path, std::string("not valid JSON: ") + e.what());
   }
   if (doc.is_object() && doc.contains("x")) doc = doc["x"];

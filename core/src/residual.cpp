@@ -6,8 +6,12 @@
 namespace mlcp {
 
 namespace {
-// a * b with the convention 0 * inf = 0 (a gap of inf times a zero force is no violation).
-double gapTimes(double gap, double force) { return force == 0 ? 0 : gap * force; }
+// w's violation times the distance to the bound it points at; with an infinite bound there is
+// no distance to measure and the violation is |w| itself.
+double gapTimes(double bound, double x, double force, double sign) {
+  if (force <= 0) return 0;
+  return std::isfinite(bound) ? force * std::max(sign * (x - bound), 0.0) : force;
+}
 }  // namespace
 
 Accuracy accuracy(const Vector& x, const Vector& w, const Vector& lo, const Vector& hi,
@@ -28,8 +32,8 @@ Accuracy accuracy(const Vector& x, const Vector& w, const Vector& lo, const Vect
     }
     const double xi = x[i], wi = w[i];
     r = std::max(r, std::abs(xi - std::clamp(xi - wi, l, h)));
-    const double cLo = gapTimes(std::max(xi - l, 0.0), std::max(wi, 0.0));
-    const double cHi = gapTimes(std::max(h - xi, 0.0), std::max(-wi, 0.0));
+    const double cLo = gapTimes(l, xi, wi, 1.0);
+    const double cHi = gapTimes(h, xi, -wi, -1.0);
     a.complementarity = std::max(a.complementarity, cLo + cHi);
     a.boundViolation = std::max({a.boundViolation, l - xi, xi - h});
   }

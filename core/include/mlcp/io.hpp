@@ -12,6 +12,7 @@
 //
 // Siconos LCP .dat files (find z >= 0, w = M z + q >= 0, z'w = 0; their convention is ours):
 // dense (storage 0) and sparse-block (storage 1) matrices, see ../shared/data/siconos/README.md.
+// Both store their values column by column (the dense form prints one column per line).
 //
 // Errors are thrown as FormatError, whose message names the file and what is wrong. A file
 // that parses but describes an invalid problem (lo > hi, findex out of range, ...) is reported
