@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# The mlcp program as a user runs it: exit codes 0 (solved), 1 (not solved), 2 (invalid input),
+# messages naming the file, JSON output. Prints "N passed, N failed".
+set -u
+mlcp=$1 data=$2 siconos=$3
+passed=0 failed=0
+check() {  # check NAME EXPECTED_CODE PATTERN -- command...
+  local name=$1 want=$2 pattern=$3
+  shift 4
+  local out code
+  out=$("$@" 2>&1)
+  code=$?
+  if [ "$code" -eq "$want" ] && grep -qE -- "$pattern" <<< "$out"; then
+    passed=$((passed + 1))
+  else
+    failed=$((failed + 1))
+    echo "FAIL $name: exit $code (want $want), output lacks /$pattern/:"
+    sed 's/^/    /' <<< "$out" | head -20
+  fi
+}
+check help 0 'pgs' -- "$mlcp" --help
+check solve-help 0 'lemke|pgs' -- "$mlcp" solve --help
+check spd 0 'converged' -- "$mlcp" solve "$data/spd.json" --solver pgs --tol 1e-9
+check boxed 0 'converged' -- "$mlcp" solve "$data/boxed.json" --solver pgs --tol 1e-9
+check findex 0 'converged' -- "$mlcp" solve "$data/findex.json" --solver pgs --tol 1e-9
+check siconos 0 'converged' -- "$mlcp" solve "$siconos/lcp/lcp_mmc.dat" --solver pgs --tol 1e-9
+check seed-pgs-refuses 1 'positive diagonal' -- "$mlcp" solve "$data/seed_lemke.json" --solver pgs
+check too-few-iterations 1 'max-iterations' -- "$mlcp" solve "$siconos/lcp/lcp_mmc.dat" --solver pgs --max-iter 3
+check gs-bounded 1 'unsupported' -- "$mlcp" solve "$data/spd.json" --solver gs
+check json 0 '"status": "converged"' -- "$mlcp" solve "$data/boxed.json" --solver pgs --json
+json=$("$mlcp" solve "$data/findex.json" --solver pgs --json)
+if python3 -c 'import json,sys; d=json.loads(sys.argv[1]); assert set(["solver","status","x","w","iterations","residual","seconds"]) <= set(d); assert len(d["x"]) == 3 and d["residual"] <= 1e-10' "$json"; then
+  passed=$((passed + 1))
+else
+  failed=$((failed + 1)); echo "FAIL json-fields: $json"
+fi
+check json-not-solved 1 '"status": "failed"' -- "$mlcp" solve "$data/seed_lemke.json" --solver pgs --json
+check guess 0 'converged' -- "$mlcp" solve "$data/spd.json" --solver pgs --guess "$data/spd_guess.json"
+check missing-file 2 'nope.json: cannot open' -- "$mlcp" solve "$data/nope.json"
+check truncated 2 'truncated.json: not valid JSON' -- "$mlcp" solve "$data/bad/truncated.json"
+check lo-above-hi 2 'lo_above_hi.json: row 1: lo = 3 > hi = 2' -- "$mlcp" solve "$data/bad/lo_above_hi.json"
+check findex-range 2 'findex\[1\] = 9 is out of range' -- "$mlcp" solve "$data/bad/findex_range.json"
+check short-dat 2 'short.dat: file ends before' -- "$mlcp" solve "$data/bad/short.dat"
+check unknown-solver 2 "unknown solver 'nosuch'" -- "$mlcp" solve "$data/spd.json" --solver nosuch
+check bad-guess 2 'guess has 1 entries' -- "$mlcp" solve "$data/spd.json" --guess "$data/one.json"
+check table 0 'lcp_deudeu.dat' -- "$mlcp" table "$siconos/lcp/lcp_deudeu.dat" --solvers pgs
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]

@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# Installs everything mlcp needs on Debian 12 (run as root, or with sudo available) and
+# fetches ODE's internal headers from Debian's source package. Idempotent and quick when
+# everything is already there. Used by tools/test.sh and tools/main.sh.
+set -euo pipefail
+repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+
+packages=(
+  build-essential cmake ninja-build pkg-config git
+  libeigen3-dev libsuitesparse-dev
+  libbullet-dev libode-dev
+  libgtest-dev libbenchmark-dev nlohmann-json3-dev libcli11-dev
+  clang-format dpkg-dev python3 python3-venv
+)
+
+sudo_if_needed() { if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi; }
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+
+# ODE's internal headers come from the Debian source package `ode`: apt needs a deb-src entry.
+src_list=/etc/apt/sources.list.d/mlcp-deb-src.sources
+need_update=0
+if [ ! -f "$src_list" ]; then
+  echo "setup: adding a deb-src entry for Debian bookworm ($src_list)"
+  sudo_if_needed tee "$src_list" > /dev/null <<'SRC'
+Types: deb-src
+URIs: http://deb.debian.org/debian
+Suites: bookworm
+Components: main
+Signed-By: /usr/share/keyrings/debian-archive-keyring.gpg
+SRC
+  need_update=1
+fi
+
+if [ ${#missing[@]} -gt 0 ] || [ $need_update -eq 1 ]; then
+  echo "setup: installing ${missing[*]:-(sources only)}"
+  sudo_if_needed apt-get update -qq
+  [ ${#missing[@]} -eq 0 ] || DEBIAN_FRONTEND=noninteractive sudo_if_needed apt-get install -y -qq --no-install-recommends "${missing[@]}" > /dev/null
+fi
+
+if [ -x "$repo/tools/fetch-ode-source.sh" ]; then
+  "$repo/tools/fetch-ode-source.sh"
+fi
+
+# Python tools (charts) run from a venv built from tools/requirements.txt.
+if [ -f "$repo/tools/requirements.txt" ]; then
+  venv="$repo/.venv"
+  stamp="$venv/.requirements"
+  if [ ! -f "$stamp" ] || ! cmp -s "$repo/tools/requirements.txt" "$stamp"; then
+    echo "setup: building the Python venv in $venv"
+    /usr/bin/python3 -m venv "$venv"
+    "$venv/bin/pip" install -q --disable-pip-version-check -r "$repo/tools/requirements.txt"
+    cp "$repo/tools/requirements.txt" "$stamp"
+  fi
+fi
+echo "setup: ok"

@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# The whole test suite: set-up, a Release build with every test (ctest), then the same tests
+# under AddressSanitizer + UndefinedBehaviorSanitizer. Exit status is non-zero on any failure.
+#   tools/test.sh            everything
+#   tools/test.sh --fast     the Release build only (no sanitizer build)
+set -euo pipefail
+repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+jobs=$(nproc 2>/dev/null || echo 2)
+"$repo/tools/setup.sh"
+
+echo "== Release build and tests"
+"$repo/tools/build.sh" "$repo/build"
+ctest --test-dir "$repo/build" --output-on-failure -j "$jobs"
+
+if [ "${1:-}" != "--fast" ]; then
+  echo "== Sanitizer build (ASan + UBSan) and tests"
+  "$repo/tools/build.sh" "$repo/build-asan" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMLCP_SANITIZE=ON
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    ctest --test-dir "$repo/build-asan" --output-on-failure -j "$jobs"
+fi
+echo "tools/test.sh: all tests passed"
