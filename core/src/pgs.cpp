@@ -9,26 +9,24 @@
 
 namespace mlcp {
 
-std::string PgsSolver::refuse(const Problem& problem) const {
-  const double omega = options().relaxation;
-  if (!(omega > 0 && omega < 2)) {
-    std::ostringstream os;
-    os << "relaxation " << omega << " is outside (0, 2)";
-    return os.str();
-  }
-  (void)problem;
-  return "";
-}
+std::string PgsSolver::refuse(const Problem&) const { return ""; }
 
 std::string GaussSeidelSolver::refuse(const Problem& problem) const {
   if (problem.classify() != ProblemClass::Linear && problem.size() > 0)
     return "gs solves problems without bounds (every row -inf..inf); use pgs for bounded rows";
-  return PgsSolver::refuse(problem);
+  return "";
 }
 
 void PgsSolver::run(const Problem& problem, Vector& x, Result& result) {
   const Options& opt = options();
   const int n = problem.size();
+  if (!(opt.relaxation > 0 && opt.relaxation < 2)) {
+    std::ostringstream os;
+    os << "relaxation " << opt.relaxation << " is outside (0, 2)";
+    result.status = Status::InvalidInput;
+    result.message = os.str();
+    return;
+  }
   if (std::string why = refuse(problem); !why.empty()) {
     result.status = Status::Unsupported;
     result.message = why;
