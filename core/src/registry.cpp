@@ -1,5 +1,6 @@
 #include "mlcp/registry.hpp"
 
+#include "mlcp/lemke.hpp"
 #include "mlcp/pgs.hpp"
 
 namespace mlcp {
@@ -15,6 +16,8 @@ const std::vector<SolverInfo>& solvers() {
   static const std::vector<SolverInfo> list = {
       {"gs", "Gauss-Seidel for problems without bounds (linear systems)", &make<GaussSeidelSolver>},
       {"pgs", "projected Gauss-Seidel / SOR for boxed problems with findex", &make<PgsSolver>},
+      {"lemke", "Lemke's lexicographic complementary pivoting, dense; boxes, findex by fixed point",
+       &make<LemkeSolver>},
   };
   return list;
 }

@@ -1,0 +1,94 @@
+// mlcp/lemke.hpp: Lemke's complementary pivoting method (registry "lemke") and its tableau trace.
+//
+// The method (the seed notes, section 1; Cottle, Pang and Stone, The Linear Complementarity
+// Problem, section 4.4). For the standard LCP w = M z + q, w, z >= 0, w'z = 0, add an
+// artificial variable z0 with a column of ones, w - M z - e z0 = q, and keep the tableau
+//
+//     [ I | -M | -e | q ]        basis w, columns w_1..w_n, z_1..z_n, z_0.
+//
+// 1. If q >= 0, (w, z) = (q, 0) solves the problem (no pivot).
+// 2. Otherwise z0 enters at the row of the most negative q; every basic value is then >= 0.
+// 3. The entering variable is the complement of the one that just left. If its column has no
+//    positive entry the method stops with ray termination (Status::Failed). Otherwise the
+//    minimum-ratio test picks the leaving row and a Gauss-Jordan pivot exchanges the two.
+// 4. When z0 leaves, the basis is complementary and the table holds a solution.
+//
+// Degeneracy: ties of the ratio test are broken by the lexicographic rule (rows of
+// [rhs, B^-1] divided by the pivot entry; B^-1 sits in the w-columns), which is equivalent to
+// perturbing q by (eps, eps^2, ..., eps^n) and makes cycling impossible, so the method always
+// ends after finitely many pivots. z0's row wins every tie of the plain ratio (it ends the
+// method at once).
+//
+// When it works. For a P-matrix M (e.g. symmetric positive definite) Lemke finds the unique
+// solution for every q. For a copositive-plus M (e.g. positive semidefinite, and the
+// [[0, A'], [-A, 0]] matrices of linear programs) it finds a solution whenever the LCP is
+// feasible, and ray termination then proves infeasibility. For other matrices (bimatrix games,
+// general indefinite M) it may end on a ray although a solution exists. Murty's examples take
+// 2^n - 1 pivots; the pivot limit is Options::maxPivots, 0 meaning 50 m + 100 for an LCP of
+// size m (Status::MaxIterations when reached).
+//
+// Cost. Dense tableau of m x (2m + 2) doubles (A is converted with Problem::toDense()); each
+// pivot costs O(m^2), a solve typically O(m) pivots. Meant for small or medium dense problems.
+//
+// Accuracy. The tableau is pivoted for complementarity, not for stability, so its final values
+// carry round-off. The solver therefore re-solves the final active set in the original
+// problem with an LU (partial pivoting) of the n x n system "w_i = 0 for rows strictly inside
+// their bounds, x_i = bound for the others" plus one step of iterative refinement, and returns
+// whichever of the two answers has the smaller residual.
+//
+// Problems that are not standard LCPs become one by a change of variables (m >= n rows):
+//   - lo_i == hi_i (fixed):       x_i = lo_i, substituted into b; the row leaves the LCP.
+//   - [lo, +inf):                 x = lo + z, z >= 0 complementary to w.
+//   - (-inf, hi]:                 x = hi - z, z >= 0 complementary to -w.
+//   - [lo, hi], both finite:      x = lo + z1 and the negative part of w, z2 = max(-w, 0):
+//                                 z1 >= 0 complementary to  w + z2 >= 0,
+//                                 z2 >= 0 complementary to  hi - lo - z1 >= 0.
+//     (x inside: z2 = 0 and w = 0; x = lo: w >= 0; x = hi: w = -z2 <= 0.)
+//   - (-inf, +inf) (equality):    eliminated by the Schur complement when the block A_FF of
+//                                 free rows is nonsingular: x_F = -A_FF^-1 (b_F + A_FK x_K),
+//                                 leaving A_KK - A_KF A_FF^-1 A_FK (SPD stays SPD, a P-matrix
+//                                 stays a P-matrix). Otherwise x = z+ - z-, both >= 0, with
+//                                 complementary rows w >= 0 and -w >= 0.
+// The transformed matrix is positive semidefinite when A is, so the guarantees above carry over
+// for PSD A; for a P-matrix A with finite boxes the doubled matrix is no longer a P-matrix and
+// ray termination, though not expected, is reported as it is.
+//
+// Friction (findex) rows: an outer fixed point on the bounds. Iteration k solves the boxed
+// problem with bounds lo_i |x_j|, hi_i |x_j| taken from the previous answer (from the start
+// point, zero unless a guess is given, at k = 1), then re-solves its active set with the true
+// coupled bounds (x_i = +-mu_i |x_j| as linear equations). It stops when the residual with the
+// true bounds is within Options::tolerance (Converged), when the bounds stop moving above the
+// tolerance (Failed), or after Options::maxIterations outer steps (MaxIterations). The fixed
+// point need not converge (large mu, strongly coupled contacts); the status then says so.
+// Result::iterations counts pivots over all outer steps.
+//
+// Warm start: a guess only seeds the friction bounds; pivoting always starts from the slack
+// basis.
+#pragma once
+
+#include <iosfwd>
+
+#include "mlcp/solver.hpp"
+
+namespace mlcp {
+
+class LemkeSolver : public Solver {
+ public:
+  const char* name() const override { return "lemke"; }
+
+ protected:
+  void run(const Problem& problem, Vector& x, Result& result) override;
+};
+
+// Runs Lemke on a standard LCP (lo = 0, hi = +inf, no findex) and prints every tableau to out:
+// the column labels w1..wn z1..zn z0 | q, one row per basic variable, and before each table
+// the pivot that produced it ("pivot 2: z2 enters, w1 leaves (row 1)"). Entries are exact
+// fractions when every entry of A and b is an integer (64-bit fractions; if one would overflow
+// the trace restarts in decimals and says so), decimals otherwise. Uses options.maxPivots and
+// options.tolerance. Returns the outcome like a solver would (status, pivots in iterations,
+// message, accuracy of the answer) and stores the answer in *x when x is given. Other problem
+// classes are refused with Status::Unsupported and a message, printing nothing.
+Result traceLemke(const Problem& problem, std::ostream& out, const Options& options = Options(),
+                  Vector* x = nullptr);
+
+}  // namespace mlcp
