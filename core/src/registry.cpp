@@ -1,5 +1,7 @@
 #include "mlcp/registry.hpp"
 
+#include "mlcp/fallback.hpp"
+#include "mlcp/ldlt.hpp"
 #include "mlcp/lemke.hpp"
 #include "mlcp/pgs.hpp"
 
@@ -18,6 +20,10 @@ const std::vector<SolverInfo>& solvers() {
       {"pgs", "projected Gauss-Seidel / SOR for boxed problems with findex", &make<PgsSolver>},
       {"lemke", "Lemke's lexicographic complementary pivoting, dense; boxes, findex by fixed point",
        &make<LemkeSolver>},
+      {"ldlt", "sparse LDL^T (or LU) direct solve for problems without bounds; pattern reused",
+       &make<LdltSolver>},
+      {"auto", "picks a chain per problem class and size, with verified fallback",
+       &make<AutoSolver>},
   };
   return list;
 }
@@ -32,6 +38,18 @@ std::string solverNames() {
 }
 
 std::unique_ptr<Solver> makeSolver(const std::string& name, std::string* error) {
+  if (name.find('>') != std::string::npos) {  // a fallback chain "a>b>c"
+    std::vector<std::unique_ptr<Solver>> chain;
+    std::size_t start = 0;
+    while (start <= name.size()) {
+      const std::size_t end = std::min(name.find('>', start), name.size());
+      std::unique_ptr<Solver> member = makeSolver(name.substr(start, end - start), error);
+      if (!member) return nullptr;
+      chain.push_back(std::move(member));
+      start = end + 1;
+    }
+    return std::make_unique<FallbackSolver>(std::move(chain));
+  }
   for (const SolverInfo& info : solvers())
     if (name == info.name) return info.make();
   if (error) *error = "unknown solver '" + name + "' (known: " + solverNames() + ")";

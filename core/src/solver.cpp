@@ -60,6 +60,7 @@ Result Solver::solve(const Problem& problem, Vector& x) {
 Result Solver::solveWithGuess(const Problem& problem, const Vector& guess, Vector& x) {
   if (guess.size() != problem.b.size()) {
     Result r;
+    r.solver = name();
     r.status = Status::InvalidInput;
     std::ostringstream os;
     os << "guess has " << guess.size() << " entries, expected " << problem.b.size();
@@ -68,6 +69,7 @@ Result Solver::solveWithGuess(const Problem& problem, const Vector& guess, Vecto
   }
   if (!guess.allFinite()) {
     Result r;
+    r.solver = name();
     r.status = Status::InvalidInput;
     r.message = "guess holds NaN or Inf";
     return r;
@@ -85,6 +87,7 @@ Result Solver::runChecked(const Problem& problem, Vector start, Vector& x) {
     return r;
   }
   r.status = Status::Failed;
+  r.solver = name();
   run(problem, start, r);
   if (r.status == Status::InvalidInput || r.status == Status::Unsupported) {
     r.seconds = nowSeconds() - t0;

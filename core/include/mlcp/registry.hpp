@@ -18,6 +18,7 @@ struct SolverInfo {
 // Every registered solver, in a fixed order.
 const std::vector<SolverInfo>& solvers();
 // A new solver of that name, or nullptr (with a message listing the valid names in *error).
+// "a>b>c" makes a verified fallback chain of registered solvers (fallback.hpp).
 std::unique_ptr<Solver> makeSolver(const std::string& name, std::string* error = nullptr);
 // "gs, pgs, ..." for messages and help texts.
 std::string solverNames();

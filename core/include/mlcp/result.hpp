@@ -69,6 +69,10 @@ struct Result {
   double seconds = 0;           // wall time of the solve, including the final residual check
   std::string message;          // why it stopped, in words
   std::vector<double> history;  // residual per iteration when Options::recordHistory
+  // Which solver produced x ("pgs", ...): differs from the one asked for when a fallback chain
+  // or `auto` chose; fallbacks counts the solvers that were tried and rejected before it.
+  std::string solver;
+  int fallbacks = 0;
 
   bool converged() const { return status == Status::Converged; }
 };

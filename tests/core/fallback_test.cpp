@@ -1,0 +1,165 @@
+// ldlt, fallback chains and auto: the fallback happens, is counted and reported.
+#include "mlcp/fallback.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "common/generators.hpp"
+#include "mlcp/ldlt.hpp"
+#include "mlcp/pgs.hpp"
+#include "mlcp/registry.hpp"
+#include "mlcp/residual.hpp"
+
+namespace mlcp {
+namespace {
+
+Problem linearSparse(int n, unsigned seed) {
+  test::Generator g(seed);
+  test::KnownProblem kp = g.linear(g.spd(n));
+  kp.problem.setA(kp.problem.toSparse());
+  return kp.problem;
+}
+
+TEST(Ldlt, SolvesSymmetricAndNonSymmetricSystems) {
+  LdltSolver ldlt;
+  Vector x;
+  const Problem p = linearSparse(40, 1);
+  Result r = ldlt.solve(p, x);
+  ASSERT_TRUE(r.converged()) << r.message;
+  EXPECT_LE(residual(p, x), 1e-13);
+  EXPECT_EQ(r.iterations, 1);
+
+  DenseMatrix A(3, 3);
+  A << 4, 1, 0, 2, 5, 1, 0, 3, 6;  // not symmetric
+  Problem q(A, Vector::Constant(3, -1.0));
+  q.lo.setConstant(-kInf);
+  q.hi.setConstant(kInf);
+  r = ldlt.solve(q, x);
+  ASSERT_TRUE(r.converged()) << r.message;
+  EXPECT_NE(r.message.find("LU"), std::string::npos);
+  EXPECT_LE((A * x - Vector::Ones(3)).lpNorm<Eigen::Infinity>(), 1e-13);
+}
+
+TEST(Ldlt, ReusesTheSymbolicAnalysisWhileThePatternHolds) {
+  LdltSolver ldlt;
+  Vector x;
+  Problem p = linearSparse(30, 2);
+  ASSERT_TRUE(ldlt.solve(p, x).converged());
+  SparseMatrix scaled = p.sparseA() * 2.0;  // same pattern, new values
+  p.setA(scaled);
+  ASSERT_TRUE(ldlt.solve(p, x).converged());
+  EXPECT_EQ(ldlt.analyses(), 1);
+  ASSERT_TRUE(ldlt.solve(linearSparse(31, 3), x).converged());
+  EXPECT_EQ(ldlt.analyses(), 2);
+}
+
+TEST(Ldlt, RefusesBoundsAndReportsSingularSystems) {
+  LdltSolver ldlt;
+  Vector x;
+  EXPECT_EQ(ldlt.solve(test::seedLemkeExample(), x).status, Status::Unsupported);
+  DenseMatrix A = DenseMatrix::Zero(2, 2);
+  A(0, 0) = 1;
+  Problem singular(A, Vector::Ones(2));
+  singular.lo.setConstant(-kInf);
+  singular.hi.setConstant(kInf);
+  const Result r = ldlt.solve(singular, x);
+  EXPECT_FALSE(r.converged());
+  EXPECT_TRUE(r.status == Status::Failed || r.status == Status::NumericalIssue)
+      << toString(r.status);
+}
+
+// A primary that breaks in a chosen way, to check the chain reacts.
+class BrokenSolver : public Solver {
+ public:
+  explicit BrokenSolver(bool nan) : nan_(nan) {}
+  const char* name() const override { return nan_ ? "nan-maker" : "failer"; }
+
+ protected:
+  void run(const Problem&, Vector& x, Result& result) override {
+    if (nan_) {
+      x.setConstant(std::nan(""));
+      result.status = Status::Converged;  // a lying solver: the base must catch it
+    } else {
+      result.status = Status::Failed;
+      result.message = "injected failure";
+    }
+  }
+
+ private:
+  bool nan_;
+};
+
+FallbackSolver chainWith(std::unique_ptr<Solver> primary) {
+  std::vector<std::unique_ptr<Solver>> chain;
+  chain.push_back(std::move(primary));
+  chain.push_back(std::make_unique<PgsSolver>());
+  return FallbackSolver(std::move(chain));
+}
+
+TEST(Fallback, NaNFromThePrimaryFallsBackAndIsCounted) {
+  FallbackSolver chain = chainWith(std::make_unique<BrokenSolver>(true));
+  test::Generator g(4);
+  const test::KnownProblem kp = g.friction(5);
+  Vector x;
+  const Result r = chain.solve(kp.problem, x);
+  ASSERT_TRUE(r.converged()) << r.message;
+  EXPECT_EQ(r.fallbacks, 1);
+  EXPECT_EQ(r.solver, "pgs");
+  EXPECT_NE(r.message.find("nan-maker: numerical-issue"), std::string::npos) << r.message;
+  EXPECT_LE(residual(kp.problem, x), 1e-10);
+}
+
+TEST(Fallback, AFailingPrimaryFallsBack) {
+  FallbackSolver chain = chainWith(std::make_unique<BrokenSolver>(false));
+  EXPECT_EQ(chain.name(), std::string("failer>pgs"));
+  test::Generator g(5);
+  const test::KnownProblem kp = g.boxed(g.spd(10));
+  Vector x;
+  const Result r = chain.solve(kp.problem, x);
+  ASSERT_TRUE(r.converged());
+  EXPECT_EQ(r.fallbacks, 1);
+  EXPECT_NE(r.message.find("injected failure"), std::string::npos) << r.message;
+}
+
+TEST(Fallback, NothingConvergesSaysSoAndKeepsTheBestAnswer) {
+  std::unique_ptr<Solver> chain = makeSolver("gs>pgs");
+  ASSERT_TRUE(chain);
+  chain->options().maxIterations = 1;
+  test::Generator g(6);
+  const test::KnownProblem kp = g.boxed(g.spd(30, 0.01));
+  Vector x;
+  const Result r = chain->solve(kp.problem, x);
+  EXPECT_EQ(r.status, Status::MaxIterations);
+  EXPECT_EQ(r.fallbacks, 2);
+  EXPECT_EQ(r.solver, "pgs");
+  EXPECT_NE(r.message.find("no solver converged"), std::string::npos);
+  EXPECT_NE(r.message.find("gs: unsupported"), std::string::npos) << r.message;
+  EXPECT_EQ(x.size(), 30);
+}
+
+TEST(Fallback, UnknownMemberIsAClearError) {
+  std::string error;
+  EXPECT_FALSE(makeSolver("pgs>nosuch", &error));
+  EXPECT_NE(error.find("unknown solver 'nosuch'"), std::string::npos) << error;
+}
+
+TEST(Auto, ChoosesByProblemClass) {
+  std::unique_ptr<Solver> solver = makeSolver("auto");
+  Vector x;
+  Result r = solver->solve(linearSparse(20, 7), x);
+  ASSERT_TRUE(r.converged()) << r.message;
+  EXPECT_EQ(r.solver, "ldlt");
+  EXPECT_NE(r.message.find("linear"), std::string::npos);
+
+  test::Generator g(8);
+  r = solver->solve(g.friction(4).problem, x);
+  EXPECT_TRUE(r.converged()) << r.message;
+  EXPECT_NE(r.message.find("findex"), std::string::npos) << r.message;
+
+  r = solver->solve(Problem(DenseMatrix(0, 0), Vector(0)), x);
+  EXPECT_TRUE(r.converged());
+}
+
+}  // namespace
+}  // namespace mlcp
