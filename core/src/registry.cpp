@@ -1,5 +1,6 @@
 #include "mlcp/registry.hpp"
 
+#include "mlcp/dantzig.hpp"
 #include "mlcp/fallback.hpp"
 #include "mlcp/ldlt.hpp"
 #include "mlcp/lemke.hpp"
@@ -18,6 +19,8 @@ const std::vector<SolverInfo>& solvers() {
   static const std::vector<SolverInfo> list = {
       {"gs", "Gauss-Seidel for problems without bounds (linear systems)", &make<GaussSeidelSolver>},
       {"pgs", "projected Gauss-Seidel / SOR for boxed problems with findex", &make<PgsSolver>},
+      {"dantzig", "Dantzig principal pivoting for boxed problems with findex (ODE-style)",
+       &make<DantzigSolver>},
       {"lemke", "Lemke's lexicographic complementary pivoting, dense; boxes, findex by fixed point",
        &make<LemkeSolver>},
       {"ldlt", "sparse LDL^T (or LU) direct solve for problems without bounds; pattern reused",

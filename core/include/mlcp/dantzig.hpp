@@ -1,0 +1,98 @@
+// mlcp/dantzig.hpp: Dantzig-Cottle principal pivoting for boxed MLCPs with findex (registry
+// "dantzig"), in the spirit of ODE's dSolveLCP / Bullet's btDantzigLCP, written anew.
+//
+// Method. Rows are added one at a time. Every processed row is in one of the index sets
+//
+//     C (clamped):  w_i = 0,  lo_i <= x_i <= hi_i     (x_C is unknown, solved for)
+//     N (at bound): x_i = lo_i with w_i >= 0, or x_i = hi_i with w_i <= 0, or lo_i = hi_i
+//
+// and unprocessed rows keep x at their start value (inside their bounds). The invariant is
+// that every processed row satisfies its complementarity condition. Adding row i drives x_i
+// in the direction that moves w_i toward 0 while C's w stay 0 and N's x stay at their bounds:
+//
+//     A_CC dx_C = -A_Ci d,   dw = A_{.,C} dx_C + A_{.,i} d,   d = -sign(w_i).
+//
+// The step length s is the smallest of: w_i reaching 0 (i joins C), x_i reaching its own
+// bound (i joins N), a C index reaching a bound (it moves to N), an N index whose w reaches
+// 0 from its allowed side (it moves to C). After a C/N exchange the direction is recomputed
+// and driving continues. No step limit means no solution along this path: Status::Failed
+// with a message naming the row (e.g. w = -x - 1, x >= 0 is infeasible).
+//
+// Factorization. A_CC = L D U (unit lower L, diagonal D, unit upper U; U = L^T when A is
+// symmetric, detected once per solve, which halves the work). Adding an index borders the
+// factors (two triangular solves, O(|C|^2); the solve that gave dx_C already holds the new
+// column); removing one deletes its row and column and restores the trailing block with a
+// rank-one update (Bennett's algorithm, O(|C|^2)). There is no refactorization per pivot.
+// The pivot (Schur complement) of an entering index must exceed Options::pivotTolerance
+// times max |A_ii|, else Status::Failed. At the end x_C gets one step of iterative refinement
+// with the factors and rows whose sign condition drifted are driven again.
+//
+// When it works. For a P-matrix (e.g. symmetric positive definite A, i.e. physics with
+// cfm > 0) every Schur complement is positive and the method finds the unique solution. For
+// symmetric positive semidefinite A (rank-deficient contacts, cfm = 0) a consistent problem
+// usually solves (a zero-pivot row whose w is already 0 is left where it is); otherwise, and
+// for general non-symmetric matrices, the method may stop with Failed. Every answer is
+// checked by the base class with the natural-map residual.
+//
+// Cost. Per pivot O(|C|^2) for the factor solve and update plus O(|N| n) for dw on N rows
+// (O(nnz) of those rows when A is sparse); O(n^3) overall in the worst case, like a dense
+// factorization. Memory: A permuted into processing order (dense n^2, or CSR/CSC when
+// Problem::isSparse()), L (and U when A is not symmetric) at n^2 each. The workspace lives in
+// the solver object and is reused: no reallocation when n does not grow. No global state.
+//
+// Order of rows. Equality rows (-inf, inf) first, then the rows the start point guesses as
+// clamped, then the other rows, friction rows last (so that normals are settled first).
+//
+// Warm start (Options::warmStart, or solveWithGuess). A nonzero start x guesses the index
+// sets: rows strictly inside their bounds (and all equality rows) are guessed clamped and
+// factored in one block; x_C is then solved with the other rows at their clamped start
+// values; guessed rows that land outside their bounds are dropped from the block (one
+// rank-one downdate each) until the block is feasible. The remaining rows are then added one
+// by one as above. A right guess costs one factorization and no exchanges; a wrong guess costs
+// at most a cold solve plus the block work. An all-zero x is a cold start.
+//
+// Friction (findex). Options::frictionBounds:
+//   FixedOnce - stock ODE/Bullet behaviour: friction rows are processed last and their bounds
+//     are fixed to +-mu |x_normal| from the normal's value at the moment the row is reached.
+//     Later pivots may change the normal, so the answer may violate the final bounds; the
+//     base class then reports Failed with the true residual. Friction rows start at x = 0.
+//   Exact (default) - a fixed point over the bounds: after each pass the friction bounds are
+//     recomputed from the returned normals and the boxed problem is solved again, warm started
+//     from the previous index sets (usually no or few exchanges), until the findex residual
+//     is within Options::tolerance. Options::maxIterations bounds these passes
+//     (MaxIterations when exceeded); a pass whose bounds did not move but whose residual is
+//     still too large is Failed. The first pass is FixedOnce's (cold) or takes its bounds
+//     from the guess (warm).
+//
+// Result::iterations counts pivots (direction computations: each row added or exchanged)
+// summed over all passes; Options::maxPivots (0: 50 n + 100) limits them per pass
+// (MaxIterations when exceeded). Options::timeBudget is checked between pivots.
+#pragma once
+
+#include <memory>
+
+#include "mlcp/solver.hpp"
+
+namespace mlcp {
+
+class DantzigSolver : public Solver {
+ public:
+  DantzigSolver();
+  ~DantzigSolver() override;
+  DantzigSolver(DantzigSolver&&) noexcept;
+  DantzigSolver& operator=(DantzigSolver&&) noexcept;
+
+  const char* name() const override { return "dantzig"; }
+
+  // Friction fixed-point passes of the last solve (1 without findex or with FixedOnce).
+  int passes() const;
+
+ protected:
+  void run(const Problem& problem, Vector& x, Result& result) override;
+
+ private:
+  struct Workspace;
+  std::unique_ptr<Workspace> ws_;
+};
+
+}  // namespace mlcp

@@ -1,0 +1,781 @@
+#include "mlcp/dantzig.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+
+#include "mlcp/residual.hpp"
+
+namespace mlcp {
+
+namespace {
+
+enum class Set : unsigned char { Unprocessed, Clamped, AtLo, AtHi, Fixed, Free };
+enum class Outcome { Done, Failed, PivotLimit, TimeUp };
+enum class Block { None, SelfZero, SelfBound, CBound, NZero };
+
+using VMap = Eigen::Map<Vector>;
+using Strided = Eigen::Map<DenseMatrix, 0, Eigen::OuterStride<>>;
+
+VMap vmap(std::vector<double>& v, int len, int offset = 0) { return VMap(v.data() + offset, len); }
+
+bool isEquality(double lo, double hi) { return lo == -kInf && hi == kInf; }
+
+}  // namespace
+
+struct DantzigSolver::Workspace {
+  // ---- the problem in processing order: position p holds the caller's row perm[p] ----
+  int n = 0;
+  bool symmetric = true;
+  bool sparse = false;
+  std::vector<int> perm, inv, findex;
+  std::vector<double> dense, denseT;  // column-major n x n; denseT only when not symmetric
+  std::vector<int> rowPtr, rowIdx, colPtr, colIdx;  // CSR; CSC only when not symmetric
+  std::vector<double> rowVal, colVal, scatter;
+  std::vector<double> diag, b, lo, hi, muLo, muHi, x, w, xStart;
+  std::vector<double> normal;  // friction rows: the normal magnitude their bounds come from
+  std::vector<int> frictionRows;
+  DenseMatrix histG, histF;  // Anderson history of the friction fixed point (columns)
+  double pivTol = 0, epsW = 0, aMax = 0;
+
+  // ---- index sets and the factors A_CC = L D U (U = L^T when symmetric) ----
+  int m = 0;
+  int span = 0;  // 1 + the largest position ever clamped or driven in this pass
+  std::vector<double> L, Ut, D;
+  std::vector<int> C, N, slot;  // slot[p]: index of p in C or in N
+  std::vector<Set> set;
+
+  // ---- scratch ----
+  std::vector<double> a, r, u, l, z, dxFull, dwN, xs, ys;
+  std::vector<int> queue, violators;
+
+  int pivots = 0, pivotLimit = 0, passes = 0;
+  double startTime = 0, budget = 0;
+  std::string message;
+
+  // -------------------------------------------------------------------- set-up
+  void build(const Problem& pb, const Vector& guess, bool useGuess, bool exactFriction);
+  void buildDense(const Problem& pb);
+  void buildSparse(const Problem& pb);
+
+  // ------------------------------------------------------------- matrix access
+  const double* denseRow(int i) const {
+    return (symmetric ? dense : denseT).data() + size_t(i) * n;
+  }
+  double rowDot(int i, const std::vector<double>& v, int len) const {
+    if (!sparse)
+      return Eigen::Map<const Vector>(denseRow(i), len)
+          .dot(Eigen::Map<const Vector>(v.data(), len));
+    double s = 0;
+    for (int k = rowPtr[i]; k < rowPtr[i + 1]; ++k) s += rowVal[k] * v[rowIdx[k]];
+    return s;
+  }
+  // out[c] = A(C[c], j): column j of A at the clamped positions.
+  void gatherCol(int j, std::vector<double>& out) {
+    if (!sparse) {
+      const double* col = dense.data() + size_t(j) * n;
+      for (int c = 0; c < m; ++c) out[c] = col[C[c]];
+      return;
+    }
+    const bool useRows = symmetric;
+    const std::vector<int>& ptr = useRows ? rowPtr : colPtr;
+    const std::vector<int>& idx = useRows ? rowIdx : colIdx;
+    const std::vector<double>& val = useRows ? rowVal : colVal;
+    gatherSparse(ptr, idx, val, j, out);
+  }
+  // out[c] = A(i, C[c]): row i of A at the clamped positions.
+  void gatherRow(int i, std::vector<double>& out) {
+    if (!sparse) {
+      const double* row = denseRow(i);
+      for (int c = 0; c < m; ++c) out[c] = row[C[c]];
+      return;
+    }
+    gatherSparse(rowPtr, rowIdx, rowVal, i, out);
+  }
+  void gatherSparse(const std::vector<int>& ptr, const std::vector<int>& idx,
+                    const std::vector<double>& val, int j, std::vector<double>& out) {
+    for (int k = ptr[j]; k < ptr[j + 1]; ++k) scatter[idx[k]] = val[k];
+    for (int c = 0; c < m; ++c) out[c] = scatter[C[c]];
+    for (int k = ptr[j]; k < ptr[j + 1]; ++k) scatter[idx[k]] = 0;
+  }
+
+  // ------------------------------------------------------------------ factors
+  Strided lower(std::vector<double>& f) { return Strided(f.data(), m, m, Eigen::OuterStride<>(n)); }
+  std::vector<double>& upperT() { return symmetric ? L : Ut; }
+  // y <- L^{-1} y ./ D  (the new column of U for an entering index, given A_Cj in y).
+  void forward(std::vector<double>& f, std::vector<double>& y) {
+    if (m == 0) return;
+    lower(f).triangularView<Eigen::UnitLower>().solveInPlace(vmap(y, m));
+    vmap(y, m).array() /= vmap(D, m).array();
+  }
+  // y <- U^{-1} y.
+  void backward(std::vector<double>& y) {
+    if (m == 0) return;
+    lower(upperT()).triangularView<Eigen::UnitLower>().transpose().solveInPlace(vmap(y, m));
+  }
+  // y <- A_CC^{-1} y.
+  void solveCC(std::vector<double>& y) {
+    forward(L, y);
+    backward(y);
+  }
+  // Prepares u = D^-1 L^-1 A_Cj and l = D^-1 U^-T A_jC; returns the Schur pivot of j.
+  double border(int j) {
+    gatherCol(j, u);
+    forward(L, u);
+    if (symmetric) {
+      double s = 0;
+      for (int c = 0; c < m; ++c) s += u[c] * u[c] * D[c];
+      return diag[j] - s;
+    }
+    gatherRow(j, l);
+    forward(Ut, l);
+    double s = 0;
+    for (int c = 0; c < m; ++c) s += l[c] * u[c] * D[c];
+    return diag[j] - s;
+  }
+  // Appends position p to C with the bordering vectors from border()/direction() and pivot.
+  void joinC(int p, double pivot) {
+    const std::vector<double>& lrow = symmetric ? u : l;
+    for (int c = 0; c < m; ++c) L[m + size_t(c) * n] = lrow[c];
+    if (!symmetric)
+      for (int c = 0; c < m; ++c) Ut[m + size_t(c) * n] = u[c];
+    D[m] = pivot;
+    C[m] = p;
+    slot[p] = m;
+    set[p] = Set::Clamped;
+    ++m;
+    span = std::max(span, p + 1);
+  }
+  static void deleteRowCol(std::vector<double>& f, int c, int m, int ld) {
+    const int below = m - c - 1;
+    for (int j = 0; j < c; ++j) {
+      double* col = f.data() + size_t(j) * ld;
+      std::memmove(col + c, col + c + 1, sizeof(double) * below);
+    }
+    for (int j = c + 1; j < m; ++j)
+      std::memmove(f.data() + size_t(j - 1) * ld + j, f.data() + size_t(j) * ld + j + 1,
+                   sizeof(double) * (m - 1 - j));
+  }
+  // Removes C[c] from the factors: delete its row and column, then restore the trailing block
+  // with the rank-one update L22 D2 U22 + d_c l_c u_c^T (Bennett). False on a zero pivot.
+  bool leaveC(int c) {
+    const int s = m - c - 1;
+    double alpha = D[c];
+    for (int k = 0; k < s; ++k) xs[k] = L[c + 1 + k + size_t(c) * n];
+    if (!symmetric)
+      for (int k = 0; k < s; ++k) ys[k] = Ut[c + 1 + k + size_t(c) * n];
+    deleteRowCol(L, c, m, n);
+    if (!symmetric) deleteRowCol(Ut, c, m, n);
+    for (int k = c; k + 1 < m; ++k) {
+      D[k] = D[k + 1];
+      C[k] = C[k + 1];
+      slot[C[k]] = k;
+    }
+    --m;
+    const std::vector<double>& yv = symmetric ? xs : ys;
+    for (int j = 0; j < s && alpha != 0; ++j) {
+      const int J = c + j;
+      const double pj = xs[j], qj = yv[j];
+      if (pj == 0 && qj == 0) continue;
+      const double dOld = D[J], dNew = dOld + alpha * pj * qj;
+      if (!(std::abs(dNew) > pivTol)) return false;
+      const double bl = alpha * qj / dNew, bu = alpha * pj / dNew;
+      alpha *= dOld / dNew;
+      D[J] = dNew;
+      const int rest = s - j - 1;
+      if (rest == 0) break;
+      VMap xr(xs.data() + j + 1, rest), lc(L.data() + J + 1 + size_t(J) * n, rest);
+      xr -= pj * lc;
+      lc += bl * xr;
+      if (!symmetric) {
+        VMap yr(ys.data() + j + 1, rest), uc(Ut.data() + J + 1 + size_t(J) * n, rest);
+        yr -= qj * uc;
+        uc += bu * yr;
+      }
+    }
+    return true;
+  }
+
+  // -------------------------------------------------------------- index sets
+  void joinN(int p, Set s) {
+    set[p] = s;
+    slot[p] = static_cast<int>(N.size());
+    N.push_back(p);
+  }
+  void leaveN(int k) {
+    const int last = N.back();
+    N[k] = last;
+    slot[last] = k;
+    N.pop_back();
+  }
+
+  // ----------------------------------------------------------------- the method
+  Outcome drive(int i);
+  Outcome pass(bool fixedOnce, bool reuseFactors);
+  bool bulk(bool reuseFactors);
+  Outcome finish();
+  void freshW() {
+    for (int p = 0; p < n; ++p) w[p] = b[p] + rowDot(p, x, n);
+  }
+  void setFrictionBounds(const Vector& nu);
+  void gatherNormals(Vector& g) const;
+  Outcome fail(const std::string& why) {
+    message = why;
+    return Outcome::Failed;
+  }
+};
+
+// ============================================================================ set-up
+
+void DantzigSolver::Workspace::build(const Problem& pb, const Vector& guess, bool useGuess,
+                                     bool exactFriction) {
+  n = pb.size();
+  const bool hasF = pb.hasFindex();
+  auto friction = [&](int i) { return hasF && pb.findex[i] >= 0; };
+  auto interior = [&](int i) {
+    if (isEquality(pb.lo[i], pb.hi[i])) return true;
+    if (!useGuess) return false;
+    if (friction(i)) {
+      if (!exactFriction) return false;
+      const double bound = pb.hi[i] * std::abs(guess[pb.findex[i]]);
+      return std::abs(guess[i]) < bound;
+    }
+    return guess[i] > pb.lo[i] && guess[i] < pb.hi[i];
+  };
+  // Groups: 0 equality, 1 guessed clamped, 2 other rows, 3 friction rows.
+  perm.clear();
+  for (int group = 0; group < 4; ++group)
+    for (int i = 0; i < n; ++i) {
+      const int g = isEquality(pb.lo[i], pb.hi[i]) ? 0 : interior(i) ? 1 : friction(i) ? 3 : 2;
+      if (g == group) perm.push_back(i);
+    }
+  inv.resize(n);
+  for (int p = 0; p < n; ++p) inv[perm[p]] = p;
+
+  for (std::vector<double>* v : {&diag, &b, &lo, &hi, &muLo,   &muHi, &x,  &w,  &xStart, &a,
+                                 &r,    &u, &l,  &z,  &dxFull, &dwN,  &xs, &ys, &D,      &normal})
+    v->assign(n, 0.0);
+  findex.assign(n, -1);
+  set.assign(n, Set::Unprocessed);
+  slot.assign(n, -1);
+  C.assign(n, -1);
+  N.clear();
+  N.reserve(n);
+  for (int p = 0; p < n; ++p) {
+    const int i = perm[p];
+    b[p] = pb.b[i];
+    muLo[p] = lo[p] = pb.lo[i];
+    muHi[p] = hi[p] = pb.hi[i];
+    if (friction(i)) {
+      findex[p] = inv[pb.findex[i]];
+      // Bounds of the first pass: from the guess (exact, warm) or set when reached (cold).
+      normal[p] = useGuess && exactFriction ? std::abs(guess[pb.findex[i]]) : 0.0;
+      lo[p] = muLo[p] * normal[p];
+      hi[p] = muHi[p] * normal[p];
+    }
+  }
+  frictionRows.clear();
+  for (int p = 0; p < n; ++p)
+    if (findex[p] >= 0) frictionRows.push_back(p);
+  for (int p = 0; p < n; ++p) {
+    const double g = useGuess ? guess[perm[p]] : 0.0;
+    x[p] = findex[p] >= 0 && !(useGuess && exactFriction) ? 0.0 : std::clamp(g, lo[p], hi[p]);
+  }
+
+  sparse = pb.isSparse();
+  if (sparse)
+    buildSparse(pb);
+  else
+    buildDense(pb);
+  double dMax = 0;
+  for (int p = 0; p < n; ++p) dMax = std::max(dMax, std::abs(diag[p]));
+  const double scale = dMax > 0 ? dMax : (aMax > 0 ? aMax : 1.0);
+  pivTol = scale;  // multiplied by Options::pivotTolerance in run()
+  const double bNorm = n ? pb.b.lpNorm<Eigen::Infinity>() : 0.0;
+  epsW = 1e-12 * (1.0 + bNorm);
+  const size_t nn = size_t(n) * n;
+  L.resize(nn);
+  if (!symmetric) Ut.resize(nn);
+}
+
+void DantzigSolver::Workspace::buildDense(const Problem& pb) {
+  const DenseMatrix& A = pb.denseA();
+  aMax = n ? A.cwiseAbs().maxCoeff() : 0.0;
+  double asym = 0;
+  for (int j = 0; j < n; ++j)
+    for (int i = j + 1; i < n; ++i) asym = std::max(asym, std::abs(A(i, j) - A(j, i)));
+  symmetric = asym <= 1e-14 * aMax;
+  dense.resize(size_t(n) * n);
+  for (int q = 0; q < n; ++q) {
+    const double* src = A.data() + size_t(perm[q]) * n;
+    double* dst = dense.data() + size_t(q) * n;
+    for (int p = 0; p < n; ++p) dst[p] = src[perm[p]];
+  }
+  if (!symmetric) {
+    denseT.resize(size_t(n) * n);
+    for (int q = 0; q < n; ++q)
+      for (int p = 0; p < n; ++p) denseT[q + size_t(p) * n] = dense[p + size_t(q) * n];
+  }
+  for (int p = 0; p < n; ++p) diag[p] = dense[p + size_t(p) * n];
+}
+
+void DantzigSolver::Workspace::buildSparse(const Problem& pb) {
+  const SparseMatrix& S = pb.sparseA();
+  const int* outer = S.outerIndexPtr();
+  const int* inner = S.innerIndexPtr();
+  const double* val = S.valuePtr();
+  aMax = 0;
+  for (int k = 0; k < S.nonZeros(); ++k) aMax = std::max(aMax, std::abs(val[k]));
+  {
+    const SparseMatrix T = S.transpose();
+    const SparseMatrix diff = S - T;
+    double asym = 0;
+    for (int k = 0; k < diff.nonZeros(); ++k) asym = std::max(asym, std::abs(diff.valuePtr()[k]));
+    symmetric = asym <= 1e-14 * aMax;
+  }
+  const int nnz = static_cast<int>(S.nonZeros());
+  // CSR of the permuted matrix: row p is the caller's row perm[p] with columns renumbered.
+  rowPtr.assign(n + 1, 0);
+  for (int p = 0; p < n; ++p) rowPtr[p + 1] = rowPtr[p] + (outer[perm[p] + 1] - outer[perm[p]]);
+  rowIdx.resize(nnz);
+  rowVal.resize(nnz);
+  for (int p = 0; p < n; ++p) {
+    int k = rowPtr[p];
+    for (int e = outer[perm[p]]; e < outer[perm[p] + 1]; ++e, ++k) {
+      rowIdx[k] = inv[inner[e]];
+      rowVal[k] = val[e];
+      if (rowIdx[k] == p) diag[p] = val[e];
+    }
+  }
+  if (!symmetric) {
+    colPtr.assign(n + 1, 0);
+    for (int k = 0; k < nnz; ++k) ++colPtr[rowIdx[k] + 1];
+    for (int q = 0; q < n; ++q) colPtr[q + 1] += colPtr[q];
+    colIdx.resize(nnz);
+    colVal.resize(nnz);
+    std::vector<int>& next = slot;  // borrowed as a cursor; reset by the pass
+    next.assign(colPtr.begin(), colPtr.end() - 1);
+    for (int p = 0; p < n; ++p)
+      for (int k = rowPtr[p]; k < rowPtr[p + 1]; ++k) {
+        const int at = next[rowIdx[k]]++;
+        colIdx[at] = p;
+        colVal[at] = rowVal[k];
+      }
+  }
+  scatter.assign(n, 0.0);
+}
+
+// ========================================================================= the method
+
+Outcome DantzigSolver::Workspace::drive(int i) {
+  for (;;) {
+    const double wi = w[i];
+    if (x[i] <= lo[i] && wi >= -epsW) {
+      x[i] = lo[i];
+      joinN(i, Set::AtLo);
+      return Outcome::Done;
+    }
+    if (x[i] >= hi[i] && wi <= epsW) {
+      x[i] = hi[i];
+      joinN(i, Set::AtHi);
+      return Outcome::Done;
+    }
+    if (pivots >= pivotLimit) {
+      std::ostringstream os;
+      os << "pivot limit " << pivotLimit << " reached";
+      message = os.str();
+      return Outcome::PivotLimit;
+    }
+    if (budget > 0 && nowSeconds() - startTime > budget) {
+      message = "time budget spent";
+      return Outcome::TimeUp;
+    }
+    ++pivots;
+    const double d = wi < 0 ? 1.0 : -1.0;
+    // Direction: keep w_C = 0 and x_N fixed while x_i moves by d.
+    gatherCol(i, u);
+    forward(L, u);
+    std::copy(u.begin(), u.begin() + m, z.begin());
+    backward(z);
+    span = std::max(span, i + 1);
+    for (int c = 0; c < m; ++c) dxFull[C[c]] = -d * z[c];
+    dxFull[i] = d;
+    const double dwi = rowDot(i, dxFull, span);
+    const double sii = d * dwi;  // Schur complement of i with respect to C
+    auto clearDx = [&] {
+      for (int c = 0; c < m; ++c) dxFull[C[c]] = 0;
+      dxFull[i] = 0;
+    };
+    auto enterC = [&](int p, double pivot) {
+      if (!symmetric) {
+        gatherRow(p, l);
+        forward(Ut, l);
+      }
+      joinC(p, pivot);
+    };
+    const bool interior = x[i] > lo[i] && x[i] < hi[i];
+    if (interior && std::abs(wi) <= epsW && std::abs(sii) > pivTol) {
+      clearDx();
+      w[i] = 0;
+      enterC(i, sii);
+      return Outcome::Done;
+    }
+    double dxMax = 1;
+    for (int c = 0; c < m; ++c) dxMax = std::max(dxMax, std::abs(z[c]));
+    const double rateTol = 1e-13 * aMax * dxMax;
+    const int nN = static_cast<int>(N.size());
+    for (int k = 0; k < nN; ++k) {
+      const Set s = set[N[k]];
+      dwN[k] = (s == Set::AtLo || s == Set::AtHi) ? rowDot(N[k], dxFull, span) : 0.0;
+    }
+    // Step length: the first event along the ray.
+    double best = kInf;
+    Block kind = Block::None;
+    int who = -1;
+    bool whoUp = false;  // CBound: the clamped row hit its upper bound
+    if (sii > pivTol) {
+      best = std::max(0.0, -wi / dwi);
+      kind = Block::SelfZero;
+    }
+    const double room = d > 0 ? hi[i] - x[i] : x[i] - lo[i];
+    if (room < best) {
+      best = std::max(0.0, room);
+      kind = Block::SelfBound;
+    }
+    for (int c = 0; c < m; ++c) {
+      const int p = C[c];
+      const double dx = dxFull[p];
+      double s = kInf;
+      if (dx > 0 && hi[p] < kInf) s = (hi[p] - x[p]) / dx;
+      if (dx < 0 && lo[p] > -kInf) s = (lo[p] - x[p]) / dx;
+      if (s < best) {
+        best = std::max(0.0, s);
+        kind = Block::CBound;
+        who = c;
+        whoUp = dx > 0;
+      }
+    }
+    for (int k = 0; k < nN; ++k) {
+      const int p = N[k];
+      const double dw = dwN[k];
+      double s = kInf;
+      if (set[p] == Set::AtLo && dw < -rateTol) s = -w[p] / dw;
+      if (set[p] == Set::AtHi && dw > rateTol) s = -w[p] / dw;
+      if (s < best) {
+        best = std::max(0.0, s);
+        kind = Block::NZero;
+        who = k;
+      }
+    }
+    if (kind == Block::None) {
+      clearDx();
+      if (std::abs(wi) <= epsW) {  // a redundant row: its w is 0 and stays 0 along the ray
+        joinN(i, Set::Free);
+        return Outcome::Done;
+      }
+      std::ostringstream os;
+      os << "row " << perm[i] << ": nothing limits the step (w = " << wi
+         << ", Schur pivot = " << sii
+         << "); the problem has no solution on this path (infeasible, or A is not a P-matrix)";
+      return fail(os.str());
+    }
+    x[i] += d * best;
+    for (int c = 0; c < m; ++c) x[C[c]] += best * dxFull[C[c]];
+    w[i] += best * dwi;
+    for (int k = 0; k < nN; ++k) w[N[k]] += best * dwN[k];
+    clearDx();
+    switch (kind) {
+      case Block::SelfZero:
+        w[i] = 0;
+        enterC(i, sii);
+        return Outcome::Done;
+      case Block::SelfBound:
+        x[i] = d > 0 ? hi[i] : lo[i];
+        joinN(i, d > 0 ? Set::AtHi : Set::AtLo);
+        return Outcome::Done;
+      case Block::CBound: {
+        const int p = C[who];
+        const bool up = whoUp;
+        x[p] = up ? hi[p] : lo[p];
+        w[p] = 0;
+        if (!leaveC(who)) {
+          std::ostringstream os;
+          os << "row " << perm[p] << " left the clamped set and left a singular block behind";
+          return fail(os.str());
+        }
+        joinN(p, up ? Set::AtHi : Set::AtLo);
+        break;
+      }
+      case Block::NZero: {
+        const int p = N[who];
+        w[p] = 0;
+        leaveN(who);
+        const double pivot = border(p);
+        if (!(std::abs(pivot) > pivTol)) {
+          std::ostringstream os;
+          os << "row " << perm[p] << " must join the clamped set but its pivot is " << pivot
+             << " (singular principal block)";
+          return fail(os.str());
+        }
+        joinC(p, pivot);
+        break;
+      }
+      case Block::None: break;
+    }
+  }
+}
+
+// Factors the guessed clamped block (or keeps the previous pass's factors), solves x_C with
+// the other rows at their start values, and drops rows that land outside their bounds until
+// the block is feasible. Rows not kept are queued. False when the block could not be used.
+bool DantzigSolver::Workspace::bulk(bool reuseFactors) {
+  if (reuseFactors) {
+    for (int c = 0; c < m; ++c) set[C[c]] = Set::Clamped;
+  } else {
+    m = 0;
+    for (int p = 0; p < n; ++p) {
+      if (set[p] != Set::Clamped) continue;  // marked as guessed by the caller
+      set[p] = Set::Unprocessed;
+      if (lo[p] == hi[p]) continue;
+      const double pivot = border(p);
+      if (std::abs(pivot) > pivTol) joinC(p, pivot);
+    }
+  }
+  for (int c = 0; c < m; ++c) span = std::max(span, C[c] + 1);
+  while (m > 0) {
+    for (int c = 0; c < m; ++c) a[c] = b[C[c]] + rowDot(C[c], x, n);
+    solveCC(a);
+    for (int c = 0; c < m; ++c) x[C[c]] -= a[c];
+    violators.clear();
+    for (int c = 0; c < m; ++c)
+      if (x[C[c]] < lo[C[c]] || x[C[c]] > hi[C[c]]) violators.push_back(c);
+    if (violators.empty()) break;
+    for (auto it = violators.rbegin(); it != violators.rend(); ++it) {
+      const int p = C[*it];
+      x[p] = xStart[p];
+      set[p] = Set::Unprocessed;
+      if (!leaveC(*it)) return false;
+    }
+  }
+  for (int c = 0; c < m; ++c) w[C[c]] = 0;
+  return true;
+}
+
+Outcome DantzigSolver::Workspace::pass(bool fixedOnce, bool reuseFactors) {
+  N.clear();
+  span = 0;
+  if (reuseFactors) std::fill(set.begin(), set.end(), Set::Unprocessed);
+  for (int p = 0; p < n; ++p) x[p] = std::clamp(x[p], lo[p], hi[p]);
+  xStart = x;
+  if (!bulk(reuseFactors)) {  // the guessed block was unusable: start from nothing
+    m = 0;
+    x = xStart;
+    std::fill(set.begin(), set.end(), Set::Unprocessed);
+  }
+  for (int p = 0; p < n; ++p) {
+    if (set[p] != Set::Unprocessed) continue;
+    if (fixedOnce && findex[p] >= 0) {
+      normal[p] = std::abs(x[findex[p]]);
+      lo[p] = muLo[p] * normal[p];
+      hi[p] = muHi[p] * normal[p];
+      x[p] = std::clamp(x[p], lo[p], hi[p]);
+    }
+    w[p] = b[p] + rowDot(p, x, n);
+    if (lo[p] == hi[p]) {
+      x[p] = lo[p];
+      joinN(p, Set::Fixed);
+      continue;
+    }
+    const Outcome o = drive(p);
+    if (o != Outcome::Done) return o;
+  }
+  return finish();
+}
+
+// One step of iterative refinement of x_C with the factors, then rows whose sign condition
+// drifted are driven again (at most a few rounds).
+Outcome DantzigSolver::Workspace::finish() {
+  for (int round = 0; round < 3; ++round) {
+    freshW();
+    if (m > 0) {
+      for (int c = 0; c < m; ++c) a[c] = w[C[c]];
+      solveCC(a);
+      for (int c = 0; c < m; ++c) x[C[c]] -= a[c];
+      freshW();
+    }
+    violators.clear();
+    for (int p : N) {
+      const bool bad = (set[p] == Set::AtLo && w[p] < -epsW) ||
+                       (set[p] == Set::AtHi && w[p] > epsW) ||
+                       (set[p] == Set::Free && std::abs(w[p]) > epsW);
+      if (bad) violators.push_back(p);
+    }
+    if (violators.empty()) return Outcome::Done;
+    for (int p : violators) {
+      leaveN(slot[p]);
+      const Outcome o = drive(p);
+      if (o != Outcome::Done) return o;
+    }
+  }
+  return Outcome::Done;
+}
+
+void DantzigSolver::Workspace::gatherNormals(Vector& g) const {
+  for (size_t k = 0; k < frictionRows.size(); ++k) g[k] = std::abs(x[findex[frictionRows[k]]]);
+}
+
+// New friction bounds from the normal magnitudes nu (one per friction row); rows at a bound
+// follow it, so that the previous index sets stay a consistent guess.
+void DantzigSolver::Workspace::setFrictionBounds(const Vector& nu) {
+  for (size_t k = 0; k < frictionRows.size(); ++k) {
+    const int p = frictionRows[k];
+    normal[p] = nu[k];
+    lo[p] = muLo[p] * nu[k];
+    hi[p] = muHi[p] * nu[k];
+    if (set[p] == Set::AtLo) x[p] = lo[p];
+    if (set[p] == Set::AtHi) x[p] = hi[p];
+  }
+}
+
+// ======================================================================= the solver
+
+DantzigSolver::DantzigSolver() : ws_(std::make_unique<Workspace>()) {}
+DantzigSolver::~DantzigSolver() = default;
+DantzigSolver::DantzigSolver(DantzigSolver&&) noexcept = default;
+DantzigSolver& DantzigSolver::operator=(DantzigSolver&&) noexcept = default;
+
+int DantzigSolver::passes() const { return ws_->passes; }
+
+void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
+  const Options& opt = options();
+  Workspace& ws = *ws_;
+  const int n = problem.size();
+  ws.passes = 0;
+  if (n == 0) {
+    result.status = Status::Converged;
+    result.message = "empty problem";
+    return;
+  }
+  const bool exact = opt.frictionBounds == FrictionBounds::Exact;
+  const bool useGuess = !x.isZero(0.0);
+  ws.build(problem, x, useGuess, exact);
+  ws.pivTol *= opt.pivotTolerance;
+  ws.pivots = 0;
+  ws.pivotLimit = opt.maxPivots > 0 ? opt.maxPivots : 50 * n + 100;
+  ws.startTime = nowSeconds();
+  ws.budget = opt.timeBudget;
+  ws.message.clear();
+  // Pass 1 guesses the equality rows and (warm) the rows inside their bounds as clamped.
+  for (int p = 0; p < n; ++p) {
+    const int i = ws.perm[p];
+    const bool guessed = isEquality(problem.lo[i], problem.hi[i]) ||
+                         (useGuess && ws.x[p] > ws.lo[p] && ws.x[p] < ws.hi[p]);
+    ws.set[p] = guessed ? Set::Clamped : Set::Unprocessed;
+  }
+  const bool friction = problem.hasFindex();
+  const bool firstFixedOnce = friction && !(useGuess && exact);
+  auto writeBack = [&] {
+    for (int p = 0; p < n; ++p) x[ws.perm[p]] = ws.x[p];
+  };
+  int totalPivots = 0;
+  const int nf = static_cast<int>(ws.frictionRows.size());
+  constexpr int depth = 6;
+  int stored = 0;
+  double bestF = kInf, damping = 1.0;
+  int lastGain = 0;
+  Vector g(nf), nu(nf), f(nf);
+  if (friction && exact) {
+    ws.histG.resize(nf, depth);
+    ws.histF.resize(nf, depth);
+  }
+  for (int it = 1;; ++it) {
+    ws.passes = it;
+    const int before = ws.pivots;
+    const Outcome o = ws.pass(it == 1 && firstFixedOnce, it > 1);
+    totalPivots += ws.pivots - before;
+    ws.pivots = 0;
+    result.iterations = totalPivots;
+    writeBack();
+    std::ostringstream os;
+    if (o != Outcome::Done) {
+      result.status = o == Outcome::Failed       ? Status::Failed
+                      : o == Outcome::PivotLimit ? Status::MaxIterations
+                                                 : Status::TimeLimit;
+      os << ws.message;
+      if (friction && exact) os << " (friction pass " << it << ")";
+      result.message = os.str();
+      return;
+    }
+    if (!friction || !exact) {
+      result.status = Status::Converged;
+      result.message =
+          friction ? "pivoting finished (friction bounds fixed once)" : "pivoting finished";
+      return;
+    }
+    const double res = residual(problem, x);
+    if (res <= opt.tolerance) {
+      result.status = Status::Converged;
+      os << "friction bounds settled after " << it << " pass" << (it > 1 ? "es" : "");
+      result.message = os.str();
+      return;
+    }
+    if (it >= opt.maxIterations) {
+      result.status = Status::MaxIterations;
+      os << "friction bounds still moving after " << it << " passes (residual " << res << ")";
+      result.message = os.str();
+      return;
+    }
+    // Anderson acceleration of nu <- g(nu) = |x_normal(nu)|: piecewise affine, so within one
+    // active set a few extrapolations find the fixed point where plain iteration may spiral.
+    ws.gatherNormals(g);
+    for (int k = 0; k < nf; ++k) {
+      nu[k] = ws.normal[ws.frictionRows[k]];
+      f[k] = g[k] - nu[k];
+    }
+    const double fNorm = f.lpNorm<Eigen::Infinity>();
+    if (fNorm == 0) {
+      result.status = Status::Failed;
+      os << "friction bounds stopped moving but the residual is " << res;
+      result.message = os.str();
+      return;
+    }
+    if (fNorm > 10 * bestF) stored = 0;  // extrapolation went astray: restart the history
+    if (fNorm < bestF) {
+      bestF = fNorm;
+      lastGain = it;
+    } else if (it - lastGain > 20 && damping == 1.0) {
+      damping = 0.3;  // stalled (a cycle between active sets): plain damped iteration
+      stored = 0;
+    }
+    if (stored == depth) {
+      for (int j = 0; j + 1 < depth; ++j) {
+        ws.histG.col(j) = ws.histG.col(j + 1);
+        ws.histF.col(j) = ws.histF.col(j + 1);
+      }
+      --stored;
+    }
+    ws.histG.col(stored) = g;
+    ws.histF.col(stored) = f;
+    ++stored;
+    Vector next = nu + damping * f;
+    if (damping == 1.0 && stored >= 2) {
+      const int q = stored - 1;
+      DenseMatrix dF(nf, q), dG(nf, q);
+      for (int j = 0; j < q; ++j) {
+        dF.col(j) = ws.histF.col(j + 1) - ws.histF.col(j);
+        dG.col(j) = ws.histG.col(j + 1) - ws.histG.col(j);
+      }
+      const Vector gamma = dF.colPivHouseholderQr().solve(f);
+      if (gamma.allFinite()) next -= dG * gamma;
+    }
+    ws.setFrictionBounds(next.cwiseMax(0.0));
+    if (opt.timeBudget > 0 && nowSeconds() - ws.startTime > opt.timeBudget) {
+      result.status = Status::TimeLimit;
+      result.message = "time budget spent between friction passes";
+      return;
+    }
+  }
+}
+
+}  // namespace mlcp

@@ -1,0 +1,342 @@
+// dantzig specifics: the seed example, random P-matrix / SPD / boxed / mixed / findex problems
+// against known solutions, FixedOnce versus Exact friction, infeasible and singular problems,
+// warm start, workspace reuse, sparse input. Every answer is checked with mlcp::accuracy().
+#include "mlcp/dantzig.hpp"
+
+#include <gtest/gtest.h>
+
+#include "common/generators.hpp"
+#include "mlcp/registry.hpp"
+#include "mlcp/residual.hpp"
+
+namespace mlcp {
+namespace {
+
+using test::Generator;
+using test::KnownProblem;
+
+// Solves and checks the answer independently: residual, and x* when the solution is unique.
+Result expectSolved(DantzigSolver& s, const KnownProblem& kp, double tol = 1e-9) {
+  Vector x;
+  const Result r = s.solve(kp.problem, x);
+  EXPECT_TRUE(r.converged()) << kp.name << ": " << toString(r.status) << " " << r.message;
+  const Accuracy a = accuracy(kp.problem, x);
+  EXPECT_LE(a.residual, tol) << kp.name;
+  EXPECT_LE(a.boundViolation, tol * (1 + kp.problem.b.lpNorm<Eigen::Infinity>())) << kp.name;
+  if (kp.unique && x.size() == kp.solution.size()) {
+    EXPECT_LE((x - kp.solution).lpNorm<Eigen::Infinity>(), 1e-8 * (1 + kp.solution.norm()))
+        << kp.name;
+  }
+  return r;
+}
+
+// Random J (rows x 6 bodies' worth of columns), A = J J^T + eps I.
+DenseMatrix jacobianGram(Generator& g, int rows, int cols, double eps) {
+  DenseMatrix J(rows, cols);
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < cols; ++j) J(i, j) = g.uniform(-1, 1);
+  return J * J.transpose() + eps * DenseMatrix::Identity(rows, rows);
+}
+
+// Friction pyramids: per contact a normal row [0, inf) and two rows [-mu, mu] -> normal.
+Problem frictionPyramids(DenseMatrix A, Generator& g, double mu) {
+  const int n = static_cast<int>(A.rows());
+  Vector b(n);
+  for (int i = 0; i < n; ++i) b[i] = g.uniform(-1, 1);
+  for (int k = 0; k < n; k += 3) b[k] = -g.uniform(0.2, 1);  // approaching contacts
+  Problem p(std::move(A), b);
+  p.findex.assign(n, -1);
+  for (int k = 0; k < n; k += 3)
+    for (int t = 1; t <= 2; ++t) {
+      p.lo[k + t] = -mu;
+      p.hi[k + t] = mu;
+      p.findex[k + t] = k;
+    }
+  return p;
+}
+
+TEST(Dantzig, IsRegistered) {
+  auto s = makeSolver("dantzig");
+  ASSERT_NE(s, nullptr);
+  EXPECT_STREQ(s->name(), "dantzig");
+}
+
+TEST(Dantzig, SeedExample) {
+  // Not symmetric, not a P-matrix (A_33 = 0), but positive semidefinite: solvable here.
+  const Problem p = test::seedLemkeExample();
+  DantzigSolver s;
+  Vector x;
+  const Result r = s.solve(p, x);
+  ASSERT_TRUE(r.converged()) << r.message;
+  EXPECT_LE(residual(p, x), 1e-12);
+  EXPECT_NEAR(x[0], 20.0 / 19, 1e-12);
+  EXPECT_NEAR(x[1], 21.0 / 19, 1e-12);
+  EXPECT_NEAR(x[2], 0.0, 1e-12);
+  EXPECT_GE(r.iterations, 2);
+}
+
+TEST(Dantzig, RandomSpdStandardLcps) {
+  Generator g(11);
+  DantzigSolver s;
+  for (int trial = 0; trial < 20; ++trial) {
+    const int n = 1 + g.pick(40);
+    expectSolved(s, g.standard(g.spd(n), trial % 3 == 0));
+  }
+}
+
+TEST(Dantzig, RandomNonsymmetricPMatrices) {
+  // Diagonally dominant with positive diagonal: a P-matrix, not symmetric.
+  Generator g(12);
+  DantzigSolver s;
+  for (int trial = 0; trial < 20; ++trial) {
+    const int n = 2 + g.pick(30);
+    DenseMatrix A(n, n);
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) A(i, j) = g.uniform(-1, 1);
+    for (int i = 0; i < n; ++i) A(i, i) = A.row(i).cwiseAbs().sum() + 0.5;
+    expectSolved(s, g.standard(A));
+    expectSolved(s, g.boxed(A));
+  }
+}
+
+TEST(Dantzig, BoxedAndMixedEqualityRows) {
+  Generator g(13);
+  DantzigSolver s;
+  for (int trial = 0; trial < 30; ++trial) {
+    const int n = 1 + g.pick(50);
+    const KnownProblem kp = g.boxed(g.spd(n, trial % 2 ? 0.1 : 0.01));
+    expectSolved(s, kp);
+  }
+  expectSolved(s, g.linear(g.spd(25)));
+}
+
+TEST(Dantzig, FindexExactSatisfiesTheFinalBounds) {
+  Generator g(14);
+  DantzigSolver s;
+  for (int trial = 0; trial < 20; ++trial) {
+    const KnownProblem kp = g.friction(1 + g.pick(12));
+    const Result r = expectSolved(s, kp);
+    EXPECT_GE(s.passes(), 1);
+    (void)r;
+  }
+}
+
+TEST(Dantzig, FrictionPyramidsFromJacobians) {
+  Generator g(15);
+  DantzigSolver s;
+  for (int trial = 0; trial < 10; ++trial) {
+    const int contacts = 2 + g.pick(10);
+    const Problem p = frictionPyramids(jacobianGram(g, 3 * contacts, 12, 1e-3), g, 0.5);
+    Vector x;
+    const Result r = s.solve(p, x);
+    EXPECT_TRUE(r.converged()) << toString(r.status) << " " << r.message;
+    const Accuracy a = accuracy(p, x);
+    EXPECT_LE(a.residual, 1e-9);
+    EXPECT_LE(a.boundViolation, 1e-9 * (1 + p.b.lpNorm<Eigen::Infinity>()));
+  }
+}
+
+// On random pyramids FixedOnce runs, reports its status truthfully (the base class checks the
+// true findex bounds) and, at mu = 1, sometimes returns an answer outside the final bounds.
+TEST(Dantzig, FixedOnceRunsAndCanViolateTheFinalBounds) {
+  Generator g(16);
+  DantzigSolver exact, stock;
+  stock.options().frictionBounds = FrictionBounds::FixedOnce;
+  int violated = 0;
+  for (int trial = 0; trial < 30; ++trial) {
+    const int contacts = 2 + g.pick(6);
+    const Problem p = frictionPyramids(jacobianGram(g, 3 * contacts, 12, 1e-3), g, 1.0);
+    Vector xe, xs;
+    const Result re = exact.solve(p, xe);
+    const Result rs = stock.solve(p, xs);
+    EXPECT_TRUE(re.converged()) << re.message;
+    EXPECT_EQ(stock.passes(), 1);
+    // FixedOnce is never wrong about its own status: the base class checks the true bounds.
+    const Accuracy as = accuracy(p, xs);
+    EXPECT_EQ(rs.converged(), as.residual <= stock.options().tolerance);
+    if (as.boundViolation > 1e-9) {
+      ++violated;
+      EXPECT_FALSE(rs.converged());
+    }
+  }
+  EXPECT_GT(violated, 0) << "no case showed the stock behaviour's bound violation";
+}
+
+TEST(Dantzig, FixedOnceViolationConstructed) {
+  // Row 0 a normal, row 1 its friction (mu = 0.5, coupled to the normal through A_01 = 0.9),
+  // row 2 an inactive contact. Stock order: the normal first (x_0 = 2), then the friction
+  // row with bounds fixed at +-1; x_1 saturates at 1 and pulls the normal down to 1.1, so the
+  // final bound 0.55 is violated by 0.45. Exact iterates x_0 <- 2 - 0.45 x_0 to 2 / 1.45.
+  DenseMatrix A(3, 3);
+  A << 1, 0.9, 0, 0.9, 1, 0, 0, 0, 1;
+  Problem p(A, Vector((Vector(3) << -2, -5, 0.3).finished()));
+  p.findex = {-1, 0, -1};
+  p.lo[1] = -0.5;
+  p.hi[1] = 0.5;
+  DantzigSolver exact, stock;
+  stock.options().frictionBounds = FrictionBounds::FixedOnce;
+  Vector xe, xs;
+  const Result re = exact.solve(p, xe);
+  const Result rs = stock.solve(p, xs);
+  ASSERT_TRUE(re.converged()) << re.message;
+  EXPECT_LE(accuracy(p, xe).boundViolation, 1e-12);
+  EXPECT_NEAR(xe[0], 2 / 1.45, 1e-9);
+  EXPECT_NEAR(xs[0], 1.1, 1e-12);
+  EXPECT_NEAR(xs[1], 1.0, 1e-12);
+  EXPECT_GT(accuracy(p, xs).boundViolation, 0.4);
+  EXPECT_EQ(rs.status, Status::Failed) << rs.message;
+  EXPECT_GT(exact.passes(), 1);
+}
+
+TEST(Dantzig, InfeasibleIsFailed) {
+  // w = -x - 1 >= 0 with x >= 0 has no solution.
+  Problem p(DenseMatrix::Constant(1, 1, -1.0), Vector::Constant(1, -1.0));
+  DantzigSolver s;
+  Vector x;
+  const Result r = s.solve(p, x);
+  EXPECT_EQ(r.status, Status::Failed) << r.message;
+  EXPECT_NE(r.message.find("row 0"), std::string::npos) << r.message;
+  EXPECT_GT(residual(p, x), 1e-10);
+}
+
+TEST(Dantzig, InconsistentSingularLinearSystemIsFailed) {
+  DenseMatrix A(2, 2);
+  A << 1, 1, 1, 1;
+  Problem p(A, Vector((Vector(2) << -1, -2).finished()));
+  p.lo.setConstant(-kInf);
+  p.hi.setConstant(kInf);
+  DantzigSolver s;
+  Vector x;
+  const Result r = s.solve(p, x);
+  EXPECT_FALSE(r.converged());
+  EXPECT_NE(r.status, Status::InvalidInput);
+}
+
+TEST(Dantzig, SingularPsdContactsOfABox) {
+  // 4 contact normals of one box against the ground: A = J J^T has rank 3 (no cfm). With b in
+  // the range of J (consistent), a solution exists; it is not unique.
+  Generator g(17);
+  DantzigSolver s;
+  int solved = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    DenseMatrix J(4, 3);
+    for (int i = 0; i < 4; ++i) J.row(i) << 1, g.uniform(-1, 1), g.uniform(-1, 1);
+    Vector v(3);
+    v << -g.uniform(0.5, 2), g.uniform(-0.2, 0.2), g.uniform(-0.2, 0.2);
+    Problem p(DenseMatrix(J * J.transpose()), J * v);
+    Vector x;
+    const Result r = s.solve(p, x);
+    const double res = residual(p, x);
+    if (r.converged()) {
+      ++solved;
+      EXPECT_LE(res, 1e-10);
+    } else {
+      EXPECT_TRUE(r.status == Status::Failed || r.status == Status::MaxIterations) << r.message;
+    }
+  }
+  EXPECT_GE(solved, 15) << "singular but consistent contact sets should mostly solve";
+}
+
+TEST(Dantzig, SingularFrictionBoxWithSmallCfm) {
+  // A box on the ground: 4 contacts with friction, 12 rows from 6 body velocities.
+  Generator g(18);
+  DantzigSolver s;
+  for (int trial = 0; trial < 10; ++trial) {
+    const Problem p = frictionPyramids(jacobianGram(g, 12, 6, trial % 2 ? 1e-6 : 0.0), g, 0.6);
+    Vector x;
+    const Result r = s.solve(p, x);
+    const Accuracy a = accuracy(p, x);
+    if (r.converged())
+      EXPECT_LE(a.residual, 1e-10);
+    else
+      EXPECT_NE(r.status, Status::InvalidInput) << r.message;
+    EXPECT_TRUE(a.finite);
+  }
+}
+
+TEST(Dantzig, WarmStartFromTheSolutionNeedsNoPivots) {
+  Generator g(19);
+  DantzigSolver s;
+  const KnownProblem kp = g.boxed(g.spd(60));
+  Vector x;
+  const Result cold = s.solve(kp.problem, x);
+  ASSERT_TRUE(cold.converged());
+  s.options().warmStart = true;
+  Vector y = x;
+  const Result warm = s.solve(kp.problem, y);
+  ASSERT_TRUE(warm.converged()) << warm.message;
+  EXPECT_LE(residual(kp.problem, y), 1e-10);
+  EXPECT_LT(warm.iterations, cold.iterations);
+  // A perturbed guess still gives the right answer.
+  Vector guess = x + 0.3 * Vector::Random(x.size());
+  const Result r = s.solveWithGuess(kp.problem, guess, y);
+  ASSERT_TRUE(r.converged()) << r.message;
+  EXPECT_LE((y - kp.solution).lpNorm<Eigen::Infinity>(), 1e-8);
+}
+
+TEST(Dantzig, WarmStartFindex) {
+  Generator g(20);
+  DantzigSolver s;
+  const KnownProblem kp = g.friction(10);
+  Vector x;
+  ASSERT_TRUE(s.solve(kp.problem, x).converged());
+  Vector y;
+  const Result r = s.solveWithGuess(kp.problem, x, y);
+  ASSERT_TRUE(r.converged()) << r.message;
+  EXPECT_EQ(s.passes(), 1);
+  EXPECT_LE(residual(kp.problem, y), 1e-10);
+}
+
+TEST(Dantzig, WorkspaceReuseAcrossSizes) {
+  Generator g(21);
+  DantzigSolver s;
+  for (int n : {30, 5, 60, 1, 60, 17}) {
+    expectSolved(s, g.boxed(g.spd(n)));
+    expectSolved(s, g.friction(std::max(1, n / 3)));
+  }
+}
+
+TEST(Dantzig, SparseInputMatchesDense) {
+  Generator g(22);
+  DantzigSolver s;
+  for (int trial = 0; trial < 5; ++trial) {
+    // Block tridiagonal SPD (a chain of bodies), stored sparse.
+    const int n = 60;
+    DenseMatrix A = DenseMatrix::Zero(n, n);
+    for (int i = 0; i < n; ++i) {
+      A(i, i) = 4;
+      if (i + 1 < n) A(i, i + 1) = A(i + 1, i) = g.uniform(-1, 1);
+      if (i + 3 < n) A(i, i + 3) = A(i + 3, i) = g.uniform(-0.5, 0.5);
+    }
+    KnownProblem kp = trial % 2 ? g.boxed(A) : g.standard(A);
+    kp.problem.setA(SparseMatrix(A.sparseView()));
+    ASSERT_TRUE(kp.problem.isSparse());
+    expectSolved(s, kp);
+    // Non-symmetric sparse.
+    A(0, 5) += 0.7;
+    KnownProblem kn = g.boxed(A);
+    kn.problem.setA(SparseMatrix(A.sparseView()));
+    expectSolved(s, kn);
+  }
+}
+
+TEST(Dantzig, PivotLimitIsMaxIterations) {
+  Generator g(23);
+  DantzigSolver s;
+  s.options().maxPivots = 3;
+  const KnownProblem kp = g.boxed(g.spd(40));
+  Vector x;
+  const Result r = s.solve(kp.problem, x);
+  EXPECT_EQ(r.status, Status::MaxIterations) << r.message;
+  EXPECT_LE(r.iterations, 3);
+}
+
+TEST(Dantzig, EmptyProblem) {
+  DantzigSolver s;
+  Problem p(DenseMatrix(0, 0), Vector(0));
+  Vector x;
+  EXPECT_TRUE(s.solve(p, x).converged());
+}
+
+}  // namespace
+}  // namespace mlcp
