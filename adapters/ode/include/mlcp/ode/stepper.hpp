@@ -1,0 +1,138 @@
+// mlcp/ode/stepper.hpp: any core solver as ODE's island stepper.
+//
+//     mlcp::ode::Stepper stepper("dantzig");   // or "pgs", "lemke", ... (mlcp::solverNames())
+//     stepper.step(world, h);                   // instead of dWorldStep(world, h)
+//
+// How it plugs in. dWorldStep is two calls into ODE's world processing:
+// dxReallocateWorldProcessContext (auto-disabling, islands, arena sized by a memory estimator)
+// then dxProcessIslands, which calls an island stepper of type dstepper_fn_t once per island.
+// Stepper::step makes the same two calls with its own estimator and island stepper, so ODE
+// still does everything around the solve: islands, auto-disable (disabled bodies are not in
+// any island), joint row generation (every joint type, every dContact surface mode, limits and
+// motors, ERP/CFM), joint feedback and body integration (dxStepBody).
+//
+// The island pipeline (src/island.cpp), by stages:
+//   1. prepare bodies: gravity into the force accumulator, world-frame inverse inertia, the
+//      implicit gyroscopic torque (Lacoursiere 2006), exactly as dxStepIsland does;
+//   2. prepare rows: getInfo1 for every joint (it must run before getInfo2), joints ordered
+//      unbounded | mixed | LCP as ODE does, getInfo2 into factored rows (mlcp::RowSystem): two
+//      6-wide Jacobian blocks per row, world-frame inverse inertia per body;
+//   3. convert to the canonical form. ODE solves A lambda = rhs + w with
+//          A   = J M^-1 J^T + diag(cfm / h),
+//          rhs = c / h - J (M^-1 f_ext + v / h),
+//      where c and cfm are getInfo2's (ODE scales both by 1/h) and lambda is a force. Ours is
+//      w = A x + b, so b = -rhs; lo, hi and findex (made island-global) are copied;
+//   4. warm start: lambda of the last step per joint (per contact: matched by body pair,
+//      order and position), when the solver can use it;
+//   5. solve: "pgs" runs mlcp::RowPgs on the rows (O(nnz J) per sweep, no A); every other
+//      core solver gets RowSystem::assemble (sparse by the body graph, or dense); a verified
+//      fallback runs when the primary's answer is unusable or far off;
+//   6. store impulses: constraint force J^T lambda per body and joint feedback exactly as
+//      dxStepIsland fills it, v += h M^-1 (f_ext + J^T lambda), dxStepBody, zero accumulators.
+//
+// Adapter-only solver names (not in the core registry), for diffing against stock ODE:
+//   "ode-step"      forwards each island to ODE's own dxStepIsland (bitwise equal to
+//                   dWorldStep; no statistics beyond rows and time);
+//   "ode-quickstep" forwards to dxQuickStepIsland (equal to dWorldQuickStep);
+//   "ode-lcp"       our stages 1-3 and 6 with ODE's own Dantzig solver dxSolveLCP on the dense
+//                   A (matches dWorldStep to round-off; its residual is stock's residual).
+//
+// Threads. ODE may run islands on several threads when the world has a threading
+// implementation; this stepper serializes its islands with a mutex.
+#pragma once
+
+#include <ode/ode.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mlcp/result.hpp"
+
+namespace mlcp::ode {
+
+struct StepperOptions {
+  // Options of the core solver (tolerance, maxIterations, relaxation, frictionBounds, ...); see
+  // mlcp/result.hpp. warmStart there is ignored: warmStart below decides.
+  mlcp::Options solver;
+  // Start each island's solve from the last step's lambda of the same joints. Default true.
+  bool warmStart = true;
+  // A contact of the last step warm-starts a contact of this step when both join the same two
+  // bodies, have the same rank among that pair's contacts, and their positions are closer
+  // than this distance (in ODE's length unit, m). Default 0.05.
+  double contactMatchDistance = 0.05;
+  // Assemble A in sparse storage for solvers that take an assembled problem (all but "pgs");
+  // false builds it dense. Default true.
+  bool sparse = true;
+  // Solver name run when the primary's answer is unusable (not finite, invalid, unsupported)
+  // or Failed with a residual above fallbackResidual; its answer is taken only when its
+  // residual is lower. "" disables the fallback; "ode-..." primaries never fall back. Default
+  // "pgs".
+  std::string fallback = "pgs";
+  // Residual (scaled natural-map, see mlcp/residual.hpp) above which a Failed primary answer
+  // is handed to the fallback. Default 1e-3.
+  double fallbackResidual = 1e-3;
+  // Diagnostics: a second solver (any name the stepper accepts except the forwarding ones) run
+  // on the same island problem after the primary; its residual and time go to IslandStats,
+  // its answer is discarded. "" for none. Default "".
+  std::string reference;
+};
+
+struct IslandStats {
+  int bodies = 0;
+  int joints = 0;  // active joints (getInfo1 gave m > 0)
+  int rows = 0;
+  int unbounded = 0;  // rows with lo = -inf, hi = +inf
+  int iterations = 0;
+  double residual = kNotComputed;  // of the answer applied to the bodies
+  Status status = Status::Converged;
+  std::string message;
+  bool fellBack = false;  // the fallback's answer was applied
+  bool warmStarted = false;
+  double solveSeconds = 0;                  // the solver(s) only
+  double islandSeconds = 0;                 // the whole island, rows to integration
+  double referenceResidual = kNotComputed;  // StepperOptions::reference's answer
+  double referenceSeconds = 0;
+};
+
+struct StepStats {
+  std::vector<IslandStats> islands;
+  double seconds = 0;  // the whole step() call
+  int rows() const;
+  int fallbacks() const;
+  double maxResidual() const;  // over islands with rows; 0 when there are none
+  int maxIterations() const;
+};
+
+class Stepper {
+ public:
+  // Throws std::invalid_argument naming the known solvers when `solver` (or options.fallback,
+  // options.reference) is not a name the stepper knows.
+  explicit Stepper(const std::string& solver, const StepperOptions& options = {});
+  ~Stepper();
+  Stepper(const Stepper&) = delete;
+  Stepper& operator=(const Stepper&) = delete;
+
+  // One step of size h (> 0), like dWorldStep: returns false when ODE could not allocate its
+  // working memory (as dWorldStep returns 0), true otherwise.
+  bool step(dWorldID world, dReal h);
+
+  const std::string& solverName() const;
+  const StepperOptions& options() const;
+  // The core solver's options (StepperOptions::solver), adjustable between steps.
+  mlcp::Options& solverOptions();
+  // Statistics of the last step (cleared at the start of each step).
+  const StepStats& lastStep() const;
+  // Forget the warm-start cache (e.g. after teleporting bodies).
+  void resetWarmStart();
+
+  // Every name accepted as a solver: the core registry's and the adapter's ("ode-...").
+  static std::string knownSolvers();
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace mlcp::ode

@@ -1,0 +1,483 @@
+#include "island.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <stdexcept>
+
+#include "mlcp/registry.hpp"
+#include "mlcp/residual.hpp"
+
+namespace mlcp::ode {
+
+namespace {
+
+constexpr int kRowWidth = dDA__MAX;  // 6: [linear; angular]
+
+Eigen::Matrix3d toEigen(const dMatrix3 m) {
+  Eigen::Matrix3d out;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) out(r, c) = m[r * 4 + c];
+  return out;
+}
+
+// Stage 1, as dxStepIsland_Stage0_Bodies (same operations in the same order, so that the
+// forces and inertias equal stock's to the bit).
+void prepareBodies(dxWorld* world, dxBody* const* body, unsigned nb, dReal h, RowSystem& rows) {
+  rows.bodies.resize(nb);
+  for (unsigned i = 0; i < nb; ++i) body[i]->tag = static_cast<int>(i);
+  for (int axis = 0; axis < 3; ++axis) {
+    const dReal g = world->gravity[axis];
+    if (g == 0) continue;
+    for (unsigned i = 0; i < nb; ++i)
+      if ((body[i]->flags & dxBodyNoGravity) == 0) body[i]->facc[axis] += body[i]->mass.mass * g;
+  }
+  for (unsigned i = 0; i < nb; ++i) {
+    dxBody* b = body[i];
+    dMatrix3 tmp, invI;
+    dMultiply2_333(tmp, b->invI, b->posr.R);
+    dMultiply0_333(invI, b->posr.R, tmp);
+    rows.bodies[i].invMass = b->invMass;
+    rows.bodies[i].invInertia = toEigen(invI);
+    if ((b->flags & dxBodyGyroscopic) && b->invMass > 0) {
+      // The implicit gyroscopic torque (Lacoursiere 2006), as ODE computes it.
+      dMatrix3 I;
+      dMultiply2_333(tmp, b->mass.I, b->posr.R);
+      dMultiply0_333(I, b->posr.R, tmp);
+      dVector3 L;
+      dMultiply0_331(L, I, b->avel);
+      dMatrix3 Itild = {0};
+      dSetCrossMatrixMinus(Itild, L, dV3E__MAX);
+      for (int k = dM3E__MIN; k != dM3E__MAX; ++k) Itild[k] = Itild[k] * h + I[k];
+      dScaleVector3(L, dRecip(h));
+      dMatrix3 itInv;
+      if (dInvertMatrix3(itInv, Itild) != 0) {
+        dMultiply0_333(Itild, I, itInv);
+        Itild[dM3E_XX] -= 1;
+        Itild[dM3E_YY] -= 1;
+        Itild[dM3E_ZZ] -= 1;
+        dVector3 tau0;
+        dMultiply0_331(tau0, Itild, L);
+        for (int k = 0; k < 3; ++k) b->tacc[k] += tau0[k];
+      }
+    }
+  }
+}
+
+// Stage 2 and 3: getInfo1 for all joints (before any getInfo2), joints ordered unbounded |
+// mixed | LCP (stable within each class), then getInfo2 into the rows and the right-hand side
+// in the canonical form. Returns the number of purely unbounded joints (what dxStepIsland
+// passes to dxSolveLCP as nub).
+int prepareRows(dxWorld* world, dxBody* const* body, unsigned nb, dxJoint* const* joint,
+                unsigned nj, dReal h, IslandWork& w) {
+  w.joints.clear();
+  for (unsigned k = 0; k < nj; ++k) {
+    dxJoint::Info1 info;
+    joint[k]->getInfo1(&info);
+    joint[k]->tag = -1;  // inactive unless numbered below
+    if (info.m > 0) w.joints.push_back({joint[k], info.m, info.nub, -1});
+  }
+  // w.joints holds the active joints in island order; order them by class, stably.
+  std::stable_partition(w.joints.begin(), w.joints.end(),
+                        [](const JointRows& j) { return j.nub == j.m; });
+  const auto mixedBegin = std::find_if(w.joints.begin(), w.joints.end(),
+                                       [](const JointRows& j) { return j.nub != j.m; });
+  const int unboundedJoints = static_cast<int>(mixedBegin - w.joints.begin());
+  std::stable_partition(mixedBegin, w.joints.end(), [](const JointRows& j) { return j.nub > 0; });
+
+  int m = 0;
+  for (std::size_t k = 0; k < w.joints.size(); ++k) {
+    w.joints[k].joint->tag = static_cast<int>(k);
+    w.joints[k].offset = m;
+    m += w.joints[k].m;
+  }
+
+  RowSystem& rows = w.rows;
+  rows.rows.resize(m);
+  rows.b.resize(m);
+  rows.lo.resize(m);
+  rows.hi.resize(m);
+  rows.cfm.resize(m);
+  rows.findex.assign(m, -1);
+
+  const dReal fps = dRecip(h);
+  for (const JointRows& jr : w.joints) {
+    dReal J1[6 * kRowWidth] = {0}, J2[6 * kRowWidth] = {0};
+    dReal rhsCfm[6 * 2], loHi[6 * 2];
+    int findex[6];
+    for (int k = 0; k < jr.m; ++k) {
+      rhsCfm[2 * k + dxJoint::GI2_RHS] = 0;
+      rhsCfm[2 * k + dxJoint::GI2_CFM] = world->global_cfm;
+      loHi[2 * k + dxJoint::GI2_LO] = -dInfinity;
+      loHi[2 * k + dxJoint::GI2_HI] = dInfinity;
+      findex[k] = -1;
+    }
+    jr.joint->getInfo2(fps, world->global_erp, kRowWidth, J1, J2, 2, rhsCfm, loHi, findex);
+    const dxBody* b0 = jr.joint->node[0].body;
+    const dxBody* b1 = jr.joint->node[1].body;
+    for (int k = 0; k < jr.m; ++k) {
+      const int i = jr.offset + k;
+      ConstraintRow& row = rows.rows[i];
+      row.bodyA = b0->tag;
+      row.bodyB = b1 ? b1->tag : -1;
+      for (int c = 0; c < kRowWidth; ++c) {
+        row.jA[c] = J1[k * kRowWidth + c];
+        row.jB[c] = b1 ? J2[k * kRowWidth + c] : 0.0;
+      }
+      rows.b[i] = rhsCfm[2 * k + dxJoint::GI2_RHS] * fps;  // ODE's rhs for now
+      rows.cfm[i] = rhsCfm[2 * k + dxJoint::GI2_CFM] * fps;
+      rows.lo[i] = loHi[2 * k + dxJoint::GI2_LO];
+      rows.hi[i] = loHi[2 * k + dxJoint::GI2_HI];
+      // findex is joint-local. An infinite friction coefficient needs no coupling (and the
+      // core requires finite mu); ODE would only differ when the normal force is exactly 0.
+      if (findex[k] != -1 && std::isfinite(rows.hi[i])) rows.findex[i] = findex[k] + jr.offset;
+    }
+  }
+
+  // rhs = c/h - J (M^-1 f_ext + v/h), after every getInfo2 (joints may add to f_ext). The
+  // products are summed in dxStepIsland's order.
+  std::vector<Vector6>& tmp = w.bodyTmp;
+  tmp.resize(nb);
+  for (unsigned i = 0; i < nb; ++i) {
+    const dxBody* b = body[i];
+    for (int k = 0; k < 3; ++k) tmp[i][k] = b->facc[k] * b->invMass + b->lvel[k] * fps;
+    dMatrix3 invI;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) invI[r * 4 + c] = rows.bodies[i].invInertia(r, c);
+    dVector3 a;
+    dMultiply0_331(a, invI, b->tacc);
+    for (int k = 0; k < 3; ++k) tmp[i][3 + k] = a[k] + b->avel[k] * fps;
+  }
+  auto dot6 = [](const Vector6& j, const Vector6& t) {
+    double s = j[0] * t[0];
+    for (int c = 1; c < kRowWidth; ++c) s += j[c] * t[c];
+    return s;
+  };
+  for (int i = 0; i < m; ++i) {
+    const ConstraintRow& row = rows.rows[i];
+    double rhs = rows.b[i];
+    rhs -= dot6(row.jA, tmp[row.bodyA]);
+    if (row.bodyB >= 0) rhs -= dot6(row.jB, tmp[row.bodyB]);
+    rows.b[i] = -rhs;  // canonical w = A x + b
+  }
+  return unboundedJoints;
+}
+
+// Stage 6, as dxStepIsland_Stage4: feedback J^T lambda per joint and body, then
+// v += h M^-1 (f_ext + J^T lambda), integrate, clear the accumulators.
+void storeImpulses(dxBody* const* body, unsigned nb, const IslandWork& w, const Vector& x, dReal h,
+                   std::vector<Vector6>& force) {
+  force.assign(nb, Vector6::Zero());
+  for (const JointRows& jr : w.joints) {
+    for (int side = 0; side < 2; ++side) {
+      const dxBody* b = jr.joint->node[side].body;
+      if (!b) continue;
+      Vector6 f = Vector6::Zero();
+      for (int k = 0; k < jr.m; ++k) {
+        const ConstraintRow& row = w.rows.rows[jr.offset + k];
+        f += (side == 0 ? row.jA : row.jB) * x[jr.offset + k];
+      }
+      if (dJointFeedback* fb = jr.joint->feedback) {
+        dReal* lin = side == 0 ? fb->f1 : fb->f2;
+        dReal* ang = side == 0 ? fb->t1 : fb->t2;
+        for (int k = 0; k < 3; ++k) {
+          lin[k] = f[k];
+          ang[k] = f[3 + k];
+        }
+      }
+      force[b->tag] += f;
+    }
+  }
+  for (unsigned i = 0; i < nb; ++i) {
+    dxBody* b = body[i];
+    const double hm = h * b->invMass;
+    dVector3 angular;
+    for (int k = 0; k < 3; ++k) {
+      b->lvel[k] += (force[i][k] + b->facc[k]) * hm;
+      angular[k] = (force[i][3 + k] + b->tacc[k]) * h;
+    }
+    const Eigen::Matrix3d& invI = w.rows.bodies[i].invInertia;
+    for (int r = 0; r < 3; ++r)
+      b->avel[r] += invI(r, 0) * angular[0] + invI(r, 1) * angular[1] + invI(r, 2) * angular[2];
+    dxStepBody(b, h);
+    dZeroVector3(b->facc);
+    dZeroVector3(b->tacc);
+  }
+}
+
+Accuracy islandAccuracy(const RowSystem& rows, const Vector& x) {
+  return accuracy(x, rows.slack(x), rows.lo, rows.hi, rows.findex,
+                  rows.size() ? rows.b.lpNorm<Eigen::Infinity>() : 0.0);
+}
+
+// ODE's own Dantzig solver on the island, in ODE's layout: A x = rhs + w with rhs = -b.
+Result solveWithOdeLcp(IslandWork& w, int nub, dxWorldProcessMemArena* arena,
+                       const Options& options, Vector& x) {
+  const double t0 = nowSeconds();
+  const unsigned m = static_cast<unsigned>(w.rows.size());
+  const unsigned skip = dPAD(m);
+  const Problem dense = w.rows.assemble(false);
+  // 64-byte aligned A, as dxStepIsland allocates it.
+  w.odeA.assign(static_cast<std::size_t>(m) * skip + 8, 0.0);
+  double* A = w.odeA.data();
+  while (reinterpret_cast<std::uintptr_t>(A) % 64 != 0) ++A;
+  for (unsigned r = 0; r < m; ++r)
+    for (unsigned c = 0; c < m; ++c) A[r * skip + c] = dense.denseA()(r, c);
+  w.odeBx.resize(2 * m);
+  w.odeLh.resize(2 * m);
+  w.odeFindex.resize(m);
+  for (unsigned i = 0; i < m; ++i) {
+    w.odeBx[2 * i + PBX_B] = -w.rows.b[i];
+    w.odeBx[2 * i + PBX_X] = 0;
+    w.odeLh[2 * i + PLH_LO] = w.rows.lo[i];
+    w.odeLh[2 * i + PLH_HI] = w.rows.hi[i];
+    w.odeFindex[i] = w.rows.findex[i];
+  }
+  void* state = arena->SaveState();
+  dxSolveLCP(arena, m, A, w.odeBx.data(), nullptr, static_cast<unsigned>(nub), w.odeLh.data(),
+             w.odeFindex.data());
+  arena->RestoreState(state);
+  x.resize(m);
+  for (unsigned i = 0; i < m; ++i) x[i] = w.odeBx[2 * i + PBX_X];
+  Result r;
+  r.status = Status::Converged;  // dxSolveLCP reports nothing; the residual decides
+  r.message = "ODE dxSolveLCP";
+  applyAccuracy(r, islandAccuracy(w.rows, x), options.tolerance);
+  r.seconds = nowSeconds() - t0;
+  return r;
+}
+
+bool usable(const Result& r, const Vector& x, int n) {
+  if (x.size() != n || !x.allFinite()) return false;
+  return r.status != Status::InvalidInput && r.status != Status::Unsupported &&
+         r.status != Status::NumericalIssue;
+}
+
+}  // namespace
+
+Method makeMethod(const std::string& name) {
+  Method m;
+  m.name = name;
+  if (name == "ode-step") {
+    m.kind = Method::Kind::ForwardStep;
+  } else if (name == "ode-quickstep") {
+    m.kind = Method::Kind::ForwardQuickStep;
+  } else if (name == "ode-lcp") {
+    m.kind = Method::Kind::OdeLcp;
+  } else if (name == "pgs") {
+    m.kind = Method::Kind::RowPgs;
+  } else {
+    std::string error;
+    m.solver = makeSolver(name, &error);
+    if (!m.solver)
+      throw std::invalid_argument("mlcp::ode::Stepper: unknown solver '" + name +
+                                  "' (known: " + Stepper::knownSolvers() + ")");
+    m.kind = Method::Kind::Assembled;
+  }
+  return m;
+}
+
+// --- warm start ----------------------------------------------------------------------------
+
+bool WarmStartCache::lookup(dxJoint* joint, int m, double* lambda, double matchDistance) const {
+  dxBody* b0 = joint->node[0].body;
+  dxBody* b1 = joint->node[1].body;
+  if (joint->type() == dJointTypeContact) {
+    const auto key = std::make_pair(b0, b1);
+    const int rank = lookupRank_[key]++;
+    const auto it = contacts_[read_].find(key);
+    if (it == contacts_[read_].end() || rank >= static_cast<int>(it->second.size())) return false;
+    const ContactEntry& e = it->second[rank];
+    const dReal* pos = static_cast<dxJointContact*>(joint)->contact.geom.pos;
+    const double d2 = (pos[0] - e.pos[0]) * (pos[0] - e.pos[0]) +
+                      (pos[1] - e.pos[1]) * (pos[1] - e.pos[1]) +
+                      (pos[2] - e.pos[2]) * (pos[2] - e.pos[2]);
+    if (e.m != m || d2 > matchDistance * matchDistance) return false;
+    std::copy(e.lambda.begin(), e.lambda.begin() + m, lambda);
+    return true;
+  }
+  const auto it = joints_[read_].find(joint);
+  if (it == joints_[read_].end()) return false;
+  const Entry& e = it->second;
+  if (e.type != joint->type() || e.m != m || e.body0 != b0 || e.body1 != b1) return false;
+  std::copy(e.lambda.begin(), e.lambda.begin() + m, lambda);
+  return true;
+}
+
+void WarmStartCache::store(dxJoint* joint, int m, const double* lambda) {
+  const int write = 1 - read_;
+  dxBody* b0 = joint->node[0].body;
+  dxBody* b1 = joint->node[1].body;
+  if (joint->type() == dJointTypeContact) {
+    const auto key = std::make_pair(b0, b1);
+    const int rank = storeRank_[key]++;
+    std::vector<ContactEntry>& list = contacts_[write][key];
+    if (static_cast<int>(list.size()) <= rank) list.resize(rank + 1);
+    ContactEntry& e = list[rank];
+    e.m = m;
+    const dReal* pos = static_cast<dxJointContact*>(joint)->contact.geom.pos;
+    std::copy(pos, pos + 3, e.pos.begin());
+    std::copy(lambda, lambda + m, e.lambda.begin());
+    return;
+  }
+  Entry& e = joints_[write][joint];
+  e.type = joint->type();
+  e.m = m;
+  e.body0 = b0;
+  e.body1 = b1;
+  std::copy(lambda, lambda + m, e.lambda.begin());
+}
+
+void WarmStartCache::endStep() {
+  read_ = 1 - read_;
+  joints_[1 - read_].clear();
+  contacts_[1 - read_].clear();
+  lookupRank_.clear();
+  storeRank_.clear();
+}
+
+void WarmStartCache::clear() {
+  for (int k = 0; k < 2; ++k) {
+    joints_[k].clear();
+    contacts_[k].clear();
+  }
+  lookupRank_.clear();
+  storeRank_.clear();
+}
+
+}  // namespace mlcp::ode
+
+// --- the island stepper --------------------------------------------------------------------
+
+namespace mlcp::ode {
+
+namespace {
+
+Result solveWith(Method& method, IslandWork& w, int nub, dxWorldProcessMemArena* arena,
+                 const StepperOptions& so, bool warm, Vector& x) {
+  Options opt = so.solver;
+  opt.warmStart = warm;
+  x = warm ? w.x0 : Vector::Zero(w.rows.size());
+  switch (method.kind) {
+    case Method::Kind::RowPgs: method.rowPgs.options() = opt; return method.rowPgs.solve(w.rows, x);
+    case Method::Kind::OdeLcp: return solveWithOdeLcp(w, nub, arena, opt, x);
+    case Method::Kind::Assembled:
+      if (!w.haveAssembled) {
+        w.assembled = w.rows.assemble(so.sparse);
+        w.haveAssembled = true;
+      }
+      method.solver->options() = opt;
+      return method.solver->solve(w.assembled, x);
+    default: break;
+  }
+  Result r;
+  r.status = Status::Unsupported;
+  r.message = method.name + " forwards whole islands and cannot solve a problem";
+  return r;
+}
+
+}  // namespace
+
+}  // namespace mlcp::ode
+
+using mlcp::ode::IslandWork;
+using mlcp::ode::JointRows;
+using mlcp::ode::Method;
+
+void mlcp::ode::Stepper::Impl::runIsland(const dxStepperProcessingCallContext* ctx) {
+  std::lock_guard<std::mutex> lock(mutex);
+  const double t0 = nowSeconds();
+  dxWorld* world = ctx->m_world;
+  dxBody* const* body = ctx->m_islandBodiesStart;
+  dxJoint* const* joint = ctx->m_islandJointsStart;
+  const unsigned nb = ctx->m_islandBodiesCount, nj = ctx->m_islandJointsCount;
+  const dReal h = ctx->m_stepSize;
+
+  IslandStats st;
+  st.bodies = static_cast<int>(nb);
+  if (primary.forwards()) {
+    for (unsigned k = 0; k < nj; ++k) {
+      dxJoint::Info1 info;
+      joint[k]->getInfo1(&info);
+      st.joints += info.m > 0;
+      st.rows += info.m;
+    }
+    if (primary.kind == Method::Kind::ForwardStep)
+      dxStepIsland(ctx);
+    else
+      dxQuickStepIsland(ctx);
+    st.message = primary.name;
+    st.islandSeconds = nowSeconds() - t0;
+    stats.islands.push_back(std::move(st));
+    return;
+  }
+
+  IslandWork& w = work;
+  prepareBodies(world, body, nb, h, w.rows);
+  const int nub = prepareRows(world, body, nb, joint, nj, h, w);
+  const int m = w.rows.size();
+  st.joints = static_cast<int>(w.joints.size());
+  st.rows = m;
+  for (int i = 0; i < m; ++i) st.unbounded += w.rows.lo[i] == -kInf && w.rows.hi[i] == kInf;
+  w.haveAssembled = false;
+
+  if (m > 0) {
+    // Stage 4: warm start.
+    w.x0.setZero(m);
+    bool warm = false;
+    if (options.warmStart)
+      for (const JointRows& jr : w.joints)
+        warm |= this->warm.lookup(jr.joint, jr.m, w.x0.data() + jr.offset,
+                                  options.contactMatchDistance);
+    st.warmStarted = warm;
+
+    // Stage 5: solve, check, fall back.
+    const double ts = nowSeconds();
+    Result r = solveWith(primary, w, nub, ctx->m_stepperArena, options, warm, w.x);
+    bool ok = usable(r, w.x, m);
+    double res = ok ? islandAccuracy(w.rows, w.x).residual : kInf;
+    if (hasFallback && (!ok || (r.status == Status::Failed && res > options.fallbackResidual))) {
+      Result rf = solveWith(fallback, w, nub, ctx->m_stepperArena, options, warm, w.xAlt);
+      const double resf = usable(rf, w.xAlt, m) ? islandAccuracy(w.rows, w.xAlt).residual : kInf;
+      if (resf < res) {
+        st.fellBack = true;
+        rf.message = fallback.name + " after " + primary.name + " (" + toString(r.status) +
+                     ", residual " + std::to_string(res) + "): " + rf.message;
+        rf.iterations += r.iterations;
+        r = std::move(rf);
+        std::swap(w.x, w.xAlt);
+        res = resf;
+        ok = true;
+      }
+    }
+    if (!ok) {
+      // Nothing usable: apply no constraint forces rather than NaN.
+      w.x.setZero(m);
+      res = islandAccuracy(w.rows, w.x).residual;
+      r.message = "no usable answer (" + std::string(toString(r.status)) + ": " + r.message +
+                  "); constraint forces set to zero";
+    }
+    st.solveSeconds = nowSeconds() - ts;
+    st.status = r.status;
+    st.iterations = r.iterations;
+    st.residual = res;
+    st.message = r.message;
+
+    if (hasReference) {
+      const double tr = nowSeconds();
+      Result rr = solveWith(reference, w, nub, ctx->m_stepperArena, options, warm, w.xAlt);
+      st.referenceSeconds = nowSeconds() - tr;
+      st.referenceResidual = usable(rr, w.xAlt, m) ? islandAccuracy(w.rows, w.xAlt).residual : kInf;
+    }
+    for (const JointRows& jr : w.joints) this->warm.store(jr.joint, jr.m, w.x.data() + jr.offset);
+  } else {
+    w.x.resize(0);
+    st.residual = 0;
+    st.message = "no constraint rows";
+  }
+
+  // Stage 6: store impulses and integrate.
+  storeImpulses(body, nb, w, w.x, h, w.bodyTmp);
+  st.islandSeconds = nowSeconds() - t0;
+  stats.islands.push_back(std::move(st));
+}

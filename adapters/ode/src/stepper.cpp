@@ -1,0 +1,166 @@
+#include <algorithm>
+#include <stdexcept>
+#include <unordered_map>
+
+#include "island.hpp"
+#include "mlcp/registry.hpp"
+
+namespace mlcp::ode {
+
+namespace {
+
+// ODE's stepper and estimator callbacks carry no user pointer: they find the stepper through
+// the world being stepped (the estimator through its bodies' world).
+std::mutex registryMutex;
+std::unordered_map<const dxWorld*, Stepper::Impl*>& activeSteppers() {
+  static std::unordered_map<const dxWorld*, Stepper::Impl*> map;
+  return map;
+}
+
+Stepper::Impl* activeStepper(const dxWorld* world) {
+  std::lock_guard<std::mutex> lock(registryMutex);
+  const auto it = activeSteppers().find(world);
+  return it == activeSteppers().end() ? nullptr : it->second;
+}
+
+// Registers the stepper for the duration of one step.
+class ActiveScope {
+ public:
+  ActiveScope(const dxWorld* world, Stepper::Impl* impl) : world_(world) {
+    std::lock_guard<std::mutex> lock(registryMutex);
+    if (!activeSteppers().emplace(world, impl).second)
+      throw std::logic_error("mlcp::ode::Stepper::step: the world is being stepped already");
+  }
+  ~ActiveScope() {
+    std::lock_guard<std::mutex> lock(registryMutex);
+    activeSteppers().erase(world_);
+  }
+
+ private:
+  const dxWorld* world_;
+};
+
+unsigned sureMaxRows(dxJoint* const* joint, unsigned nj) {
+  unsigned m = 0;
+  for (unsigned k = 0; k < nj; ++k) {
+    dxJoint::SureMaxInfo info;
+    joint[k]->getSureMaxInfo(&info);
+    m += info.max_m;
+  }
+  return m;
+}
+
+}  // namespace
+
+int StepStats::rows() const {
+  int n = 0;
+  for (const IslandStats& s : islands) n += s.rows;
+  return n;
+}
+
+int StepStats::fallbacks() const {
+  return static_cast<int>(std::count_if(islands.begin(), islands.end(),
+                                        [](const IslandStats& s) { return s.fellBack; }));
+}
+
+double StepStats::maxResidual() const {
+  double r = 0;
+  for (const IslandStats& s : islands)
+    if (s.rows > 0 && !(s.residual <= r)) r = s.residual;  // NaN (not computed) wins
+  return r;
+}
+
+int StepStats::maxIterations() const {
+  int n = 0;
+  for (const IslandStats& s : islands) n = std::max(n, s.iterations);
+  return n;
+}
+
+std::string Stepper::knownSolvers() { return solverNames() + ", ode-step, ode-quickstep, ode-lcp"; }
+
+Stepper::Stepper(const std::string& solver, const StepperOptions& options)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->name = solver;
+  impl_->options = options;
+  impl_->primary = makeMethod(solver);
+  if (!options.fallback.empty()) {
+    impl_->fallback = makeMethod(options.fallback);
+    if (impl_->fallback.forwards())
+      throw std::invalid_argument("mlcp::ode::Stepper: fallback '" + options.fallback +
+                                  "' forwards whole islands and cannot be a fallback");
+    // ODE's own solvers are there to reproduce stock ODE, answers and all.
+    impl_->hasFallback = !impl_->primary.forwards() && impl_->primary.kind != Method::Kind::OdeLcp;
+  }
+  if (!options.reference.empty()) {
+    impl_->reference = makeMethod(options.reference);
+    if (impl_->reference.forwards())
+      throw std::invalid_argument("mlcp::ode::Stepper: reference '" + options.reference +
+                                  "' forwards whole islands and cannot be a reference");
+    impl_->hasReference = !impl_->primary.forwards();
+  }
+}
+
+Stepper::~Stepper() = default;
+
+const std::string& Stepper::solverName() const { return impl_->name; }
+const StepperOptions& Stepper::options() const { return impl_->options; }
+mlcp::Options& Stepper::solverOptions() { return impl_->options.solver; }
+const StepStats& Stepper::lastStep() const { return impl_->stats; }
+void Stepper::resetWarmStart() { impl_->warm.clear(); }
+
+bool Stepper::step(dWorldID world, dReal h) {
+  if (!world) throw std::invalid_argument("mlcp::ode::Stepper::step: null world");
+  if (!(h > 0)) throw std::invalid_argument("mlcp::ode::Stepper::step: step size must be > 0");
+  const double t0 = nowSeconds();
+  impl_->stats.islands.clear();
+  ActiveScope scope(world, impl_.get());
+  // dWorldStep's two calls, with our estimator and island stepper.
+  dxWorldProcessIslandsInfo islands;
+  bool ok = dxReallocateWorldProcessContext(world, islands, h, &Impl::estimateMemory) &&
+            dxProcessIslands(world, islands, h, &Impl::stepIsland, &Impl::estimateMaxCallCount);
+  impl_->warm.endStep();
+  impl_->stats.seconds = nowSeconds() - t0;
+  return ok;
+}
+
+void Stepper::Impl::stepIsland(const dxStepperProcessingCallContext* context) {
+  activeStepper(context->m_world)->runIsland(context);
+}
+
+sizeint Stepper::Impl::estimateMemory(dxBody* const* body, unsigned nb, dxJoint* const* joint,
+                                      unsigned nj) {
+  const Impl* impl = nb > 0 ? activeStepper(body[0]->world) : nullptr;
+  return impl ? impl->memoryFor(body, nb, joint, nj) : 0;
+}
+
+unsigned Stepper::Impl::estimateMaxCallCount(unsigned activeThreads, unsigned allowedThreads) {
+  return std::max(dxEstimateStepMaxCallCount(activeThreads, allowedThreads),
+                  dxEstimateQuickStepMaxCallCount(activeThreads, allowedThreads));
+}
+
+// Arena bytes for one island: ODE's own estimate for the forwarding methods, dxSolveLCP's
+// work space for "ode-lcp"; our own buffers live on the heap and are reused.
+sizeint Stepper::Impl::memoryFor(dxBody* const* body, unsigned nb, dxJoint* const* joint,
+                                 unsigned nj) const {
+  sizeint need = 0;
+  for (const Method* m : {&primary, &fallback, &reference}) {
+    switch (m->kind) {
+      case Method::Kind::ForwardStep:
+        if (m == &primary)
+          need = std::max(need, dxEstimateStepMemoryRequirements(body, nb, joint, nj));
+        break;
+      case Method::Kind::ForwardQuickStep:
+        if (m == &primary)
+          need = std::max(need, dxEstimateQuickStepMemoryRequirements(body, nb, joint, nj));
+        break;
+      case Method::Kind::OdeLcp:
+        if (m == &primary || (m == &fallback && hasFallback) || (m == &reference && hasReference))
+          need = std::max(need, dxEstimateSolveLCPMemoryReq(sureMaxRows(joint, nj), false));
+        break;
+      default: break;
+    }
+  }
+  return dEFFICIENT_SIZE(need);
+}
+
+}  // namespace mlcp::ode
