@@ -1,0 +1,175 @@
+// mlcp/bullet/constraint_solver.hpp: any core solver as a drop-in btConstraintSolver.
+//
+//     mlcp::bullet::Settings s;
+//     s.solver = "dantzig";                       // any mlcp::makeSolver name, or "si"
+//     auto solver = std::make_unique<mlcp::bullet::ConstraintSolver>(s);
+//     world->setConstraintSolver(solver.get());   // a stock btDiscreteDynamicsWorld
+//     ...
+//     const mlcp::bullet::StepStats& st = solver->lastStep();
+//
+// Pipeline of one solveGroup call (the stages are named as in Box2D v3's solver):
+//
+//  1. prepare rows — Bullet's own sequential-impulse (SI) setup builds every row (joints,
+//     contacts, friction, rolling/torsional friction, split-impulse penetration rows) exactly as
+//     SI would; we inherit it from btSequentialImpulseConstraintSolver, like btMLCPSolver does.
+//  2. islands — the group is split into connected components of the dynamic-body graph (static
+//     and kinematic bodies do not connect anything) and each component is solved alone. Bullet
+//     merges small islands into one group (m_minimumSolverBatchSize); we undo that.
+//  3. per island, the factored rows become an mlcp::RowSystem in canonical form w = A x + b:
+//       J rows     [n1; r1 x n1] and [n2; r2 x n2] from the solver constraint, linear factors
+//                  folded into the linear part, angular factors into M^-1's inertia block
+//                  (diag(af) I^-1 diag(af), symmetric; SI itself uses af^2 I^-1 on one side);
+//       b_i      = -m_rhs / m_jacDiagABInv   (Bullet's rhs is a velocity error times 1/A_ii:
+//                                             its b is minus ours);
+//       cfm_i    = m_cfm / m_jacDiagABInv    (the regularisation SI's iteration converges to);
+//       bounds     joints as given; contacts [0, inf); friction [-mu, mu] with findex = its
+//                  contact row; rolling friction the same with its own coefficient (SI also
+//                  caps it at mu_r in absolute terms, which is not a complementarity bound).
+//  4. warm start — x0 = Bullet's applied impulses (the cached impulse times the warm-starting
+//     factor for contacts and friction, 0 for joints), already applied to the solver bodies by
+//     SI's setup.
+//  5. solve — "pgs" runs on the rows themselves (mlcp::RowPgs, O(nnz J) per sweep, no matrix);
+//     every other core solver gets A = J M^-1 J^T + diag(cfm) assembled from the body graph,
+//     dense for small islands and sparse above Settings::denseMaxRows.
+//  6. check — every answer is accepted only when it is finite and its scaled natural-map
+//     residual (mlcp::accuracy, recomputed here) is <= Settings::acceptResidual; otherwise the
+//     fallback solver runs from the same start, and the better of the two answers is kept. Both
+//     events are counted in StepStats.
+//  7. store impulses — per row delta = x - appliedImpulse goes through btSolverBody::
+//     internalApplyImpulse (as btMLCPSolver does); SI's finish then writes contact impulses,
+//     joint feedback, breaking thresholds, velocities and transforms.
+//  With split impulse on (Bullet's default) and a non-zero penetration rhs in an island, a second
+//  problem with the same A and b = -m_rhsPenetration / m_jacDiagABInv gives push impulses.
+//
+// "si" runs Bullet's own SI iterations instead (for side-by-side runs with the same statistics).
+#pragma once
+
+#include <BulletDynamics/ConstraintSolver/btSequentialImpulseConstraintSolver.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mlcp/bullet/islands.hpp"
+#include "mlcp/result.hpp"
+#include "mlcp/rows.hpp"
+#include "mlcp/solver.hpp"
+
+namespace mlcp::bullet {
+
+// How the diagonal regularisation (CFM) of each row is taken.
+enum class CfmModel {
+  // cfm_i = m_cfm / m_jacDiagABInv: what Bullet's SI iteration converges to (contacts
+  // globalCfm / dt, friction 0, joints their own CFM times A_ii).
+  Engine,
+  // globalCfm / dt on every row, per-row CFM ignored: what the stock btMLCPSolver assembles. Only
+  // for diffing against stock.
+  StockMlcp,
+};
+
+struct Settings {
+  // Core solver by registry name (mlcp::solverNames()), or "si" for Bullet's own sequential
+  // impulse iterations. Default "pgs".
+  std::string solver = "pgs";
+  // Options of the primary solver (tolerance, iteration and pivot limits, ...). warmStart is
+  // governed by Settings::warmStart. Default: core defaults.
+  Options options;
+  // Solver that runs when the primary's answer is rejected, "" for none. Default "pgs".
+  std::string fallback = "pgs";
+  // Options of the fallback. Default: core defaults (tolerance 1e-10, 1000 sweeps).
+  Options fallbackOptions;
+  // Largest scaled natural-map residual (dimensionless) at which an answer is accepted. Set it to
+  // +inf for SI-like fixed-iteration PGS. Default 1e-6.
+  double acceptResidual = 1e-6;
+  // pgs/gs take their sweep count from btContactSolverInfo::m_numIterations (as SI and the stock
+  // MLCP solvers do) instead of options.maxIterations. Default false.
+  bool bulletIterations = false;
+  // Start every solve from Bullet's applied impulses. Default true.
+  bool warmStart = true;
+  // Islands with at most this many rows give matrix-based solvers a dense A, larger ones a
+  // sparse A. Default 64.
+  int denseMaxRows = 64;
+  // Regularisation model; see CfmModel. Default Engine.
+  CfmModel cfm = CfmModel::Engine;
+  // Keep every island's rows, start, answer and result of the last step (for tests and tools;
+  // costs copies). Default false.
+  bool keepIslands = false;
+  // With "si": also measure the residual of SI's answer (costs about one sweep; excluded from
+  // StepStats::seconds). Default true.
+  bool measureSi = true;
+};
+
+// One solved problem (an island, or its split-impulse twin) of the last step.
+struct IslandRecord {
+  RowSystem system;
+  Vector start;        // warm start given to the solver
+  Vector x;            // the answer written back
+  Result result;       // of the answer written back
+  std::string solver;  // which solver gave it ("dantzig", "pgs" after a fallback, "si")
+  bool split = false;  // the split-impulse (position) problem
+  bool fellBack = false;
+};
+
+// Statistics of one simulation step (every solveGroup call between prepareSolve and the next
+// prepareSolve, which btDiscreteDynamicsWorld issues once per step).
+struct StepStats {
+  int groups = 0;       // solveGroup calls
+  int islands = 0;      // problems solved (connected components, split-impulse twins included)
+  int rows = 0;         // rows handed to solvers
+  int inertRows = 0;    // rows touching no dynamic body (no effect; left at their start value)
+  int iterations = 0;   // sweeps or pivots, summed over islands
+  double residual = 0;  // worst scaled natural-map residual over islands (NaN if not measured)
+  Status status = Status::Converged;  // worst status over islands (after the fallback)
+  double seconds = 0;         // wall time of stages 2-7 (SI: its iterations), summed over groups
+  double measureSeconds = 0;  // time spent measuring residuals outside the solve (si only)
+  int fallbacks = 0;          // islands whose primary answer was rejected
+  int failures = 0;           // islands where the fallback's answer was rejected too
+  std::string message;        // why the first rejected answer was rejected ("" if none)
+};
+
+// The check every answer passes (drop-in and bridge alike): the solver ran (not InvalidInput or
+// Unsupported), and the recomputed scaled residual is finite and <= acceptResidual. The status
+// itself is not trusted either way.
+bool acceptable(const Result& r, double acceptResidual);
+
+class ConstraintSolver : public btSequentialImpulseConstraintSolver {
+ public:
+  // Throws std::invalid_argument with the list of valid names for an unknown solver/fallback.
+  explicit ConstraintSolver(const Settings& settings = Settings());
+  ~ConstraintSolver() override;
+
+  const Settings& settings() const { return settings_; }
+
+  const StepStats& lastStep() const { return last_; }
+  // Sums over all steps so far (residual/status: worst seen).
+  const StepStats& totals() const { return totals_; }
+  // With Settings::keepIslands: the problems of the last step.
+  const std::vector<IslandRecord>& islands() const { return records_; }
+
+  void prepareSolve(int numBodies, int numManifolds) override;
+  void allSolved(const btContactSolverInfo& info, btIDebugDraw* debugDrawer) override;
+
+ protected:
+  btScalar solveGroupCacheFriendlyIterations(btCollisionObject** bodies, int numBodies,
+                                             btPersistentManifold** manifolds, int numManifolds,
+                                             btTypedConstraint** constraints, int numConstraints,
+                                             const btContactSolverInfo& info,
+                                             btIDebugDraw* debugDrawer) override;
+
+ private:
+  void solveIsland(Island& island, const btContactSolverInfo& info, bool split);
+  void measureSi(int sweeps);
+  void record(const Result& r, int rows);
+  void finishStep();
+
+  Settings settings_;
+  std::unique_ptr<Solver> primary_, secondary_;
+  bool primaryIsRowPgs_ = false, secondaryIsRowPgs_ = false, si_ = false;
+  IslandBuilder builder_;
+  StepStats current_, last_, totals_;
+  bool stepOpen_ = false;
+  std::vector<IslandRecord> records_;
+  Vector xPrimary_, xSecondary_;
+};
+
+}  // namespace mlcp::bullet

@@ -1,0 +1,63 @@
+// mlcp/bullet/islands.hpp: Bullet's solver rows as connected components in canonical form.
+//
+// Input: the pools btSequentialImpulseConstraintSolver's setup fills (solver bodies; joint,
+// contact, friction and rolling-friction rows). Output: one Island per connected component of
+// the dynamic-body graph, each holding an mlcp::RowSystem (rows in Bullet's order: joints,
+// contacts, friction, rolling friction — the stock btMLCPSolver's order) and pointers back to
+// Bullet's rows for the write-back. The conversion rules are listed in constraint_solver.hpp.
+//
+// Static bodies (Bullet maps them all to one fixed solver body) and kinematic bodies (inverse
+// mass 0) are "the world": they couple nothing, so two boxes resting on the same ground are two
+// islands. Buffers are kept between calls so a steady scene allocates little per step.
+#pragma once
+
+#include <BulletDynamics/ConstraintSolver/btSequentialImpulseConstraintSolver.h>
+
+#include <vector>
+
+#include "mlcp/rows.hpp"
+
+namespace mlcp::bullet {
+
+enum class CfmModel;
+
+struct Island {
+  RowSystem system;                       // w = A x + b with b from m_rhs
+  std::vector<btSolverConstraint*> rows;  // Bullet's row for each system row
+  Vector start;                           // applied impulses (warm start)
+  Vector splitB;                          // b of the split-impulse problem (m_rhsPenetration)
+  Vector splitStart;                      // applied push impulses
+  bool hasSplit = false;                  // splitB has a non-zero entry
+};
+
+// The pools of one solveGroup call, as btSequentialImpulseConstraintSolver holds them.
+struct BulletRows {
+  btAlignedObjectArray<btSolverBody>* bodies = nullptr;
+  btConstraintArray* joints = nullptr;
+  btConstraintArray* contacts = nullptr;
+  btConstraintArray* friction = nullptr;
+  btConstraintArray* rolling = nullptr;
+};
+
+class IslandBuilder {
+ public:
+  // Splits the rows into islands. globalCfm and timeStep feed CfmModel::StockMlcp only;
+  // warmStart false starts every island from zero.
+  void build(const BulletRows& rows, const btContactSolverInfo& info, CfmModel cfm, bool warmStart);
+
+  int count() const { return count_; }
+  Island& island(int k) { return islands_[k]; }
+  // Rows whose bodies are all static or kinematic (left untouched: they move nothing).
+  int inertRows() const { return inert_; }
+
+ private:
+  int find(int k);
+
+  std::vector<Island> islands_;
+  int count_ = 0, inert_ = 0;
+  std::vector<btSolverConstraint*> all_;
+  std::vector<int> findex_, dynamic_, parent_, islandOfRoot_, rowIsland_, rowLocal_, bodyLocal_;
+  std::vector<int> bodyCount_;
+};
+
+}  // namespace mlcp::bullet

@@ -1,0 +1,179 @@
+#include "mlcp/bullet/islands.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "mlcp/bullet/constraint_solver.hpp"
+
+namespace mlcp::bullet {
+
+namespace {
+
+Eigen::Vector3d toEigen(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
+
+// Contacts use 1e10 as "unbounded" and joints BT_INFINITY; both mean +inf to us.
+double bound(btScalar v) {
+  const double d = static_cast<double>(v);
+  if (d >= 1e10) return kInf;
+  if (d <= -1e10) return -kInf;
+  return d;
+}
+
+}  // namespace
+
+int IslandBuilder::find(int k) {
+  while (parent_[k] != k) {
+    parent_[k] = parent_[parent_[k]];
+    k = parent_[k];
+  }
+  return k;
+}
+
+void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info, CfmModel cfm,
+                          bool warmStart) {
+  const btAlignedObjectArray<btSolverBody>& bodies = *in.bodies;
+  const int nb = bodies.size();
+  const int nj = in.joints->size(), nc = in.contacts->size(), nf = in.friction->size(),
+            nr = in.rolling->size();
+  const int n = nj + nc + nf + nr;
+
+  // Rows in the stock order; friction rows point at their contact row.
+  all_.resize(n);
+  findex_.assign(n, -1);
+  for (int i = 0; i < nj; ++i) all_[i] = &(*in.joints)[i];
+  for (int i = 0; i < nc; ++i) all_[nj + i] = &(*in.contacts)[i];
+  for (int i = 0; i < nf; ++i) {
+    all_[nj + nc + i] = &(*in.friction)[i];
+    findex_[nj + nc + i] = nj + (*in.friction)[i].m_frictionIndex;
+  }
+  for (int i = 0; i < nr; ++i) {
+    all_[nj + nc + nf + i] = &(*in.rolling)[i];
+    findex_[nj + nc + nf + i] = nj + (*in.rolling)[i].m_frictionIndex;
+  }
+
+  dynamic_.resize(nb);
+  parent_.resize(nb);
+  for (int k = 0; k < nb; ++k) {
+    const btRigidBody* rb = bodies[k].m_originalBody;
+    dynamic_[k] = (rb && rb->getInvMass() != 0) ? k : -1;
+    parent_[k] = k;
+  }
+  auto dyn = [&](int solverBody) { return solverBody >= 0 ? dynamic_[solverBody] : -1; };
+  for (int i = 0; i < n; ++i) {
+    const int a = dyn(all_[i]->m_solverBodyIdA), b = dyn(all_[i]->m_solverBodyIdB);
+    if (a >= 0 && b >= 0) parent_[find(a)] = find(b);
+  }
+
+  // Islands numbered by first appearance in row order; rows keep their relative order.
+  islandOfRoot_.assign(nb, -1);
+  bodyLocal_.assign(nb, -1);
+  rowIsland_.resize(n);
+  rowLocal_.resize(n);
+  count_ = 0;
+  inert_ = 0;
+  std::vector<int>& rowsPer = bodyCount_;  // reused: rows per island, then bodies per island
+  rowsPer.clear();
+  for (int i = 0; i < n; ++i) {
+    const int a = dyn(all_[i]->m_solverBodyIdA), b = dyn(all_[i]->m_solverBodyIdB);
+    if (a < 0 && b < 0) {
+      rowIsland_[i] = -1;
+      ++inert_;
+      continue;
+    }
+    const int root = find(a >= 0 ? a : b);
+    if (islandOfRoot_[root] < 0) {
+      islandOfRoot_[root] = count_++;
+      rowsPer.push_back(0);
+    }
+    rowIsland_[i] = islandOfRoot_[root];
+    rowLocal_[i] = rowsPer[rowIsland_[i]]++;
+  }
+  if (static_cast<int>(islands_.size()) < count_) islands_.resize(count_);
+  for (int k = 0; k < count_; ++k) {
+    Island& isl = islands_[k];
+    const int m = rowsPer[k];
+    RowSystem& s = isl.system;
+    s.rows.resize(m);
+    s.bodies.clear();
+    s.b.resize(m);
+    s.lo.resize(m);
+    s.hi.resize(m);
+    s.cfm.resize(m);
+    s.findex.assign(m, -1);
+    isl.rows.resize(m);
+    isl.start.resize(m);
+    isl.splitB.resize(m);
+    isl.splitStart.resize(m);
+    isl.hasSplit = false;
+  }
+
+  // A dynamic body's local index in its island, created on first use.
+  auto localBody = [&](Island& isl, int solverBody) -> int {
+    const int d = dyn(solverBody);
+    if (d < 0) return -1;
+    if (bodyLocal_[d] < 0) {
+      const btSolverBody& sb = bodies[d];
+      const btRigidBody* rb = sb.m_originalBody;
+      BodyInverseMass m;
+      m.invMass = rb->getInvMass();
+      const Eigen::Vector3d af = toEigen(sb.m_angularFactor);
+      const btMatrix3x3& I = rb->getInvInertiaTensorWorld();
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) m.invInertia(r, c) = af[r] * I[r][c] * af[c];
+      bodyLocal_[d] = static_cast<int>(isl.system.bodies.size());
+      isl.system.bodies.push_back(m);
+    }
+    return bodyLocal_[d];
+  };
+
+  const double stockCfm = info.m_globalCfm / info.m_timeStep;
+  for (int i = 0; i < n; ++i) {
+    if (rowIsland_[i] < 0) continue;
+    Island& isl = islands_[rowIsland_[i]];
+    RowSystem& s = isl.system;
+    const int r = rowLocal_[i];
+    btSolverConstraint& c = *all_[i];
+    isl.rows[r] = &c;
+    ConstraintRow& row = s.rows[r];
+    row.bodyA = localBody(isl, c.m_solverBodyIdA);
+    row.bodyB = localBody(isl, c.m_solverBodyIdB);
+    if (row.bodyA >= 0) {
+      const btVector3 lin = c.m_contactNormal1 * bodies[c.m_solverBodyIdA].m_linearFactor;
+      row.jA << toEigen(lin), toEigen(c.m_relpos1CrossNormal);
+    } else {
+      row.jA.setZero();
+    }
+    if (row.bodyB >= 0) {
+      const btVector3 lin = c.m_contactNormal2 * bodies[c.m_solverBodyIdB].m_linearFactor;
+      row.jB << toEigen(lin), toEigen(c.m_relpos2CrossNormal);
+    } else {
+      row.jB.setZero();
+    }
+    // rhs and cfm are stored pre-multiplied by 1 / A_ii; undo it (as btMLCPSolver does).
+    const double jd = c.m_jacDiagABInv;
+    const bool scaled = !btFuzzyZero(c.m_jacDiagABInv);
+    s.b[r] = scaled ? -c.m_rhs / jd : 0.0;
+    isl.splitB[r] = scaled ? -c.m_rhsPenetration / jd : 0.0;
+    if (isl.splitB[r] != 0) isl.hasSplit = true;
+    if (cfm == CfmModel::StockMlcp)
+      s.cfm[r] = stockCfm;
+    else
+      s.cfm[r] = scaled ? std::max(0.0, c.m_cfm / jd) : 0.0;
+    if (findex_[i] >= 0) {
+      s.findex[r] = rowLocal_[findex_[i]];
+      s.lo[r] = -std::abs(static_cast<double>(c.m_friction));
+      s.hi[r] = std::abs(static_cast<double>(c.m_friction));
+    } else if (i >= nj) {  // contact
+      s.lo[r] = 0;
+      s.hi[r] = kInf;
+    } else {
+      s.lo[r] = bound(c.m_lowerLimit);
+      s.hi[r] = bound(c.m_upperLimit);
+    }
+    isl.start[r] = warmStart ? static_cast<double>(c.m_appliedImpulse) : 0.0;
+    isl.splitStart[r] = warmStart ? static_cast<double>(c.m_appliedPushImpulse) : 0.0;
+  }
+}
+
+}  // namespace mlcp::bullet
