@@ -1,0 +1,115 @@
+// Core solvers side by side: every registered solver among pgs, dantzig and lemke on the same
+// dense SPD boxed problems (n = 10 .. 1000) and one sparse block-banded problem (n = 1002).
+// The residual of each answer (mlcp::residual, checked independently) is a counter; so are
+// the solver's iterations (sweeps or pivots) and whether it converged. Compare times within
+// one run: the machines are noisy.
+#include <benchmark/benchmark.h>
+
+#include <random>
+
+#include "mlcp/registry.hpp"
+#include "mlcp/residual.hpp"
+
+namespace {
+
+using namespace mlcp;
+
+// Boxed SPD problem with a random mix of standard, finite-box and equality rows.
+Problem denseSpd(int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  DenseMatrix B(n, n);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) B(i, j) = u(rng);
+  DenseMatrix A = B * B.transpose() + 0.1 * n * DenseMatrix::Identity(n, n);
+  Vector b(n);
+  for (int i = 0; i < n; ++i) b[i] = n * u(rng);
+  Problem p(std::move(A), b);
+  for (int i = 0; i < n; ++i) {
+    if (i % 5 == 0) {
+      p.lo[i] = -kInf;
+    } else if (i % 5 == 1) {
+      p.lo[i] = -1;
+      p.hi[i] = 1;
+    }
+  }
+  return p;
+}
+
+// Block-tridiagonal SPD (a chain of bodies with 3-row contacts): 334 blocks of 3, n = 1002.
+Problem sparseBanded(unsigned seed) {
+  const int blocks = 334, n = 3 * blocks;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<Eigen::Triplet<double>> t;
+  for (int k = 0; k < blocks; ++k)
+    for (int i = 0; i < 3; ++i) {
+      const int r = 3 * k + i;
+      t.emplace_back(r, r, 4.0);
+      for (int j = 0; j < 3; ++j) {
+        if (k + 1 < blocks) {
+          const double v = 0.4 * u(rng);
+          t.emplace_back(r, 3 * (k + 1) + j, v);
+          t.emplace_back(3 * (k + 1) + j, r, v);
+        }
+      }
+    }
+  SparseMatrix A(n, n);
+  A.setFromTriplets(t.begin(), t.end());
+  Vector b(n);
+  for (int i = 0; i < n; ++i) b[i] = u(rng);
+  Problem p(std::move(A), b);
+  for (int i = 0; i < n; i += 3) {
+    p.lo[i + 1] = p.lo[i + 2] = -0.5;
+    p.hi[i + 1] = p.hi[i + 2] = 0.5;
+  }
+  return p;
+}
+
+void run(benchmark::State& state, const std::string& name, const Problem& p) {
+  std::unique_ptr<Solver> s = makeSolver(name);
+  s->options().maxIterations = 20000;
+  Vector x;
+  Result r;
+  for (auto _ : state) {
+    x.resize(0);  // cold start every time
+    r = s->solve(p, x);
+    benchmark::DoNotOptimize(x.data());
+  }
+  state.counters["n"] = p.size();
+  state.counters["residual"] = residual(p, x);
+  state.counters["iterations"] = r.iterations;
+  state.counters["converged"] = r.converged() ? 1 : 0;
+}
+
+void registerAll() {
+  static std::vector<Problem> problems;  // owned for the program's lifetime
+  const std::vector<int> sizes = {10, 50, 100, 200, 500, 1000};
+  problems.reserve(sizes.size() + 1);
+  for (int n : sizes) problems.push_back(denseSpd(n, 1000u + n));
+  problems.push_back(sparseBanded(7));
+  for (const char* name : {"pgs", "dantzig", "lemke"}) {
+    if (!makeSolver(name)) continue;  // not built into this library
+    for (size_t k = 0; k < problems.size(); ++k) {
+      const Problem* p = &problems[k];
+      const std::string label = std::string(name) +
+                                (p->isSparse() ? "/sparse_banded/" : "/dense_spd/") +
+                                std::to_string(p->size());
+      // Lemke's dense tableau beyond n = 500 takes seconds per solve: skip it.
+      if (std::string(name) == "lemke" && p->size() > 500) continue;
+      benchmark::RegisterBenchmark(label.c_str(), [p, name](benchmark::State& st) {
+        run(st, name, *p);
+      })->Unit(benchmark::kMillisecond);
+    }
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  registerAll();
+  benchmark::Initialize(&argc, argv);
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
