@@ -43,6 +43,13 @@ check findex-range 2 'findex\[1\] = 9 is out of range' -- "$mlcp" solve "$data/b
 check short-dat 2 'short.dat: file ends before' -- "$mlcp" solve "$data/bad/short.dat"
 check unknown-solver 2 "unknown solver 'nosuch'" -- "$mlcp" solve "$data/spd.json" --solver nosuch
 check bad-guess 2 'guess has 1 entries' -- "$mlcp" solve "$data/spd.json" --guess "$data/one.json"
+check trace 0 'pivot 3: z1 enters, z0 leaves' -- "$mlcp" trace lemke "$data/seed_lemke.json"
+check trace-final-table 0 'w3 +\| +32/19 +7/19 +1 +0 +0 +-110/19 +-58/19 +\| 12/19' -- "$mlcp" trace lemke "$data/seed_lemke.json"
+check trace-boxed 2 'boxed.json' -- "$mlcp" trace lemke "$data/boxed.json"
+check trace-method 2 "only 'lemke'" -- "$mlcp" trace simplex "$data/seed_lemke.json"
+check seed-lemke 0 'converged' -- "$mlcp" solve "$data/seed_lemke.json" --solver lemke --tol 1e-12
+check seed-auto 0 'converged' -- "$mlcp" solve "$data/seed_lemke.json" --solver auto
+check chain 0 'converged' -- "$mlcp" solve "$data/seed_lemke.json" --solver 'pgs>lemke'
 check table 0 'lcp_deudeu.dat' -- "$mlcp" table "$siconos/lcp/lcp_deudeu.dat" --solvers pgs
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -13,6 +13,7 @@ enum ExitCode { kSolved = 0, kNotSolved = 1, kInvalidInput = 2 };
 using Runner = std::function<int()>;
 Runner addSolveCommand(CLI::App& app);
 Runner addTableCommand(CLI::App& app);
+Runner addTraceCommand(CLI::App& app);
 
 // Shared by subcommands that take solver settings.
 struct SolverSettings {

@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   };
   add(&mlcp::cli::addSolveCommand);
   add(&mlcp::cli::addTableCommand);
+  add(&mlcp::cli::addTraceCommand);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
