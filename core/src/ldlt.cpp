@@ -63,30 +63,19 @@ void LdltSolver::run(const Problem& problem, Vector& x, Result& result) {
   const bool symmetric = isSymmetric(A);
   Impl& m = *impl_;
   const Vector rhs = -problem.b;
-  bool ok = false;
-  if (symmetric) {
-    if (!m.samePattern(A, true)) {
-      m.ldlt.analyzePattern(A);
-      m.remember(A, true);
+  // Analyze when the pattern is new, factorize, solve, refine once.
+  auto factorSolve = [&](auto& factorization) {
+    if (!m.samePattern(A, symmetric)) {
+      factorization.analyzePattern(A);
+      m.remember(A, symmetric);
     }
-    m.ldlt.factorize(A);
-    ok = m.ldlt.info() == Eigen::Success;
-    if (ok) {
-      x = m.ldlt.solve(rhs);
-      x += m.ldlt.solve(Vector(rhs - A * x));  // one step of iterative refinement
-    }
-  } else {
-    if (!m.samePattern(A, false)) {
-      m.lu.analyzePattern(A);
-      m.remember(A, false);
-    }
-    m.lu.factorize(A);
-    ok = m.lu.info() == Eigen::Success;
-    if (ok) {
-      x = m.lu.solve(rhs);
-      x += m.lu.solve(Vector(rhs - A * x));
-    }
-  }
+    factorization.factorize(A);
+    if (factorization.info() != Eigen::Success) return false;
+    x = factorization.solve(rhs);
+    x += factorization.solve(Vector(rhs - A * x));
+    return true;
+  };
+  const bool ok = symmetric ? factorSolve(m.ldlt) : factorSolve(m.lu);
   result.iterations = 1;
   if (!ok) {
     result.status = Status::Failed;
