@@ -50,6 +50,7 @@ check trace-method 2 "only 'lemke'" -- "$mlcp" trace simplex "$data/seed_lemke.j
 check seed-lemke 0 'converged' -- "$mlcp" solve "$data/seed_lemke.json" --solver lemke --tol 1e-12
 check seed-auto 0 'converged' -- "$mlcp" solve "$data/seed_lemke.json" --solver auto
 check chain 0 'converged' -- "$mlcp" solve "$data/seed_lemke.json" --solver 'pgs>lemke'
+check table-markdown 0 '\| lcp_deudeu.dat \| 2 \|' -- "$mlcp" table --markdown "$siconos/lcp/lcp_deudeu.dat" --solvers pgs,lemke
 check table 0 'lcp_deudeu.dat' -- "$mlcp" table "$siconos/lcp/lcp_deudeu.dat" --solvers pgs
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -5,6 +5,8 @@
 #include <CLI/CLI.hpp>
 #include <functional>
 
+#include "mlcp/result.hpp"
+
 namespace mlcp::cli {
 
 enum ExitCode { kSolved = 0, kNotSolved = 1, kInvalidInput = 2 };
@@ -22,5 +24,6 @@ struct SolverSettings {
   double relaxation = 1.0;
 };
 void addSolverSettings(CLI::App& cmd, SolverSettings& s);
+void applySettings(const SolverSettings& s, Options& options);
 
 }  // namespace mlcp::cli

@@ -23,6 +23,12 @@ void addSolverSettings(CLI::App& cmd, SolverSettings& s) {
       ->capture_default_str();
 }
 
+void applySettings(const SolverSettings& s, Options& options) {
+  options.tolerance = s.tolerance;
+  options.maxIterations = s.maxIterations;
+  options.relaxation = s.relaxation;
+}
+
 namespace {
 
 struct SolveArgs {
@@ -61,9 +67,7 @@ int runSolve(const SolveArgs& args) {
     return kInvalidInput;
   }
   Options& opt = solver->options();
-  opt.tolerance = args.settings.tolerance;
-  opt.maxIterations = args.settings.maxIterations;
-  opt.relaxation = args.settings.relaxation;
+  applySettings(args.settings, opt);
   Vector x;
   Result r =
       args.guess.empty() ? solver->solve(problem, x) : solver->solveWithGuess(problem, guess, x);

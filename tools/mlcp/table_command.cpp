@@ -13,6 +13,7 @@ namespace {
 struct TableArgs {
   std::vector<std::string> files;
   std::vector<std::string> solvers;
+  bool markdown = false;
   SolverSettings settings;
 };
 
@@ -21,13 +22,53 @@ std::string baseName(const std::string& path) {
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
 
+struct Row {
+  std::string problem;
+  int n = 0;
+  std::string solver;
+  Result result;
+};
+
+void printPlain(const std::vector<Row>& rows) {
+  std::printf("%-36s %5s  %-14s %-16s %8s %11s %10s\n", "problem", "n", "solver", "status", "iter",
+              "residual", "ms");
+  for (const Row& row : rows)
+    std::printf("%-36s %5d  %-14s %-16s %8d %11.3e %10.3f\n", row.problem.c_str(), row.n,
+                row.solver.c_str(), toString(row.result.status), row.result.iterations,
+                row.result.residual, row.result.seconds * 1e3);
+}
+
+// One line per problem, one column per solver; the reasons for failures listed below.
+void printMarkdown(const std::vector<Row>& rows, const std::vector<std::string>& names) {
+  std::printf("| problem | n |");
+  for (const std::string& name : names) std::printf(" %s |", name.c_str());
+  std::printf("\n|---|---|");
+  for (std::size_t k = 0; k < names.size(); ++k) std::printf("---|");
+  std::printf("\n");
+  std::vector<std::string> notes;
+  for (std::size_t i = 0; i < rows.size(); i += names.size()) {
+    std::printf("| %s | %d |", rows[i].problem.c_str(), rows[i].n);
+    for (std::size_t k = 0; k < names.size(); ++k) {
+      const Row& row = rows[i + k];
+      if (row.result.converged()) {
+        std::printf(" %.0e |", row.result.residual);
+      } else {
+        std::printf(" **%s** |", toString(row.result.status));
+        notes.push_back(row.problem + ", " + row.solver + ": " + row.result.message);
+      }
+    }
+    std::printf("\n");
+  }
+  if (!notes.empty()) std::printf("\n");
+  for (const std::string& note : notes) std::printf("- %s\n", note.c_str());
+}
+
 int runTable(const TableArgs& args) {
   std::vector<std::string> names = args.solvers;
   if (names.empty())
     for (const SolverInfo& info : solvers()) names.push_back(info.name);
+  std::vector<Row> rows;
   int unsolved = 0;
-  std::printf("%-36s %5s  %-8s %-16s %8s %11s %10s\n", "problem", "n", "solver", "status", "iter",
-              "residual", "ms");
   for (const std::string& file : args.files) {
     Problem problem;
     try {
@@ -43,19 +84,19 @@ int runTable(const TableArgs& args) {
         std::fprintf(stderr, "mlcp table: %s\n", error.c_str());
         return kInvalidInput;
       }
-      solver->options().tolerance = args.settings.tolerance;
-      solver->options().maxIterations = args.settings.maxIterations;
-      solver->options().relaxation = args.settings.relaxation;
+      applySettings(args.settings, solver->options());
       Vector x;
-      const Result r = solver->solve(problem, x);
-      unsolved += r.converged() ? 0 : 1;
-      std::printf("%-36s %5d  %-8s %-16s %8d %11.3e %10.3f\n", baseName(file).c_str(),
-                  problem.size(), name.c_str(), toString(r.status), r.iterations, r.residual,
-                  r.seconds * 1e3);
+      rows.push_back({baseName(file), problem.size(), name, solver->solve(problem, x)});
+      unsolved += rows.back().result.converged() ? 0 : 1;
     }
   }
-  std::printf("%d of %zu runs did not reach the tolerance %.1e\n", unsolved,
-              args.files.size() * names.size(), args.settings.tolerance);
+  if (args.markdown) {
+    printMarkdown(rows, names);
+  } else {
+    printPlain(rows);
+  }
+  std::printf("\n%d of %zu runs did not reach the tolerance %.1e\n", unsolved, rows.size(),
+              args.settings.tolerance);
   return kSolved;
 }
 
@@ -67,6 +108,8 @@ Runner addTableCommand(CLI::App& app) {
       "table", "Run solvers on problem files and print one line per (file, solver).");
   cmd->add_option("files", args->files, "problem files (.json or Siconos .dat)")->required();
   cmd->add_option("--solvers", args->solvers, "solver names (default: all)")->delimiter(',');
+  cmd->add_flag("--markdown", args->markdown,
+                "a Markdown table: problems x solvers, residual or status, failure reasons below");
   addSolverSettings(*cmd, args->settings);
   return [args] { return runTable(*args); };
 }
