@@ -1,0 +1,665 @@
+#include "mlcp/scene/scene.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+namespace mlcp::scene {
+
+using nlohmann::json;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+// A typo such as "count": 1e6 should fail fast rather than allocate for minutes.
+constexpr long long kMaxGeneratedBodies = 100000;
+
+double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+double norm(const Vec3& a) { return std::sqrt(dot(a, a)); }
+
+std::string shortDump(const json& v) {
+  std::string s = v.dump();
+  if (s.size() > 60) s = s.substr(0, 57) + "...";
+  return s;
+}
+
+std::string inQuotes(const std::string& s) { return "\"" + s + "\""; }
+
+std::string joinNames(std::initializer_list<const char*> names) {
+  std::string s;
+  for (const char* n : names) s += std::string(s.empty() ? "" : ", ") + n;
+  return s;
+}
+
+// A JSON value together with its path in the document, so that every check can name where it
+// failed: "bodies[3].shape.size".
+class Node {
+ public:
+  Node(const json& value, std::string path, const std::string& source)
+      : v_(value), path_(std::move(path)), source_(source) {}
+
+  [[noreturn]] void fail(const std::string& what) const {
+    throw FormatError(source_ + ": " + (path_.empty() ? "top level" : path_) + ": " + what);
+  }
+
+  const json& value() const { return v_; }
+  const std::string& path() const { return path_; }
+
+  const Node& requireObject() const {
+    if (!v_.is_object()) fail("expected an object, got " + shortDump(v_));
+    return *this;
+  }
+  bool has(const char* key) const { return v_.is_object() && v_.contains(key); }
+  Node at(const char* key) const {
+    requireObject();
+    if (!v_.contains(key)) fail(std::string("missing field \"") + key + "\"");
+    return child(key);
+  }
+  Node child(const std::string& key) const {
+    return Node(v_.at(key), path_.empty() ? key : path_ + "." + key, source_);
+  }
+  std::size_t arraySize() const {
+    if (!v_.is_array()) fail("expected an array, got " + shortDump(v_));
+    return v_.size();
+  }
+  Node item(std::size_t i) const {
+    return Node(v_.at(i), path_ + "[" + std::to_string(i) + "]", source_);
+  }
+
+  // Keys outside `allowed` (and "comment", allowed everywhere) are errors: they are typos.
+  void allowOnly(std::initializer_list<const char*> allowed) const {
+    requireObject();
+    for (auto it = v_.begin(); it != v_.end(); ++it) {
+      if (it.key() == "comment") continue;
+      bool known =
+          std::any_of(allowed.begin(), allowed.end(), [&](const char* a) { return it.key() == a; });
+      if (!known)
+        fail("unknown field " + inQuotes(it.key()) + " (allowed here: " + joinNames(allowed) + ")");
+    }
+  }
+  void forbid(const char* key, const std::string& why) const {
+    if (has(key)) child(key).fail("not allowed: " + why);
+  }
+
+  double number() const {
+    if (!v_.is_number()) fail("expected a number, got " + shortDump(v_));
+    double d = v_.get<double>();
+    if (!std::isfinite(d)) fail("expected a finite number, got " + shortDump(v_));
+    return d;
+  }
+  double positive() const {
+    double d = number();
+    if (d <= 0) fail("expected a positive number, got " + shortDump(v_));
+    return d;
+  }
+  double nonNegative() const {
+    double d = number();
+    if (d < 0) fail("expected a number >= 0, got " + shortDump(v_));
+    return d;
+  }
+  double inRange(double lo, double hi) const {
+    double d = number();
+    if (d < lo || d > hi) {
+      std::ostringstream os;
+      os << "expected a number in [" << lo << ", " << hi << "], got " << shortDump(v_);
+      fail(os.str());
+    }
+    return d;
+  }
+  long long integer(long long min, long long max) const {
+    double d = v_.is_number() ? v_.get<double>() : NAN;
+    if (!v_.is_number() || d != std::floor(d) || d < double(min) || d > double(max))
+      fail("expected an integer in [" + std::to_string(min) + ", " + std::to_string(max) +
+           "], got " + shortDump(v_));
+    return static_cast<long long>(d);
+  }
+  std::string string() const {
+    if (!v_.is_string() || v_.get<std::string>().empty())
+      fail("expected a non-empty string, got " + shortDump(v_));
+    return v_.get<std::string>();
+  }
+  bool boolean() const {
+    if (!v_.is_boolean()) fail("expected true or false, got " + shortDump(v_));
+    return v_.get<bool>();
+  }
+  Vec3 vec3(const char* what = "3 numbers") const {
+    if (!v_.is_array() || v_.size() != 3 ||
+        !std::all_of(v_.begin(), v_.end(), [](const json& e) { return e.is_number(); }))
+      fail(std::string("expected ") + what + ", got " + shortDump(v_));
+    Vec3 r{v_[0].get<double>(), v_[1].get<double>(), v_[2].get<double>()};
+    if (!std::all_of(r.begin(), r.end(), [](double d) { return std::isfinite(d); }))
+      fail(std::string("expected ") + what + ", got " + shortDump(v_));
+    return r;
+  }
+  Vec3 positiveVec3() const {
+    Vec3 r = vec3("3 positive numbers");
+    if (!std::all_of(r.begin(), r.end(), [](double d) { return d > 0; }))
+      fail("expected 3 positive numbers, got " + shortDump(v_));
+    return r;
+  }
+  Vec3 unitVec3() const {
+    Vec3 r = vec3("a direction (3 numbers, not all 0)");
+    double n = norm(r);
+    if (n < 1e-12) fail("expected a direction (3 numbers, not all 0), got " + shortDump(v_));
+    return {r[0] / n, r[1] / n, r[2] / n};
+  }
+
+ private:
+  const json& v_;
+  std::string path_;
+  const std::string& source_;
+};
+
+// Optional fields: the default when absent, else the checked value.
+double numberOr(const Node& n, const char* key, double fallback, double (Node::*get)() const) {
+  return n.has(key) ? (n.child(key).*get)() : fallback;
+}
+Vec3 vec3Or(const Node& n, const char* key, const Vec3& fallback) {
+  return n.has(key) ? n.child(key).vec3() : fallback;
+}
+
+Quat parseOrientation(const Node& n) {
+  if (n.value().is_array()) {
+    const json& a = n.value();
+    if (a.size() != 4 || !std::all_of(a.begin(), a.end(), [](const json& e) {
+          return e.is_number() && std::isfinite(e.get<double>());
+        }))
+      n.fail("expected a quaternion [w, x, y, z] or {\"axis\": [x, y, z], \"degrees\": a}, got " +
+             shortDump(a));
+    Quat q{a[0].get<double>(), a[1].get<double>(), a[2].get<double>(), a[3].get<double>()};
+    double len = std::sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
+    // Normalise rounding in hand-written values, but catch quaternions that are not rotations.
+    if (std::abs(len - 1) > 1e-3) {
+      std::ostringstream os;
+      os << "quaternion [w, x, y, z] must have length 1, has " << len
+         << " (or write {\"axis\": [x, y, z], \"degrees\": a})";
+      n.fail(os.str());
+    }
+    return {q.w / len, q.x / len, q.y / len, q.z / len};
+  }
+  if (!n.value().is_object())
+    n.fail("expected a quaternion [w, x, y, z] or {\"axis\": [x, y, z], \"degrees\": a}, got " +
+           shortDump(n.value()));
+  n.allowOnly({"axis", "degrees", "radians"});
+  Vec3 axis = n.at("axis").unitVec3();
+  if (n.has("degrees") == n.has("radians"))
+    n.fail("give exactly one of \"degrees\" or \"radians\"");
+  double angle =
+      n.has("degrees") ? n.child("degrees").number() * kPi / 180.0 : n.child("radians").number();
+  return fromAxisAngle(axis, angle);
+}
+
+Shape parseShape(const Node& n) {
+  n.requireObject();
+  const std::string type = n.at("type").string();
+  Shape s;
+  if (type == "box") {
+    n.allowOnly({"type", "size"});
+    s.type = ShapeType::Box;
+    s.size = n.at("size").positiveVec3();
+  } else if (type == "sphere") {
+    n.allowOnly({"type", "radius"});
+    s.type = ShapeType::Sphere;
+    s.radius = n.at("radius").positive();
+  } else if (type == "capsule") {
+    n.allowOnly({"type", "radius", "length"});
+    s.type = ShapeType::Capsule;
+    s.radius = n.at("radius").positive();
+    s.length = n.at("length").nonNegative();
+  } else if (type == "plane") {
+    n.allowOnly({"type", "normal", "offset"});
+    s.type = ShapeType::Plane;
+    s.normal = n.has("normal") ? n.child("normal").unitVec3() : Vec3{0, 0, 1};
+    s.offset = numberOr(n, "offset", 0.0, &Node::number);
+  } else {
+    n.child("type").fail("unknown shape " + inQuotes(type) + " (known: plane, box, sphere, capsule)");
+  }
+  return s;
+}
+
+// Extent of an unrotated shape along z (what a stack piles up).
+double heightOf(const Shape& s) {
+  switch (s.type) {
+    case ShapeType::Box: return s.size[2];
+    case ShapeType::Sphere: return 2 * s.radius;
+    case ShapeType::Capsule: return s.length + 2 * s.radius;
+    case ShapeType::Plane: break;
+  }
+  return 0;
+}
+
+enum class BodyRole { Explicit, Template, UnrotatedTemplate };
+
+// Parses a body, or a generator's template body (no name or position: the generator sets
+// them; stacks and pyramids also keep their bodies unrotated).
+Body parseBody(const Node& n, BodyRole role, const Scene& scene) {
+  n.requireObject();
+  if (role == BodyRole::Explicit) {
+    n.allowOnly({"name", "shape", "mass", "material", "position", "orientation", "velocity",
+                 "angular_velocity"});
+  } else {
+    n.forbid("name", "the generator names its bodies");
+    n.forbid("position", "the generator places its bodies");
+    if (role == BodyRole::UnrotatedTemplate)
+      n.forbid("orientation", "stack and pyramid bodies are not rotated (use a grid)");
+    n.allowOnly({"shape", "mass", "material", "orientation", "velocity", "angular_velocity"});
+  }
+  Body b;
+  if (role == BodyRole::Explicit) b.name = n.at("name").string();
+  b.shape = parseShape(n.at("shape"));
+  if (b.shape.type == ShapeType::Plane) {
+    if (role != BodyRole::Explicit) n.child("shape").fail("a generator cannot make planes");
+    if (n.has("mass") && n.child("mass").number() != 0)
+      n.child("mass").fail("a plane is static: its mass must be 0 or omitted");
+    const char* why = "a plane is placed by shape.normal and shape.offset and does not move";
+    for (const char* key : {"position", "orientation", "velocity", "angular_velocity"})
+      n.forbid(key, why);
+  } else {
+    if (!n.has("mass")) n.fail("missing field \"mass\" (kg; 0 makes the body static)");
+    b.mass = n.child("mass").nonNegative();
+    if (role != BodyRole::Explicit && b.mass == 0)
+      n.child("mass").fail("a generator's bodies must be dynamic (mass > 0)");
+    b.position = vec3Or(n, "position", b.position);
+    if (n.has("orientation")) b.orientation = parseOrientation(n.child("orientation"));
+    b.velocity = vec3Or(n, "velocity", b.velocity);
+    b.angularVelocity = vec3Or(n, "angular_velocity", b.angularVelocity);
+    if (b.mass == 0 && (norm(b.velocity) != 0 || norm(b.angularVelocity) != 0))
+      n.fail("a static body (mass 0) cannot have a velocity");
+  }
+  if (n.has("material")) {
+    const std::string m = n.child("material").string();
+    b.material = scene.findMaterial(m);
+    if (b.material < 0) n.child("material").fail("no material named " + inQuotes(m));
+  }
+  return b;
+}
+
+void expandStack(const Node& n, const Body& t, const std::string& name, const Vec3& base,
+                 std::vector<Body>& out) {
+  n.allowOnly({"generator", "name", "body", "position", "count", "gap", "mass_factor"});
+  const long long count = n.at("count").integer(1, kMaxGeneratedBodies);
+  const double gap = numberOr(n, "gap", 0.0, &Node::nonNegative);
+  const double factor = numberOr(n, "mass_factor", 1.0, &Node::positive);
+  const double h = heightOf(t.shape);
+  double mass = t.mass;
+  for (long long i = 0; i < count; ++i) {
+    Body b = t;
+    b.name = name + "." + std::to_string(i);
+    b.position = {base[0], base[1], base[2] + double(i) * (h + gap) + h / 2};
+    b.mass = mass;
+    mass *= factor;
+    out.push_back(std::move(b));
+  }
+  if (!std::isfinite(mass / factor)) n.child("mass_factor").fail("the masses overflow");
+}
+
+void expandPyramid(const Node& n, const Body& t, const std::string& name, const Vec3& base,
+                   std::vector<Body>& out) {
+  n.allowOnly({"generator", "name", "body", "position", "base", "dimensions", "gap"});
+  if (t.shape.type != ShapeType::Box)
+    n.at("body").child("shape").fail("a pyramid is made of boxes");
+  const long long layers = n.at("base").integer(1, 1000);
+  const long long dims = n.has("dimensions") ? n.child("dimensions").integer(2, 3) : 2;
+  const long long total =
+      dims == 2 ? layers * (layers + 1) / 2 : layers * (layers + 1) * (2 * layers + 1) / 6;
+  if (total > kMaxGeneratedBodies) n.child("base").fail("too many bodies");
+  const double gap = numberOr(n, "gap", 0.0, &Node::nonNegative);
+  const double px = t.shape.size[0] + gap, py = t.shape.size[1] + gap, h = t.shape.size[2];
+  int index = 0;
+  for (long long k = 0; k < layers; ++k) {
+    const long long m = layers - k;  // boxes per row in this layer
+    const long long rows = dims == 2 ? 1 : m;
+    for (long long j = 0; j < rows; ++j) {
+      for (long long i = 0; i < m; ++i) {
+        Body b = t;
+        b.name = name + "." + std::to_string(index++);
+        const double y = dims == 2 ? 0.0 : (double(j) - double(m - 1) / 2) * py;
+        b.position = {base[0] + (double(i) - double(m - 1) / 2) * px, base[1] + y,
+                      base[2] + double(k) * h + h / 2};
+        out.push_back(std::move(b));
+      }
+    }
+  }
+}
+
+void expandGrid(const Node& n, const Body& t, const std::string& name, const Vec3& first,
+                std::vector<Body>& out) {
+  n.allowOnly({"generator", "name", "body", "position", "count", "spacing"});
+  const Node c = n.at("count");
+  if (c.arraySize() != 3) c.fail("expected 3 integers [nx, ny, nz], got " + shortDump(c.value()));
+  long long count[3];
+  for (std::size_t a = 0; a < 3; ++a) count[a] = c.item(a).integer(1, kMaxGeneratedBodies);
+  if (count[0] * count[1] * count[2] > kMaxGeneratedBodies) c.fail("too many bodies");
+  const Vec3 spacing = n.at("spacing").vec3("3 numbers >= 0");
+  if (std::any_of(spacing.begin(), spacing.end(), [](double d) { return d < 0; }))
+    n.child("spacing").fail("expected 3 numbers >= 0, got " +
+                            shortDump(n.child("spacing").value()));
+  int index = 0;
+  for (long long k = 0; k < count[2]; ++k)
+    for (long long j = 0; j < count[1]; ++j)
+      for (long long i = 0; i < count[0]; ++i) {
+        Body b = t;
+        b.name = name + "." + std::to_string(index++);
+        b.position = {first[0] + double(i) * spacing[0], first[1] + double(j) * spacing[1],
+                      first[2] + double(k) * spacing[2]};
+        out.push_back(std::move(b));
+      }
+}
+
+void expandGenerator(const Node& n, const Scene& scene, std::vector<Body>& out) {
+  const std::string kind = n.at("generator").string();
+  const std::string name = n.at("name").string();
+  const Vec3 position = vec3Or(n, "position", Vec3{0, 0, 0});
+  const bool rotatable = kind == "grid";
+  const Body t =
+      parseBody(n.at("body"), rotatable ? BodyRole::Template : BodyRole::UnrotatedTemplate, scene);
+  if (kind == "stack") {
+    expandStack(n, t, name, position, out);
+  } else if (kind == "pyramid") {
+    expandPyramid(n, t, name, position, out);
+  } else if (kind == "grid") {
+    expandGrid(n, t, name, position, out);
+  } else {
+    n.child("generator")
+        .fail("unknown generator " + inQuotes(kind) + " (known: stack, pyramid, grid)");
+  }
+}
+
+void parseMaterials(const Node& n, Scene& scene) {
+  n.requireObject();
+  for (auto it = n.value().begin(); it != n.value().end(); ++it) {
+    if (it.key() == "comment") continue;
+    const Node m = n.child(it.key());
+    m.allowOnly({"friction", "restitution"});
+    Material mat;
+    mat.name = it.key();
+    mat.friction = numberOr(m, "friction", mat.friction, &Node::nonNegative);
+    if (m.has("restitution")) mat.restitution = m.child("restitution").inRange(0, 1);
+    int existing = scene.findMaterial(mat.name);
+    if (existing >= 0)
+      scene.materials[existing] = mat;  // only "default" can already be there
+    else
+      scene.materials.push_back(mat);
+  }
+}
+
+void parseSettings(const Node& n, Settings& s) {
+  n.allowOnly({"time_step", "steps", "erp", "cfm", "sleeping", "max_contacts_per_pair"});
+  s.timeStep = numberOr(n, "time_step", s.timeStep, &Node::positive);
+  if (n.has("steps")) s.steps = int(n.child("steps").integer(1, 100000000));
+  if (n.has("erp")) s.erp = n.child("erp").inRange(0, 1);
+  s.cfm = numberOr(n, "cfm", s.cfm, &Node::nonNegative);
+  if (n.has("sleeping")) s.sleeping = n.child("sleeping").boolean();
+  if (n.has("max_contacts_per_pair"))
+    s.maxContactsPerPair = int(n.child("max_contacts_per_pair").integer(1, 64));
+}
+
+void parseSolver(const Node& n, SolverDefaults& s) {
+  n.allowOnly({"name", "iterations", "tolerance", "warm_start"});
+  if (n.has("name")) s.name = n.child("name").string();
+  if (n.has("iterations")) s.iterations = int(n.child("iterations").integer(1, 100000000));
+  s.tolerance = numberOr(n, "tolerance", s.tolerance, &Node::positive);
+  if (n.has("warm_start")) s.warmStart = n.child("warm_start").boolean();
+}
+
+int jointBody(const Node& n, const Scene& scene) {
+  const std::string name = n.string();
+  const int i = scene.findBody(name);
+  if (i < 0) n.fail("no body named " + inQuotes(name));
+  if (scene.bodies[i].isStatic())
+    n.fail("body " + inQuotes(name) +
+           " is static; a joint to the fixed world lists only the moving body");
+  return i;
+}
+
+void parseJointLimitsAndMotor(const Node& n, Joint& j) {
+  if (n.has("limits")) {
+    const Node l = n.child("limits");
+    l.allowOnly({"lower", "upper"});
+    j.limits.enabled = true;
+    j.limits.lower = l.at("lower").number();
+    j.limits.upper = l.at("upper").number();
+    if (j.limits.lower > j.limits.upper) {
+      std::ostringstream os;
+      os << "lower (" << j.limits.lower << ") is above upper (" << j.limits.upper << ")";
+      l.fail(os.str());
+    }
+  }
+  if (n.has("motor")) {
+    const Node m = n.child("motor");
+    m.allowOnly({"velocity", "max_force"});
+    j.motor.enabled = true;
+    j.motor.velocity = m.at("velocity").number();
+    j.motor.maxForce = m.at("max_force").nonNegative();
+  }
+}
+
+Joint parseJoint(const Node& n, std::size_t index, const Scene& scene) {
+  n.requireObject();
+  Joint j;
+  j.name = n.has("name") ? n.child("name").string() : "joints[" + std::to_string(index) + "]";
+  const Node typeNode = n.at("type");
+  const std::string type = typeNode.string();
+  if (type == "ball") {
+    j.type = JointType::Ball;
+    n.allowOnly({"name", "type", "bodies", "anchor", "collide_connected"});
+  } else if (type == "hinge") {
+    j.type = JointType::Hinge;
+    n.allowOnly(
+        {"name", "type", "bodies", "anchor", "axis", "limits", "motor", "collide_connected"});
+  } else if (type == "slider") {
+    j.type = JointType::Slider;
+    n.allowOnly(
+        {"name", "type", "bodies", "anchor", "axis", "limits", "motor", "collide_connected"});
+  } else if (type == "fixed") {
+    j.type = JointType::Fixed;
+    n.allowOnly({"name", "type", "bodies", "anchor", "collide_connected"});
+  } else {
+    typeNode.fail("unknown joint type " + inQuotes(type) + " (known: ball, hinge, slider, fixed)");
+  }
+
+  const Node bodies = n.at("bodies");
+  const std::size_t count = bodies.arraySize();
+  if (count < 1 || count > 2)
+    bodies.fail("expected 1 body name (jointed to the world) or 2, got " +
+                shortDump(bodies.value()));
+  j.body0 = jointBody(bodies.item(0), scene);
+  if (count == 2) {
+    j.body1 = jointBody(bodies.item(1), scene);
+    if (j.body1 == j.body0) bodies.fail("a joint needs two different bodies");
+  }
+
+  const bool anchorRequired = j.type == JointType::Ball || j.type == JointType::Hinge;
+  if (anchorRequired || n.has("anchor"))
+    j.anchor = n.at("anchor").vec3();
+  else
+    j.anchor = scene.bodies[j.body0].position;
+  if (j.type == JointType::Hinge || j.type == JointType::Slider) {
+    j.axis = n.at("axis").unitVec3();
+    parseJointLimitsAndMotor(n, j);
+  }
+  if (n.has("collide_connected")) j.collideConnected = n.child("collide_connected").boolean();
+  return j;
+}
+
+std::string stem(const std::string& source) {
+  std::filesystem::path p(source);
+  return p.extension() == ".json" ? p.stem().string() : p.filename().string();
+}
+
+std::string withoutJsonPrefix(const std::string& what) {
+  // nlohmann's messages start with "[json.exception.parse_error.101] ".
+  auto close = what.find("] ");
+  return what.rfind("[json.exception", 0) == 0 && close != std::string::npos
+             ? what.substr(close + 2)
+             : what;
+}
+
+}  // namespace
+
+Vec3 rotate(const Quat& q, const Vec3& v) {
+  // v + 2 u x (u x v + w v), u = (x, y, z): the expanded q v q^-1 for unit q.
+  const Vec3 u{q.x, q.y, q.z};
+  const Vec3 t{u[1] * v[2] - u[2] * v[1] + q.w * v[0], u[2] * v[0] - u[0] * v[2] + q.w * v[1],
+               u[0] * v[1] - u[1] * v[0] + q.w * v[2]};
+  return {v[0] + 2 * (u[1] * t[2] - u[2] * t[1]), v[1] + 2 * (u[2] * t[0] - u[0] * t[2]),
+          v[2] + 2 * (u[0] * t[1] - u[1] * t[0])};
+}
+
+Quat fromAxisAngle(const Vec3& axis, double radians) {
+  const double n = norm(axis);
+  const double s = std::sin(radians / 2) / n;
+  return {std::cos(radians / 2), axis[0] * s, axis[1] * s, axis[2] * s};
+}
+
+const char* toString(ShapeType type) {
+  switch (type) {
+    case ShapeType::Plane: return "plane";
+    case ShapeType::Box: return "box";
+    case ShapeType::Sphere: return "sphere";
+    case ShapeType::Capsule: return "capsule";
+  }
+  return "?";
+}
+
+const char* toString(JointType type) {
+  switch (type) {
+    case JointType::Ball: return "ball";
+    case JointType::Hinge: return "hinge";
+    case JointType::Slider: return "slider";
+    case JointType::Fixed: return "fixed";
+  }
+  return "?";
+}
+
+Vec3 inertiaOf(const Shape& s, double m) {
+  if (m <= 0) return {0, 0, 0};
+  switch (s.type) {
+    case ShapeType::Box: {
+      const double x2 = s.size[0] * s.size[0], y2 = s.size[1] * s.size[1],
+                   z2 = s.size[2] * s.size[2];
+      return {m / 12 * (y2 + z2), m / 12 * (x2 + z2), m / 12 * (x2 + y2)};
+    }
+    case ShapeType::Sphere: {
+      const double i = 0.4 * m * s.radius * s.radius;
+      return {i, i, i};
+    }
+    case ShapeType::Capsule: {
+      const double r = s.radius, h = s.length;
+      const double vCyl = kPi * r * r * h, vCaps = 4.0 / 3.0 * kPi * r * r * r;
+      const double mc = m * vCyl / (vCyl + vCaps), ms = m - mc;
+      const double axial = mc * r * r / 2 + ms * 0.4 * r * r;
+      // Each hemisphere's centre of mass sits 3r/8 from its flat face, which is h/2 from the
+      // capsule's centre: the parallel-axis terms give h^2/4 + 3hr/8.
+      const double transverse =
+          mc * (h * h / 12 + r * r / 4) + ms * (0.4 * r * r + h * h / 4 + 3 * h * r / 8);
+      return {transverse, transverse, axial};
+    }
+    case ShapeType::Plane: break;
+  }
+  return {0, 0, 0};
+}
+
+double combinedFriction(const Material& a, const Material& b) {
+  return std::sqrt(a.friction * b.friction);
+}
+double combinedRestitution(const Material& a, const Material& b) {
+  return std::max(a.restitution, b.restitution);
+}
+
+int Scene::findBody(const std::string& n) const {
+  for (std::size_t i = 0; i < bodies.size(); ++i)
+    if (bodies[i].name == n) return int(i);
+  return -1;
+}
+
+int Scene::findMaterial(const std::string& n) const {
+  for (std::size_t i = 0; i < materials.size(); ++i)
+    if (materials[i].name == n) return int(i);
+  return -1;
+}
+
+int Scene::dynamicBodyCount() const {
+  return int(
+      std::count_if(bodies.begin(), bodies.end(), [](const Body& b) { return !b.isStatic(); }));
+}
+
+Scene parseScene(const std::string& text, const std::string& sourceName) {
+  json doc;
+  try {
+    doc = json::parse(text);
+  } catch (const json::parse_error& e) {
+    throw FormatError(sourceName + ": not valid JSON: " + withoutJsonPrefix(e.what()));
+  }
+  const Node root(doc, "", sourceName);
+  root.allowOnly({"format", "name", "description", "gravity", "settings", "solver", "materials",
+                  "bodies", "joints"});
+  const Node format = root.at("format");
+  if (!format.value().is_string() || format.value().get<std::string>() != kFormat)
+    format.fail(std::string("expected \"") + kFormat + "\", got " + shortDump(format.value()));
+
+  Scene scene;
+  scene.source = sourceName;
+  scene.name = root.has("name") ? root.child("name").string() : stem(sourceName);
+  if (root.has("description")) scene.description = root.child("description").string();
+  scene.gravity = vec3Or(root, "gravity", scene.gravity);
+  if (root.has("settings")) parseSettings(root.child("settings"), scene.settings);
+  if (root.has("solver")) parseSolver(root.child("solver"), scene.solver);
+  scene.materials.push_back(Material{"default"});
+  if (root.has("materials")) parseMaterials(root.child("materials"), scene);
+
+  const Node bodies = root.at("bodies");
+  if (bodies.arraySize() == 0) bodies.fail("a scene needs at least one body");
+  std::map<std::string, std::string> firstUse;  // body name -> path of the entry that made it
+  for (std::size_t i = 0; i < bodies.arraySize(); ++i) {
+    const Node entry = bodies.item(i);
+    entry.requireObject();
+    const std::size_t before = scene.bodies.size();
+    if (entry.has("generator"))
+      expandGenerator(entry, scene, scene.bodies);
+    else
+      scene.bodies.push_back(parseBody(entry, BodyRole::Explicit, scene));
+    if (scene.bodies.size() > std::size_t(kMaxGeneratedBodies))
+      entry.fail("the scene has more than " + std::to_string(kMaxGeneratedBodies) + " bodies");
+    for (std::size_t b = before; b < scene.bodies.size(); ++b) {
+      auto [it, fresh] = firstUse.emplace(scene.bodies[b].name, entry.path());
+      if (!fresh)
+        entry.fail("body name " + inQuotes(scene.bodies[b].name) + " is already used by " +
+                   it->second);
+    }
+  }
+  if (scene.dynamicBodyCount() == 0)
+    bodies.fail("a scene needs at least one dynamic body (mass > 0)");
+  for (Body& b : scene.bodies) b.inertia = inertiaOf(b.shape, b.mass);
+
+  if (root.has("joints")) {
+    const Node joints = root.child("joints");
+    for (std::size_t i = 0; i < joints.arraySize(); ++i)
+      scene.joints.push_back(parseJoint(joints.item(i), i, scene));
+  }
+  return scene;
+}
+
+Scene loadScene(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw FormatError(path + ": cannot open file");
+  std::ostringstream os;
+  os << in.rdbuf();
+  return parseScene(os.str(), path);
+}
+
+std::vector<std::string> listSceneFiles(const std::string& folder) {
+  std::vector<std::string> files;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(folder, ec))
+    if (e.is_regular_file() && e.path().extension() == ".json") files.push_back(e.path().string());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+}  // namespace mlcp::scene
