@@ -467,7 +467,13 @@ void mlcp::ode::Stepper::Impl::runIsland(const dxStepperProcessingCallContext* c
       const double tr = nowSeconds();
       Result rr = solveWith(reference, w, nub, ctx->m_stepperArena, options, warm, w.xAlt);
       st.referenceSeconds = nowSeconds() - tr;
-      st.referenceResidual = usable(rr, w.xAlt, m) ? islandAccuracy(w.rows, w.xAlt).residual : kInf;
+      if (usable(rr, w.xAlt, m)) {
+        st.referenceResidual = islandAccuracy(w.rows, w.xAlt).residual;
+        st.referenceDifference =
+            (w.xAlt - w.x).lpNorm<Eigen::Infinity>() / (1 + w.x.lpNorm<Eigen::Infinity>());
+      } else {
+        st.referenceResidual = st.referenceDifference = kInf;
+      }
     }
     for (const JointRows& jr : w.joints) this->warm.store(jr.joint, jr.m, w.x.data() + jr.offset);
   } else {

@@ -92,6 +92,9 @@ struct IslandStats {
   double solveSeconds = 0;                  // the solver(s) only
   double islandSeconds = 0;                 // the whole island, rows to integration
   double referenceResidual = kNotComputed;  // StepperOptions::reference's answer
+  // max_i |x_ref,i - x_i| / (1 + max_i |x_i|): how far the reference's lambda is from the
+  // applied one, relative to the largest constraint force.
+  double referenceDifference = kNotComputed;
   double referenceSeconds = 0;
 };
 

@@ -1,0 +1,132 @@
+// Edge cases of the ODE stepper: no joints, disabled bodies, bilateral-only islands, bad names,
+// and the C interface.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "mlcp/ode/stepper.h"
+#include "mlcp/ode/stepper.hpp"
+#include "ode/ode_scenes.hpp"
+
+namespace mlcp::ode::test {
+namespace {
+
+double maxAbsDiff(const std::vector<double>& a, const std::vector<double>& b) {
+  double d = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) d = std::max(d, std::fabs(a[i] - b[i]));
+  return d;
+}
+
+std::unique_ptr<Scene> freeBodies() {
+  auto s = std::make_unique<Scene>();
+  dBodyID a = s->addSphereBody(0, 0, 1, 0.1, 1.0);
+  dBodyID b = s->addSphereBody(1, 0, 1, 0.1, 2.0);
+  dBodySetAngularVel(a, 1, 2, 3);
+  dBodySetLinearVel(b, 0.5, 0, 2);
+  dBodySetGyroscopicMode(b, 0);
+  return s;
+}
+
+TEST(OdeEdge, WorldWithoutJointsFallsLikeDWorldStep) {
+  auto stock = freeBodies(), ours = freeBodies();
+  Stepper stepper("dantzig");
+  for (int k = 0; k < 100; ++k) {
+    dWorldStep(stock->world, 0.01);
+    ASSERT_TRUE(stepper.step(ours->world, 0.01));
+    ASSERT_EQ(stepper.lastStep().islands.size(), 2u);
+    ASSERT_EQ(stepper.lastStep().rows(), 0);
+  }
+  EXPECT_LE(maxAbsDiff(stock->state(), ours->state()), 1e-14);
+  EXPECT_LT(ours->state()[2], 0.6) << "the body should have fallen";
+}
+
+TEST(OdeEdge, DisabledBodiesAreNotStepped) {
+  auto s = freeBodies();
+  dBodyDisable(s->bodies[0]);
+  const std::vector<double> before = s->state();
+  Stepper stepper("pgs");
+  for (int k = 0; k < 10; ++k) ASSERT_TRUE(stepper.step(s->world, 0.01));
+  EXPECT_EQ(stepper.lastStep().islands.size(), 1u);
+  const std::vector<double> after = s->state();
+  for (int i = 0; i < 13; ++i) EXPECT_EQ(before[i], after[i]) << "disabled body, entry " << i;
+  EXPECT_NE(before[13 + 2], after[13 + 2]) << "the enabled body should move";
+}
+
+TEST(OdeEdge, AutoDisableWorksAsWithDWorldStep) {
+  auto s = boxOnPlane(0.0);
+  dWorldSetAutoDisableFlag(s->world, 1);
+  dWorldSetAutoDisableSteps(s->world, 10);
+  dWorldSetAutoDisableTime(s->world, 0);
+  dBodySetAutoDisableDefaults(s->bodies[0]);
+  Stepper stepper("dantzig");
+  for (int k = 0; k < 100; ++k)
+    s->step([&](dWorldID w, dReal h) { ASSERT_TRUE(stepper.step(w, h)); }, 0.01);
+  EXPECT_FALSE(dBodyIsEnabled(s->bodies[0])) << "a resting box should fall asleep";
+  EXPECT_TRUE(stepper.lastStep().islands.empty());
+  EXPECT_NEAR(s->state()[2], 0.25, 1e-3);
+}
+
+TEST(OdeEdge, IslandWithOnlyBilateralJoints) {
+  auto ours = pendulumChain(4, 0.3), stock = pendulumChain(4, 0.3);
+  StepperOptions options;
+  options.fallback = "";
+  Stepper stepper("dantzig", options), reference("ode-lcp");
+  for (int k = 0; k < 100; ++k) {
+    ours->step([&](dWorldID w, dReal h) { ASSERT_TRUE(stepper.step(w, h)); }, 0.01);
+    stock->step([&](dWorldID w, dReal h) { ASSERT_TRUE(reference.step(w, h)); }, 0.01);
+    ASSERT_EQ(stepper.lastStep().islands.size(), 1u);
+    const IslandStats& st = stepper.lastStep().islands[0];
+    ASSERT_EQ(st.rows, 20);  // 4 hinges of 5 rows
+    ASSERT_EQ(st.unbounded, st.rows);
+    ASSERT_EQ(st.status, Status::Converged) << st.message;
+    ASSERT_LE(st.residual, 1e-10);
+  }
+  EXPECT_LE(maxAbsDiff(ours->state(), stock->state()), 1e-9);
+}
+
+TEST(OdeEdge, UnknownSolverNameIsAClearError) {
+  try {
+    Stepper stepper("no-such-solver");
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("unknown solver 'no-such-solver'"), std::string::npos) << what;
+    EXPECT_NE(what.find("dantzig"), std::string::npos) << what;
+    EXPECT_NE(what.find("ode-lcp"), std::string::npos) << what;
+  }
+  StepperOptions options;
+  options.fallback = "nope";
+  EXPECT_THROW(Stepper("pgs", options), std::invalid_argument);
+  options.fallback = "ode-step";
+  EXPECT_THROW(Stepper("pgs", options), std::invalid_argument);
+  auto s = freeBodies();
+  Stepper stepper("pgs");
+  EXPECT_THROW(stepper.step(s->world, 0), std::invalid_argument);
+  EXPECT_THROW(stepper.step(nullptr, 0.01), std::invalid_argument);
+}
+
+TEST(OdeEdge, CInterface) {
+  EXPECT_EQ(mlcp_ode_stepper_create("bogus"), nullptr);
+  EXPECT_NE(std::string(mlcp_ode_last_error()).find("unknown solver 'bogus'"), std::string::npos);
+  EXPECT_EQ(mlcp_ode_stepper_create(nullptr), nullptr);
+
+  mlcp_ode_stepper* stepper = mlcp_ode_stepper_create("dantzig");
+  ASSERT_NE(stepper, nullptr);
+  EXPECT_EQ(mlcp_ode_stepper_set_tolerance(stepper, -1), 0);
+  EXPECT_EQ(mlcp_ode_stepper_set_tolerance(stepper, 1e-9), 1);
+  EXPECT_EQ(mlcp_ode_stepper_set_max_iterations(stepper, 0), 0);
+  EXPECT_EQ(mlcp_ode_stepper_set_max_iterations(stepper, 50), 1);
+  auto s = boxStack(2);
+  for (int k = 0; k < 50; ++k)
+    s->step([&](dWorldID w, dReal h) { ASSERT_EQ(mlcp_ode_stepper_step(stepper, w, h), 1); }, 0.01);
+  EXPECT_EQ(mlcp_ode_stepper_last_rows(stepper), 24);  // 2 boxes x 4 contacts x 3 rows
+  EXPECT_LE(mlcp_ode_stepper_last_residual(stepper), 1e-9);
+  EXPECT_EQ(mlcp_ode_stepper_last_fallbacks(stepper), 0);
+  EXPECT_EQ(mlcp_ode_stepper_step(stepper, s->world, -1), 0);
+  mlcp_ode_stepper_destroy(stepper);
+}
+
+}  // namespace
+}  // namespace mlcp::ode::test
