@@ -55,12 +55,24 @@ struct StandardForm {
 
 bool isFree(double lo, double hi) { return lo == -kInf && hi == kInf; }
 
+// Relative width below which a box [lo, hi] is treated as the point lo (see toStandard).
+constexpr double kNarrowBox = 1e-13;
+
 StandardForm toStandard(const DenseMatrix& A, const Vector& b, const Vector& lo, const Vector& hi) {
   StandardForm f;
   const int n = static_cast<int>(b.size());
+  // Boxes narrower than round-off relative to the scale of x (the largest finite bound, or
+  // ||b|| / max|A_ij|) count as fixed: friction bounds from a normal value of 1e-30 would
+  // otherwise be ratio-test ties that noise decides (it led to false rays).
+  const double aMax = A.size() ? A.cwiseAbs().maxCoeff() : 0.0;
+  double xScale = aMax > 0 ? b.lpNorm<Eigen::Infinity>() / aMax : 0.0;
+  for (int i = 0; i < n; ++i)
+    for (double v : {lo[i], hi[i]})
+      if (std::isfinite(v)) xScale = std::max(xScale, std::abs(v));
+  const double narrow = kNarrowBox * xScale;
   std::vector<int> freeRows;
   for (int i = 0; i < n; ++i) {
-    if (lo[i] == hi[i])
+    if (hi[i] - lo[i] <= narrow)
       f.fixed.push_back(i);
     else if (isFree(lo[i], hi[i]))
       freeRows.push_back(i);

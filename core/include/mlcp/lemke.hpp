@@ -37,7 +37,9 @@
 // whichever of the two answers has the smaller residual.
 //
 // Problems that are not standard LCPs become one by a change of variables (m >= n rows):
-//   - lo_i == hi_i (fixed):       x_i = lo_i, substituted into b; the row leaves the LCP.
+//   - lo_i == hi_i (fixed):       x_i = lo_i, substituted into b; the row leaves the LCP. So does
+//                                 a box narrower than 1e-13 times the scale of x (the largest
+//                                 finite |bound| or ||b|| / max|A_ij|): x_i = lo_i.
 //   - [lo, +inf):                 x = lo + z, z >= 0 complementary to w.
 //   - (-inf, hi]:                 x = hi - z, z >= 0 complementary to -w.
 //   - [lo, hi], both finite:      x = lo + z1 and the negative part of w, z2 = max(-w, 0):
