@@ -1,0 +1,378 @@
+#!/usr/bin/env python3
+"""Charts from mlcp CSV files: work-precision charts of a sweep, heat maps of a stability grid.
+
+Usage (from the repository, after tools/setup.sh has built .venv):
+  .venv/bin/python tools/chart.py work-precision SWEEP.csv -o OUTDIR [--stat mean|median|max]
+  .venv/bin/python tools/chart.py heatmap STABILITY.csv -o OUTDIR
+
+Both write one PNG and one SVG per scene into OUTDIR and print their paths. A bad file stops
+with a message naming the file, the line and what is wrong (exit code 2).
+
+Sweep CSV (`mlcp sweep`, tidy: one row per scene x engine x solver x setting value x step;
+columns in any order, extra columns ignored):
+  scene            scene name
+  engine           bullet | ode | ...
+  solver           solver name (registry name or fallback chain)
+  setting          name of the swept setting, e.g. iterations, tolerance
+  value            its value in this row (a number)
+  step             step index, 0-based
+  solver_ms        wall time of the MLCP solve(s) in this step, milliseconds
+  residual         scaled natural-map residual of the step's MLCP (dimensionless)
+  iterations       iterations (or pivots) the solver used
+  status           converged | max-iterations | time-limit | failed | unsupported |
+                   invalid-input | numerical-issue
+  fallbacks        number of fallbacks taken in this step
+  max_penetration  deepest contact penetration after the step, m
+  joint_error      largest joint position error after the step, m
+Each point of a chart is one (scene, engine, solver, setting, value): the statistic (--stat,
+default mean) over its steps of solver_ms (x) and residual (y), plus max_penetration and
+joint_error in the side panels. One line per engine + solver (+ setting) runs through the
+setting's values, each point labelled with its value. Hollow markers: some steps failed
+(failed, unsupported, invalid-input or numerical-issue). Non-finite values are left out;
+zeros are drawn at the bottom of the log axis.
+
+Stability CSV (`mlcp stability`; one row per cell):
+  engine, solver   as above
+  x_name, x_value  the setting along the horizontal axis and its value (a number)
+  y_name, y_value  the setting along the vertical axis and its value (a number)
+  outcome          stable | drifting | collapsed | exploded | solver-failure
+  scene            optional: one chart per scene when present
+One panel per engine + solver, cells coloured (and lettered) by outcome.
+"""
+
+import argparse
+import csv
+import math
+import os
+import re
+import statistics
+import sys
+from collections import OrderedDict, defaultdict
+
+import matplotlib
+
+matplotlib.use("Agg")  # headless: CI has no display
+# pyplot and friends are imported by load_pyplot() once the input has been checked: they take
+# a second or two to load, which a bad file should not have to wait for.
+plt = ListedColormap = Line2D = Patch = FuncFormatter = LogLocator = NullFormatter = None
+
+
+def load_pyplot():
+    global plt, ListedColormap, Line2D, Patch, FuncFormatter, LogLocator, NullFormatter
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import ListedColormap
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+SWEEP_COLUMNS = ["scene", "engine", "solver", "setting", "value", "step", "solver_ms",
+                 "residual", "iterations", "status", "fallbacks", "max_penetration",
+                 "joint_error"]
+STABILITY_COLUMNS = ["engine", "solver", "x_name", "x_value", "y_name", "y_value", "outcome"]
+FAILED = {"failed", "unsupported", "invalid-input", "numerical-issue"}
+STATUSES = {"converged", "max-iterations", "time-limit"} | FAILED
+OUTCOMES = OrderedDict([  # outcome -> (colour, letter); colour-blind-safe-ish, lettered anyway
+    ("stable", ("#1b7837", "S")),
+    ("drifting", ("#e8c547", "D")),
+    ("collapsed", ("#f4a261", "C")),
+    ("exploded", ("#c0392b", "E")),
+    ("solver-failure", ("#5e3c99", "F")),
+])
+ENGINE_STYLE = {"bullet": ("-", "o"), "ode": ("--", "s")}
+OTHER_STYLES = [(":", "^"), ("-.", "D"), ((0, (5, 1)), "v")]
+LOG_FLOOR = 1e-17  # where zeros go on a log axis
+
+
+class InputError(Exception):
+    pass
+
+
+def read_rows(path, required):
+    """The CSV's rows as dicts, after checking the header has every required column."""
+    try:
+        f = open(path, newline="")
+    except OSError as e:
+        raise InputError(f"{path}: cannot open ({e.strerror})")
+    with f:
+        reader = csv.DictReader(f)
+        header = reader.fieldnames or []
+        missing = [c for c in required if c not in header]
+        if missing:
+            raise InputError(f"{path}: missing column(s) {', '.join(missing)} "
+                             f"(the header has: {', '.join(header) or 'nothing'})")
+        rows = []
+        for row in reader:
+            if None in row or any(row[c] is None for c in required):
+                raise InputError(f"{path}: line {reader.line_num}: expected "
+                                 f"{len(header)} fields")
+            row["_line"] = reader.line_num
+            rows.append(row)
+    if not rows:
+        raise InputError(f"{path}: no data rows")
+    return rows
+
+
+def number(path, row, column, allow_nonfinite=True):
+    text = row[column].strip()
+    try:
+        v = float(text)
+    except ValueError:
+        raise InputError(f"{path}: line {row['_line']}: column {column}: "
+                         f"expected a number, got {text!r}")
+    if not allow_nonfinite and not math.isfinite(v):
+        raise InputError(f"{path}: line {row['_line']}: column {column}: "
+                         f"expected a finite number, got {text!r}")
+    return v
+
+
+def safe_name(text):
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", text).strip("_") or "chart"
+
+
+def fmt_value(v):
+    """Short tick text: 1/240 for time steps and the like, else 4 significant digits."""
+    if 0 < abs(v) < 1:
+        inverse = 1 / abs(v)
+        if abs(inverse - round(inverse)) < 1e-4 * inverse and round(inverse) <= 100000:
+            return f"{'-' if v < 0 else ''}1/{round(inverse)}"
+    return format(v, ".4g")
+
+
+def engine_style(engine, engines):
+    if engine in ENGINE_STYLE:
+        return ENGINE_STYLE[engine]
+    others = [e for e in engines if e not in ENGINE_STYLE]
+    return OTHER_STYLES[others.index(engine) % len(OTHER_STYLES)]
+
+
+def tidy_log_axis(axis, lo, hi):
+    """Readable ticks on a log axis: over less than 3 decades, plain numbers at 1, 2, 5 x 10^k
+    (matplotlib would otherwise label crowded minor ticks); over more, powers of ten only."""
+    axis.set_minor_formatter(NullFormatter())
+    if hi / lo < 1e3:
+        axis.set_major_locator(LogLocator(base=10, subs=(1, 2, 5)))
+        axis.set_major_formatter(FuncFormatter(lambda v, _: format(v, "g")))
+
+
+def save(fig, outdir, stem):
+    paths = []
+    for ext in ("png", "svg"):
+        p = os.path.join(outdir, f"{stem}.{ext}")
+        fig.savefig(p, dpi=130 if ext == "png" else None, bbox_inches="tight")
+        paths.append(p)
+    plt.close(fig)
+    return paths
+
+
+# ----------------------------------------------------------------------------------------------
+# Work-precision charts
+
+METRICS = [  # (column, axis label, panel title)
+    ("residual", "residual (scaled natural map, \u221e-norm)", "accuracy of the solves"),
+    ("max_penetration", "max penetration [m]", "penetration"),
+    ("joint_error", "joint error [m]", "joint drift"),
+]
+
+
+def aggregate(path, rows, stat):
+    reduce = {"mean": statistics.fmean, "median": statistics.median, "max": max}[stat]
+    groups = defaultdict(list)
+    for row in rows:
+        status = row["status"].strip()
+        if status not in STATUSES:
+            raise InputError(f"{path}: line {row['_line']}: column status: unknown status "
+                             f"{status!r} (known: {', '.join(sorted(STATUSES))})")
+        key = (row["scene"], row["engine"], row["solver"], row["setting"],
+               number(path, row, "value", allow_nonfinite=False))
+        groups[key].append(row)
+    points = []
+    for (scene, engine, solver, setting, value), members in groups.items():
+        p = {"scene": scene, "engine": engine, "solver": solver, "setting": setting,
+             "value": value, "steps": len(members),
+             "failed": sum(r["status"].strip() in FAILED for r in members)}
+        for column in ["solver_ms"] + [m[0] for m in METRICS]:
+            vals = [number(path, r, column) for r in members]
+            vals = [v for v in vals if math.isfinite(v)]
+            p[column] = reduce(vals) if vals else math.nan
+        points.append(p)
+    return points
+
+
+def work_precision(args):
+    points = aggregate(args.csv, read_rows(args.csv, SWEEP_COLUMNS), args.stat)
+    load_pyplot()
+    os.makedirs(args.out, exist_ok=True)
+    written = []
+    for scene in sorted({p["scene"] for p in points}):
+        written += work_precision_chart(scene, [p for p in points if p["scene"] == scene],
+                                        args.stat, args.out)
+    return written
+
+
+def work_precision_chart(scene, points, stat, outdir):
+    engines = sorted({p["engine"] for p in points})
+    solvers = sorted({p["solver"] for p in points})
+    several_settings = len({p["setting"] for p in points}) > 1
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    # The residual panel always; a side panel for each other metric that has something to show.
+    metrics = [m for m in METRICS
+               if m[0] == "residual" or any(math.isfinite(p[m[0]]) and p[m[0]] > 0
+                                            for p in points)]
+    fig, axes = plt.subplots(1, len(metrics), figsize=(6.2 * len(metrics), 4.8), squeeze=False)
+    axes = axes[0]
+    lines = defaultdict(list)
+    for p in points:
+        lines[(p["engine"], p["solver"], p["setting"])].append(p)
+    many = len(lines) > 6 or max(len(v) for v in lines.values()) > 8
+    clipped = False
+    for (engine, solver, setting), pts in sorted(lines.items()):
+        pts.sort(key=lambda p: p["value"])
+        style, marker = engine_style(engine, engines)
+        colour = colours[solvers.index(solver) % len(colours)]
+        label = f"{engine} / {solver}" + (f" ({setting})" if several_settings else "")
+        for ax, (column, _, _) in zip(axes, metrics):
+            xy = [(p["solver_ms"], p[column], p) for p in pts
+                  if math.isfinite(p["solver_ms"]) and math.isfinite(p[column])]
+            if not xy:
+                continue
+            clipped |= any(x <= 0 or y <= 0 for x, y, _ in xy)
+            xs = [max(x, LOG_FLOOR) for x, _, _ in xy]
+            ys = [max(y, LOG_FLOOR) for _, y, _ in xy]
+            ax.plot(xs, ys, linestyle=style, color=colour, linewidth=1.4, marker=marker,
+                    markersize=6, label=label)
+            for x, y, (_, _, p) in zip(xs, ys, xy):
+                if p["failed"]:
+                    ax.plot([x], [y], marker=marker, color=colour, markersize=6,
+                            markerfacecolor="white", linestyle="none")
+                if not many:
+                    ax.annotate(fmt_value(p["value"]), (x, y), textcoords="offset points",
+                                xytext=(5, 4), fontsize=7, color=colour)
+    steps = sorted({p["steps"] for p in points})
+    for ax, (column, ylabel, title) in zip(axes, metrics):
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel(f"solver time per step [ms] ({stat})")
+        ax.set_ylabel(f"{ylabel} ({stat})")
+        ax.set_title(title, fontsize=10)
+        tidy_log_axis(ax.xaxis, *ax.get_xlim())
+        tidy_log_axis(ax.yaxis, *ax.get_ylim())
+        ax.grid(True, which="major", alpha=0.35)
+        ax.grid(True, which="minor", alpha=0.12)
+    handles, labels = axes[0].get_legend_handles_labels()
+    if any(p["failed"] for p in points):
+        handles.append(Line2D([], [], marker="o", color="grey", markerfacecolor="white",
+                              linestyle="none"))
+        labels.append("hollow: some steps failed")
+    axes[-1].legend(handles, labels, fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1),
+                    borderaxespad=0, title="engine / solver", title_fontsize=8, frameon=False)
+    settings = sorted({p["setting"] for p in points})
+    note = (f"{stat} over {steps[0] if len(steps) == 1 else f'{steps[0]}-{steps[-1]}'} steps; "
+            f"points labelled with {', '.join(settings)}; lower left is better")
+    if clipped:
+        note += f"; zeros drawn at {LOG_FLOOR:g}"
+    fig.suptitle(f"{scene}: work-precision", fontsize=13, fontweight="bold")
+    fig.text(0.5, 0.005, note, ha="center", va="bottom", fontsize=8, color="dimgrey")
+    fig.tight_layout(rect=(0, 0.03, 1, 0.97))
+    return save(fig, outdir, safe_name(scene))
+
+
+# ----------------------------------------------------------------------------------------------
+# Stability heat maps
+
+
+def heatmap(args):
+    rows = read_rows(args.csv, STABILITY_COLUMNS)
+    charts = defaultdict(list)
+    for row in rows:
+        outcome = row["outcome"].strip()
+        if outcome not in OUTCOMES:
+            raise InputError(f"{args.csv}: line {row['_line']}: column outcome: unknown outcome "
+                             f"{outcome!r} (known: {', '.join(OUTCOMES)})")
+        row["x"] = number(args.csv, row, "x_value", allow_nonfinite=False)
+        row["y"] = number(args.csv, row, "y_value", allow_nonfinite=False)
+        charts[(row.get("scene") or "", row["x_name"], row["y_name"])].append(row)
+    load_pyplot()
+    os.makedirs(args.out, exist_ok=True)
+    several = len({k[1:] for k in charts}) > 1
+    written = []
+    for (scene, x_name, y_name), cells in sorted(charts.items()):
+        stem = "stability" + (f"_{scene}" if scene else "") + (
+            f"_{y_name}_vs_{x_name}" if several else "")
+        written += heatmap_chart(scene, x_name, y_name, cells, args.out, safe_name(stem))
+    return written
+
+
+def heatmap_chart(scene, x_name, y_name, cells, outdir, stem):
+    panels = sorted({(c["engine"], c["solver"]) for c in cells})
+    xs = sorted({c["x"] for c in cells})
+    ys = sorted({c["y"] for c in cells})
+    engines = sorted({e for e, _ in panels})
+    solvers = sorted({s for _, s in panels})
+    if len(panels) == len(engines) * len(solvers) and len(solvers) <= 4:
+        nrows, ncols = len(engines), len(solvers)  # engines down, solvers across
+    else:
+        ncols = math.ceil(math.sqrt(len(panels)))
+        nrows = math.ceil(len(panels) / ncols)
+    cw = max(3.2, 0.55 * len(xs) + 1.6)
+    ch = max(2.6, 0.42 * len(ys) + 1.3)
+    fig, axes = plt.subplots(nrows, ncols, figsize=(cw * ncols, ch * nrows + 0.9),
+                             squeeze=False)
+    names = list(OUTCOMES)
+    cmap = ListedColormap([OUTCOMES[n][0] for n in names])
+    cmap.set_bad("#eeeeee")
+    for ax in axes.flat[len(panels):]:
+        ax.set_visible(False)
+    for ax, (engine, solver) in zip(axes.flat, panels):
+        grid = [[math.nan] * len(xs) for _ in ys]
+        for c in cells:
+            if (c["engine"], c["solver"]) == (engine, solver):
+                grid[ys.index(c["y"])][xs.index(c["x"])] = names.index(c["outcome"].strip())
+        ax.imshow(grid, cmap=cmap, vmin=-0.5, vmax=len(names) - 0.5, origin="lower",
+                  aspect="auto", interpolation="nearest")
+        for i, row in enumerate(grid):
+            for j, v in enumerate(row):
+                if not math.isnan(v):
+                    name = names[int(v)]
+                    ax.text(j, i, OUTCOMES[name][1], ha="center", va="center", fontsize=8,
+                            color="black" if name in ("drifting", "collapsed") else "white")
+        ax.set_xticks(range(len(xs)), [fmt_value(x) for x in xs], rotation=45 if len(xs) > 6
+                      else 0, fontsize=8)
+        ax.set_yticks(range(len(ys)), [fmt_value(y) for y in ys], fontsize=8)
+        ax.set_xlabel(x_name)
+        ax.set_ylabel(y_name)
+        ax.set_title(f"{engine} / {solver}", fontsize=10)
+    legend = [Patch(facecolor=OUTCOMES[n][0], label=f"{OUTCOMES[n][1]}  {n}") for n in names]
+    legend.append(Patch(facecolor="#eeeeee", label="   not run"))
+    fig.legend(handles=legend, loc="lower center", ncol=len(legend), fontsize=8,
+               frameon=False)
+    title = f"{scene}: stability" if scene else "stability"
+    fig.suptitle(f"{title} ({y_name} against {x_name})", fontsize=13, fontweight="bold")
+    fig.tight_layout(rect=(0, 0.07, 1, 0.95))
+    return save(fig, outdir, stem)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(
+        description="Charts from mlcp CSV files (see the top of this script for the columns).")
+    sub = parser.add_subparsers(dest="mode", required=True)
+    wp = sub.add_parser("work-precision", help="solver time against residual, per scene")
+    wp.add_argument("csv", help="tidy sweep CSV (mlcp sweep)")
+    wp.add_argument("-o", "--out", required=True, help="folder for the PNG and SVG files")
+    wp.add_argument("--stat", choices=["mean", "median", "max"], default="mean",
+                    help="statistic over the steps of each point (default: mean)")
+    hm = sub.add_parser("heatmap", help="stability grid outcomes")
+    hm.add_argument("csv", help="stability CSV (mlcp stability)")
+    hm.add_argument("-o", "--out", required=True, help="folder for the PNG and SVG files")
+    args = parser.parse_args(argv)
+    try:
+        written = work_precision(args) if args.mode == "work-precision" else heatmap(args)
+    except InputError as e:
+        print(f"chart.py: {e}", file=sys.stderr)
+        return 2
+    for p in written:
+        print(p)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
