@@ -70,7 +70,7 @@ SWEEP_COLUMNS = ["scene", "engine", "solver", "setting", "value", "step", "solve
                  "joint_error"]
 STABILITY_COLUMNS = ["engine", "solver", "x_name", "x_value", "y_name", "y_value", "outcome"]
 FAILED = {"failed", "unsupported", "invalid-input", "numerical-issue"}
-STATUSES = {"converged", "max-iterations", "time-limit"} | FAILED
+STATUSES = ["converged", "max-iterations", "time-limit"] + sorted(FAILED)
 OUTCOMES = OrderedDict([  # outcome -> (colour, letter); colour-blind-safe-ish, lettered anyway
     ("stable", ("#1b7837", "S")),
     ("drifting", ("#e8c547", "D")),
@@ -123,6 +123,14 @@ def number(path, row, column, allow_nonfinite=True):
         raise InputError(f"{path}: line {row['_line']}: column {column}: "
                          f"expected a finite number, got {text!r}")
     return v
+
+
+def choice(path, row, column, known, what):
+    text = row[column].strip()
+    if text not in known:
+        raise InputError(f"{path}: line {row['_line']}: column {column}: unknown {what} "
+                         f"{text!r} (known: {', '.join(known)})")
+    return text
 
 
 def safe_name(text):
@@ -178,10 +186,7 @@ def aggregate(path, rows, stat):
     reduce = {"mean": statistics.fmean, "median": statistics.median, "max": max}[stat]
     groups = defaultdict(list)
     for row in rows:
-        status = row["status"].strip()
-        if status not in STATUSES:
-            raise InputError(f"{path}: line {row['_line']}: column status: unknown status "
-                             f"{status!r} (known: {', '.join(sorted(STATUSES))})")
+        choice(path, row, "status", STATUSES, "status")
         key = (row["scene"], row["engine"], row["solver"], row["setting"],
                number(path, row, "value", allow_nonfinite=False))
         groups[key].append(row)
@@ -284,10 +289,7 @@ def heatmap(args):
     rows = read_rows(args.csv, STABILITY_COLUMNS)
     charts = defaultdict(list)
     for row in rows:
-        outcome = row["outcome"].strip()
-        if outcome not in OUTCOMES:
-            raise InputError(f"{args.csv}: line {row['_line']}: column outcome: unknown outcome "
-                             f"{outcome!r} (known: {', '.join(OUTCOMES)})")
+        choice(args.csv, row, "outcome", list(OUTCOMES), "outcome")
         row["x"] = number(args.csv, row, "x_value", allow_nonfinite=False)
         row["y"] = number(args.csv, row, "y_value", allow_nonfinite=False)
         charts[(row.get("scene") or "", row["x_name"], row["y_name"])].append(row)

@@ -217,7 +217,8 @@ Shape parseShape(const Node& n) {
     s.normal = n.has("normal") ? n.child("normal").unitVec3() : Vec3{0, 0, 1};
     s.offset = numberOr(n, "offset", 0.0, &Node::number);
   } else {
-    n.child("type").fail("unknown shape " + inQuotes(type) + " (known: plane, box, sphere, capsule)");
+    n.child("type").fail("unknown shape " + inQuotes(type) +
+                         " (known: plane, box, sphere, capsule)");
   }
   return s;
 }
