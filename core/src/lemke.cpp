@@ -90,7 +90,9 @@ StandardForm toStandard(const DenseMatrix& A, const Vector& b, const Vector& lo,
     eliminate = lu.isInvertible() && lu.rcond() > 1e-13;
     if (eliminate) {
       f.eliminated = freeRows;
-      f.G = -lu.solve(DenseMatrix(A(freeRows, f.kept)));
+      // (Eigen's solve binds a null pointer for a right-hand side with no columns.)
+      f.G = f.kept.empty() ? DenseMatrix(freeRows.size(), 0)
+                           : DenseMatrix(-lu.solve(DenseMatrix(A(freeRows, f.kept))));
       f.g = -lu.solve(Vector(b1(freeRows)));
       Ar = A(f.kept, f.kept) + A(f.kept, freeRows) * f.G;
       br = b1(f.kept) + A(f.kept, freeRows) * f.g;
