@@ -135,6 +135,25 @@ double separation(const Placed& a, const Placed& b) {
   return best;
 }
 
+// Radius of a sphere about the centre that holds the whole shape (planes: infinite).
+double boundingRadius(const Body& b) {
+  switch (b.shape.type) {
+    case ShapeType::Box: return length(b.shape.size) / 2;
+    case ShapeType::Sphere: return b.shape.radius;
+    case ShapeType::Capsule: return b.shape.length / 2 + b.shape.radius;
+    case ShapeType::Plane: break;
+  }
+  return 1e300;
+}
+
+// The separation, or a lower bound of it (> `margin`) when the bounding spheres are farther
+// apart than `margin`: keeps the all-pairs checks fast (pyramid_1000 has half a million pairs).
+double separationOrFar(const Placed& a, const Placed& b, double margin) {
+  const double gap = length(sub(a.body->position, b.body->position)) - boundingRadius(*a.body) -
+                     boundingRadius(*b.body);
+  return gap > margin ? gap : separation(a, b);
+}
+
 // Pairs that may touch or overlap by design: both static, or joined by a joint that lets them.
 bool exempt(const Scene& s, int i, int j) {
   if (s.bodies[i].isStatic() && s.bodies[j].isStatic()) return true;
@@ -199,7 +218,7 @@ TEST(SceneFiles, NothingInterpenetrates) {
     for (std::size_t i = 0; i < placed.size(); ++i)
       for (std::size_t j = i + 1; j < placed.size(); ++j) {
         if (exempt(s, int(i), int(j))) continue;
-        const double sep = separation(placed[i], placed[j]);
+        const double sep = separationOrFar(placed[i], placed[j], 0.0);
         if (sep < -1e-9 && ++overlaps <= 5)
           ADD_FAILURE() << s.bodies[i].name << " and " << s.bodies[j].name << " overlap by " << -sep
                         << " m";
@@ -225,7 +244,7 @@ TEST(SceneFiles, RestingBodiesTouchTheirSupports) {
         if (j == i) continue;
         const bool lower = s.bodies[j].shape.type == ShapeType::Plane ||
                            s.bodies[j].position[2] < s.bodies[i].position[2];
-        supported = lower && std::abs(separation(placed[i], placed[j])) <= 1e-6;
+        supported = lower && std::abs(separationOrFar(placed[i], placed[j], 1e-3)) <= 1e-6;
       }
       EXPECT_TRUE(supported) << s.bodies[i].name << " hangs in the air";
     }
