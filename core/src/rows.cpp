@@ -136,38 +136,52 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
     return result;
   }
   const int n = s.size();
+  const int world = static_cast<int>(s.bodies.size());  // the zero-velocity slot
   Vector xs = (opt.warmStart && x.size() == n && x.allFinite()) ? x : Vector::Zero(n);
+  const double bNorm = n ? s.b.lpNorm<Eigen::Infinity>() : 0.0;
+  Accuracy last;           // accuracy of xs as it is after the last check
+  bool lastValid = false;  // whether xs is unchanged since
+  auto finish = [&]() {
+    if (!lastValid) last = accuracy(xs, s.slack(xs), s.lo, s.hi, s.findex, bNorm);
+    applyAccuracy(result, last, opt.tolerance);
+    x = std::move(xs);
+    result.seconds = nowSeconds() - t0;
+    return result;
+  };
 
-  // Per row: M^-1 J^T blocks and 1 / A_ii.
-  std::vector<Vector6> mA(n), mB(n);
-  Vector invDiag(n);
+  packed_.resize(n);
   for (int i = 0; i < n; ++i) {
     const ConstraintRow& r = s.rows[i];
-    mA[i] = r.bodyA >= 0 ? applyInverseMass(s.bodies[r.bodyA], r.jA) : Vector6::Zero();
-    mB[i] = r.bodyB >= 0 ? applyInverseMass(s.bodies[r.bodyB], r.jB) : Vector6::Zero();
-    const double d = r.jA.dot(mA[i]) + r.jB.dot(mB[i]) + s.cfm[i];
+    PackedRow& p = packed_[i];
+    p.a = r.bodyA >= 0 ? r.bodyA : world;
+    p.b = r.bodyB >= 0 ? r.bodyB : world;
+    p.jA = r.bodyA >= 0 ? r.jA : Vector6::Zero();
+    p.jB = r.bodyB >= 0 ? r.jB : Vector6::Zero();
+    p.mA = r.bodyA >= 0 ? applyInverseMass(s.bodies[r.bodyA], r.jA) : Vector6::Zero();
+    p.mB = r.bodyB >= 0 ? applyInverseMass(s.bodies[r.bodyB], r.jB) : Vector6::Zero();
+    p.cfm = s.cfm[i];
+    p.rhs = s.b[i];
+    p.lo = s.lo[i];
+    p.hi = s.hi[i];
+    p.findex = s.findex.empty() ? -1 : s.findex[i];
+    const double d = p.jA.dot(p.mA) + p.jB.dot(p.mB) + p.cfm;
     if (!(d > 0)) {
       std::ostringstream os;
       os << "row " << i << " has A_ii = " << d << ": pgs needs a positive diagonal";
       result.status = Status::Failed;
       result.message = os.str();
-      x = xs;
-      applyAccuracy(result,
-                    accuracy(xs, s.slack(xs), s.lo, s.hi, s.findex, s.b.lpNorm<Eigen::Infinity>()),
-                    opt.tolerance);
-      result.seconds = nowSeconds() - t0;
-      return result;
+      return finish();
     }
-    invDiag[i] = 1.0 / d;
+    p.invDiag = 1.0 / d;
   }
 
-  std::vector<Vector6> v = s.bodyVelocities(xs);
-  const double bNorm = n ? s.b.lpNorm<Eigen::Infinity>() : 0.0;
+  velocity_.assign(world + 1, Vector6::Zero());
+  for (int i = 0; i < n; ++i) {
+    velocity_[packed_[i].a] += packed_[i].mA * xs[i];
+    velocity_[packed_[i].b] += packed_[i].mB * xs[i];
+  }
+  velocity_[world].setZero();  // the world never moves (its blocks are zero anyway)
   const double omega = opt.relaxation;
-  auto effective = [&](int i, const Vector& lim) {
-    if (s.findex.empty() || s.findex[i] < 0) return lim[i];
-    return lim[i] * std::abs(xs[s.findex[i]]);
-  };
   detail::SweepMonitor monitor(opt, result);
   if (n == 0) {
     result.status = Status::Converged;
@@ -175,26 +189,27 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
   }
   for (int sweep = 1; n > 0 && sweep <= opt.maxIterations; ++sweep) {
     for (int i = 0; i < n; ++i) {
-      const ConstraintRow& r = s.rows[i];
-      double wi = s.cfm[i] * xs[i] + s.b[i];
-      if (r.bodyA >= 0) wi += r.jA.dot(v[r.bodyA]);
-      if (r.bodyB >= 0) wi += r.jB.dot(v[r.bodyB]);
-      const double xi =
-          std::clamp(xs[i] - omega * wi * invDiag[i], effective(i, s.lo), effective(i, s.hi));
+      const PackedRow& p = packed_[i];
+      const double wi = p.jA.dot(velocity_[p.a]) + p.jB.dot(velocity_[p.b]) + p.cfm * xs[i] + p.rhs;
+      double lo = p.lo, hi = p.hi;
+      if (p.findex >= 0) {
+        const double normal = std::abs(xs[p.findex]);
+        lo *= normal;
+        hi *= normal;
+      }
+      const double xi = std::clamp(xs[i] - omega * wi * p.invDiag, lo, hi);
       const double dx = xi - xs[i];
-      if (dx == 0) continue;
       xs[i] = xi;
-      if (r.bodyA >= 0) v[r.bodyA] += mA[i] * dx;
-      if (r.bodyB >= 0) v[r.bodyB] += mB[i] * dx;
+      velocity_[p.a] += p.mA * dx;
+      velocity_[p.b] += p.mB * dx;
     }
-    if (monitor.wantsCheck(sweep) &&
-        monitor.stop(sweep, accuracy(xs, s.slack(xs), s.lo, s.hi, s.findex, bNorm)))
-      break;
+    lastValid = false;
+    if (!monitor.wantsCheck(sweep)) continue;
+    last = accuracy(xs, s.slack(xs), s.lo, s.hi, s.findex, bNorm);
+    lastValid = true;
+    if (monitor.stop(sweep, last)) break;
   }
-  applyAccuracy(result, accuracy(xs, s.slack(xs), s.lo, s.hi, s.findex, bNorm), opt.tolerance);
-  x = std::move(xs);
-  result.seconds = nowSeconds() - t0;
-  return result;
+  return finish();
 }
 
 }  // namespace mlcp

@@ -435,10 +435,10 @@ void mlcp::ode::Stepper::Impl::runIsland(const dxStepperProcessingCallContext* c
     const double ts = nowSeconds();
     Result r = solveWith(primary, w, nub, ctx->m_stepperArena, options, warm, w.x);
     bool ok = usable(r, w.x, m);
-    double res = ok ? islandAccuracy(w.rows, w.x).residual : kInf;
+    double res = ok ? r.residual : kInf;  // the solver's result carries the checked residual
     if (hasFallback && (!ok || (r.status == Status::Failed && res > options.fallbackResidual))) {
       Result rf = solveWith(fallback, w, nub, ctx->m_stepperArena, options, warm, w.xAlt);
-      const double resf = usable(rf, w.xAlt, m) ? islandAccuracy(w.rows, w.xAlt).residual : kInf;
+      const double resf = usable(rf, w.xAlt, m) ? rf.residual : kInf;
       if (resf < res) {
         st.fellBack = true;
         rf.message = fallback.name + " after " + primary.name + " (" + toString(r.status) +

@@ -69,7 +69,16 @@ class RowPgs {
   Result solve(const RowSystem& system, Vector& x);
 
  private:
+  // One row as the sweep reads it: bodies remapped so that "the world" is a zero-velocity slot
+  // (no branches in the inner loop), J and M^-1 J^T side by side, 1 / A_ii.
+  struct PackedRow {
+    int a, b, findex;
+    double invDiag, cfm, rhs, lo, hi;
+    Vector6 jA, jB, mA, mB;
+  };
   Options options_;
+  std::vector<PackedRow> packed_;  // reused between solves
+  std::vector<Vector6> velocity_;
 };
 
 }  // namespace mlcp
