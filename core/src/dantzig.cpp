@@ -5,7 +5,9 @@
 #include <cstring>
 #include <sstream>
 
+#include "dantzig_block.hpp"
 #include "mlcp/residual.hpp"
+#include "sparse_pattern.hpp"
 
 namespace mlcp {
 
@@ -327,13 +329,7 @@ void DantzigSolver::Workspace::buildSparse(const Problem& pb) {
   const double* val = S.valuePtr();
   aMax = 0;
   for (int k = 0; k < S.nonZeros(); ++k) aMax = std::max(aMax, std::abs(val[k]));
-  {
-    const SparseMatrix T = S.transpose();
-    const SparseMatrix diff = S - T;
-    double asym = 0;
-    for (int k = 0; k < diff.nonZeros(); ++k) asym = std::max(asym, std::abs(diff.valuePtr()[k]));
-    symmetric = asym <= 1e-14 * aMax;
-  }
+  symmetric = detail::isSymmetric(S);
   const int nnz = static_cast<int>(S.nonZeros());
   // CSR of the permuted matrix: row p is the caller's row perm[p] with columns renumbered.
   rowPtr.assign(n + 1, 0);
@@ -640,23 +636,62 @@ void DantzigSolver::Workspace::setFrictionBounds(const Vector& nu) {
 
 // ======================================================================= the solver
 
-DantzigSolver::DantzigSolver() : ws_(std::make_unique<Workspace>()) {}
+DantzigSolver::DantzigSolver()
+    : ws_(std::make_unique<Workspace>()), block_(std::make_unique<detail::BlockPivoting>()) {}
 DantzigSolver::~DantzigSolver() = default;
 DantzigSolver::DantzigSolver(DantzigSolver&&) noexcept = default;
 DantzigSolver& DantzigSolver::operator=(DantzigSolver&&) noexcept = default;
 
 int DantzigSolver::passes() const { return ws_->passes; }
 
-void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
-  const Options& opt = options();
-  Workspace& ws = *ws_;
+bool DantzigSolver::wantsBlockStage(const Problem& problem, bool warm) const {
   const int n = problem.size();
+  if (n == 0 || params_.blockStage == DantzigParams::BlockStage::Never ||
+      options().frictionBounds == FrictionBounds::FixedOnce)
+    return false;
+  if (params_.blockStage == DantzigParams::BlockStage::Always) return true;
+  if (!warm || n < params_.autoMinRows) return false;
+  const double nonZeros = problem.isSparse()
+                              ? static_cast<double>(problem.sparseA().nonZeros())
+                              : static_cast<double>((problem.denseA().array() != 0).count());
+  return nonZeros <= params_.autoMaxDensity * double(n) * n;
+}
+
+void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
+  Workspace& ws = *ws_;
   ws.passes = 0;
-  if (n == 0) {
+  if (problem.size() == 0) {
     result.status = Status::Converged;
     result.message = "empty problem";
     return;
   }
+  blockSteps_ = 0;
+  blockSettled_ = false;
+  if (wantsBlockStage(problem, !x.isZero(0.0))) {
+    const detail::BlockPivoting::Report rep =
+        block_->run(problem, x, options(), std::max(1, params_.maxBlockSteps));
+    blockSteps_ = rep.steps;
+    if (rep.settled) {
+      blockSettled_ = true;
+      ws.passes = 1;
+      result.status = Status::Converged;
+      result.iterations = rep.steps;
+      result.message = rep.message;
+      return;
+    }
+    // x holds the best iterate: its index sets warm start the incremental pivoting.
+    runPivoting(problem, x, result);
+    result.iterations += rep.steps;
+    result.message = "block stage: " + rep.message + "; pivoting: " + result.message;
+    return;
+  }
+  runPivoting(problem, x, result);
+}
+
+void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& result) {
+  const Options& opt = options();
+  Workspace& ws = *ws_;
+  const int n = problem.size();
   const bool exact = opt.frictionBounds == FrictionBounds::Exact;
   const bool useGuess = !x.isZero(0.0);
   ws.build(problem, x, useGuess, exact);

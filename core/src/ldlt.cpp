@@ -4,6 +4,8 @@
 #include <Eigen/SparseLU>
 #include <sstream>
 
+#include "sparse_pattern.hpp"
+
 namespace mlcp {
 
 using ColMajor = Eigen::SparseMatrix<double, Eigen::ColMajor>;
@@ -11,39 +13,12 @@ using ColMajor = Eigen::SparseMatrix<double, Eigen::ColMajor>;
 struct LdltSolver::Impl {
   Eigen::SimplicialLDLT<ColMajor> ldlt;
   Eigen::SparseLU<ColMajor> lu;
-  // The pattern the symbolic analysis was done for.
-  std::vector<ColMajor::StorageIndex> outer, inner;
-  bool symmetricAnalyzed = false;
-  int analyses = 0;
-
-  bool samePattern(const ColMajor& A, bool symmetric) const {
-    if (symmetric != symmetricAnalyzed ||
-        A.outerSize() + 1 != static_cast<Eigen::Index>(outer.size()))
-      return false;
-    return std::equal(outer.begin(), outer.end(), A.outerIndexPtr()) &&
-           static_cast<Eigen::Index>(inner.size()) == A.nonZeros() &&
-           std::equal(inner.begin(), inner.end(), A.innerIndexPtr());
-  }
-  void remember(const ColMajor& A, bool symmetric) {
-    outer.assign(A.outerIndexPtr(), A.outerIndexPtr() + A.outerSize() + 1);
-    inner.assign(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros());
-    symmetricAnalyzed = symmetric;
-    ++analyses;
-  }
+  detail::PatternCache pattern;  // tagged 1 for LDL^T, 0 for LU
 };
 
 LdltSolver::LdltSolver() : impl_(std::make_unique<Impl>()) {}
 LdltSolver::~LdltSolver() = default;
-int LdltSolver::analyses() const { return impl_->analyses; }
-
-namespace {
-bool isSymmetric(const ColMajor& A) {
-  if (A.nonZeros() == 0) return true;
-  const double scale = std::max(1.0, A.coeffs().cwiseAbs().maxCoeff());
-  const ColMajor difference = A - ColMajor(A.transpose());
-  return difference.nonZeros() == 0 || difference.coeffs().cwiseAbs().maxCoeff() <= 1e-14 * scale;
-}
-}  // namespace
+int LdltSolver::analyses() const { return impl_->pattern.analyses(); }
 
 void LdltSolver::run(const Problem& problem, Vector& x, Result& result) {
   const int n = problem.size();
@@ -60,14 +35,14 @@ void LdltSolver::run(const Problem& problem, Vector& x, Result& result) {
   }
   ColMajor A = problem.toSparse();
   A.makeCompressed();
-  const bool symmetric = isSymmetric(A);
+  const bool symmetric = detail::isSymmetric(A);
   Impl& m = *impl_;
   const Vector rhs = -problem.b;
   // Analyze when the pattern is new, factorize, solve, refine once.
   auto factorSolve = [&](auto& factorization) {
-    if (!m.samePattern(A, symmetric)) {
+    if (!m.pattern.same(A, symmetric)) {
       factorization.analyzePattern(A);
-      m.remember(A, symmetric);
+      m.pattern.remember(A, symmetric);
     }
     factorization.factorize(A);
     if (factorization.info() != Eigen::Success) return false;

@@ -1,5 +1,9 @@
 // Core solvers side by side: every registered solver among pgs, dantzig and lemke on the same
 // dense SPD boxed problems (n = 10 .. 1000) and one sparse block-banded problem (n = 1002).
+// Then box pyramids of 15 and 55 boxes (tests/common/contact_scenes.hpp) as engines hand them
+// over: per iteration one time step (perturb b, assemble A sparse from the rows, solve warm
+// from the previous step's answer), for dantzig with the block stage and without it
+// ("dantzig-dense"), cold and warm, and pgs for reference at a residual target of 1e-6.
 // The residual of each answer (mlcp::residual, checked independently) is a counter; so are
 // the solver's iterations (sweeps or pivots) and whether it converged. Compare times within
 // one run: the machines are noisy.
@@ -7,6 +11,9 @@
 
 #include <random>
 
+#include "../common/contact_scenes.hpp"
+#include "mlcp/dantzig.hpp"
+#include "mlcp/pgs.hpp"
 #include "mlcp/registry.hpp"
 #include "mlcp/residual.hpp"
 
@@ -104,10 +111,67 @@ void registerAll() {
   }
 }
 
+// One time step per iteration: next b, assembly, solve (warm unless cold). stage: "block" or
+// "dense" for dantzig, "pgs" for pgs at tolerance 1e-6.
+void pyramidSteps(benchmark::State& state, int levels, const std::string& stage, bool warm) {
+  test::PyramidSpec spec;
+  spec.levels = levels;
+  test::BoxPyramid pyramid(spec);
+  std::unique_ptr<Solver> solver;
+  if (stage == "pgs") {
+    solver = std::make_unique<PgsSolver>();
+    solver->options().tolerance = 1e-6;
+    solver->options().maxIterations = 5000;
+  } else {
+    auto d = std::make_unique<DantzigSolver>();
+    d->params().blockStage =
+        stage == "block" ? DantzigParams::BlockStage::Always : DantzigParams::BlockStage::Never;
+    solver = std::move(d);
+  }
+  // The previous answer comes from a solve to the default tolerance of the dense path.
+  Vector x;
+  DantzigSolver().solve(pyramid.rows().assemble(true), x);
+  Problem p;
+  Result r;
+  double worst = 0;
+  int converged = 0, steps = 0;
+  for (auto _ : state) {
+    pyramid.nextStep(1e-4);
+    p = pyramid.rows().assemble(true);
+    Vector y;
+    r = warm ? solver->solveWithGuess(p, x, y) : solver->solve(p, y);
+    x = y;
+    worst = std::max(worst, residual(p, y));
+    converged += r.converged();
+    ++steps;
+  }
+  state.counters["n"] = p.size();
+  state.counters["worst_residual"] = worst;
+  state.counters["converged_fraction"] = steps ? double(converged) / steps : 0.0;
+  state.counters["iterations"] = r.iterations;
+}
+
+void registerPyramids() {
+  for (int levels : {5, 10}) {
+    const std::string boxes = std::to_string(levels * (levels + 1) / 2);
+    for (const char* stage : {"block", "dense", "pgs"})
+      for (bool warm : {false, true}) {
+        const std::string label = std::string(stage == std::string("pgs") ? "pgs" : "dantzig-") +
+                                  (stage == std::string("pgs") ? "" : stage) + "/pyramid" + boxes +
+                                  (warm ? "/warm" : "/cold");
+        auto* b = benchmark::RegisterBenchmark(
+            label.c_str(), [=](benchmark::State& st) { pyramidSteps(st, levels, stage, warm); });
+        b->Unit(benchmark::kMillisecond);
+        if (levels == 10 && !(warm && std::string(stage) == "block")) b->Iterations(3);
+      }
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   registerAll();
+  registerPyramids();
   benchmark::Initialize(&argc, argv);
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
