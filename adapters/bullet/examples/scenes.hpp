@@ -103,7 +103,7 @@ void stack(World& w, int count, double friction = 0.5);
 btRigidBody* incline(World& w, double theta, double mu);
 // Frictionless contacts: three spheres and a box dropped on the ground (no friction coupling).
 void frictionlessDrop(World& w);
-// Joints without contacts: a point-to-point chain of three boxes, a hinged door swinging, and a
+// Joints without contacts: a point-to-point chain of two boxes, a hinged door swinging, and a
 // box on a slider with limits, all under gravity.
 void joints(World& w);
 

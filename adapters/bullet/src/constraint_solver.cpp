@@ -81,6 +81,7 @@ void ConstraintSolver::finishStep() {
   totals_.iterations += current_.iterations;
   totals_.seconds += current_.seconds;
   totals_.measureSeconds += current_.measureSeconds;
+  totals_.assembleSeconds += current_.assembleSeconds;
   totals_.fallbacks += current_.fallbacks;
   totals_.failures += current_.failures;
   worst(totals_, current_);
@@ -174,7 +175,11 @@ void ConstraintSolver::solveIsland(Island& island, const btContactSolverInfo& in
       x = start;
       r = pgs.solve(s, x);
     } else {
-      if (!assembled) assembled = s.assemble(n > settings_.denseMaxRows);
+      if (!assembled) {
+        const double t0 = nowSeconds();
+        assembled = s.assemble(n > settings_.denseMaxRows);
+        current_.assembleSeconds += nowSeconds() - t0;
+      }
       solver->setOptions(o);
       r = solver->solveWithGuess(*assembled, start, x);
     }

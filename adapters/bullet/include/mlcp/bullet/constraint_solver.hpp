@@ -120,11 +120,12 @@ struct StepStats {
   int iterations = 0;   // sweeps or pivots, summed over islands
   double residual = 0;  // worst scaled natural-map residual over islands (NaN if not measured)
   Status status = Status::Converged;  // worst status over islands (after the fallback)
-  double seconds = 0;         // wall time of stages 2-7 (SI: its iterations), summed over groups
-  double measureSeconds = 0;  // time spent measuring residuals outside the solve (si only)
-  int fallbacks = 0;          // islands whose primary answer was rejected
-  int failures = 0;           // islands where the fallback's answer was rejected too
-  std::string message;        // why the first rejected answer was rejected ("" if none)
+  double seconds = 0;          // wall time of stages 2-7 (SI: its iterations), summed over groups
+  double measureSeconds = 0;   // time spent measuring residuals outside the solve (si only)
+  double assembleSeconds = 0;  // part of `seconds` spent assembling A for matrix-based solvers
+  int fallbacks = 0;           // islands whose primary answer was rejected
+  int failures = 0;            // islands where the fallback's answer was rejected too
+  std::string message;         // why the first rejected answer was rejected ("" if none)
 };
 
 // The check every answer passes (drop-in and bridge alike): the solver ran (not InvalidInput or

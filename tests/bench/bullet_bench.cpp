@@ -1,0 +1,211 @@
+// bullet_bench: per-step constraint-solver time and reached residual of our solvers (through the
+// drop-in mlcp::bullet::ConstraintSolver) against Bullet's SI and the stock btMLCPSolver with
+// its PGS, Dantzig and Lemke, on box pyramids of 15, 55 and 210 boxes. All ratios are measured
+// in one run. A plain program printing a table and a CSV (Google Benchmark's fixed-time loops
+// do not fit minute-long stock steps).
+//
+// Method: every configuration gets a fresh pyramid, settles it with SI for `warmup` steps (the
+// same states for all), then switches to its solver and times `steps` steps. Time is the wall
+// time of btConstraintSolver::solveGroup (Bullet's row setup, the solve and the write-back),
+// minus the time spent measuring residuals for this table. Residuals are the scaled natural-map
+// residual (mlcp::accuracy) of each step's answer, worst over the timed steps, on the problem
+// the stock btMLCPSolver assembles: our solvers use CfmModel::StockMlcp for that reason.
+// globalCfm is 1e-5 (what Bullet's demos use with direct solvers; with 0 a box face's four
+// contact points make A singular). A configuration whose step is predicted (n^3 from the
+// previous size for pivoting methods) or measured to take more than 1 s is skipped.
+//
+//   bullet_bench [--steps N] [--warmup N] [--sizes 15,55,210] [--csv file]
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+
+#include "mlcp/solver.hpp"
+#include "scenes.hpp"
+
+namespace {
+
+namespace sc = mlcp::bullet::scenes;
+
+// Times solveGroup of the solver it wraps.
+class Timed : public btConstraintSolver {
+ public:
+  explicit Timed(std::unique_ptr<btConstraintSolver> inner) : inner_(std::move(inner)) {}
+  void prepareSolve(int nb, int nm) override { inner_->prepareSolve(nb, nm); }
+  btScalar solveGroup(btCollisionObject** b, int nb, btPersistentManifold** m, int nm,
+                      btTypedConstraint** c, int nc, const btContactSolverInfo& info,
+                      btIDebugDraw* dd, btDispatcher* d) override {
+    const double t0 = mlcp::nowSeconds();
+    const btScalar r = inner_->solveGroup(b, nb, m, nm, c, nc, info, dd, d);
+    seconds += mlcp::nowSeconds() - t0;
+    return r;
+  }
+  void allSolved(const btContactSolverInfo& info, btIDebugDraw* dd) override {
+    inner_->allSolved(info, dd);
+  }
+  void reset() override { inner_->reset(); }
+  btConstraintSolverType getSolverType() const override { return inner_->getSolverType(); }
+  btConstraintSolver* inner() { return inner_.get(); }
+  double seconds = 0;
+
+ private:
+  std::unique_ptr<btConstraintSolver> inner_;
+};
+
+struct Config {
+  std::string label;  // table name
+  std::string name;   // makeBulletSolver name
+  bool pivoting;      // time grows like n^3 (skip prediction)
+};
+
+struct Row {
+  double ms = NAN, residual = NAN;
+  int rows = 0, fallbacks = 0, iterations = 0;
+  double assembleMs = NAN;
+  std::string note;
+};
+
+Row run(const Config& cfg, int boxes, int warmup, int steps) {
+  sc::World w;
+  w.info().m_globalCfm = 1e-5;
+  sc::pyramid(w, boxes);
+  w.step(warmup);  // stock SI settles the pyramid: every configuration starts from this state
+
+  mlcp::bullet::Settings s;
+  s.cfm = mlcp::bullet::CfmModel::StockMlcp;
+  if (cfg.name == "pgs") {
+    // Sequential-impulse-like: Bullet's 10 sweeps, residual checked once, always accepted.
+    s.bulletIterations = true;
+    s.acceptResidual = INFINITY;
+    s.fallback = "";
+  }
+  w.setSolver(std::make_unique<Timed>(sc::makeBulletSolver(cfg.name, s)));
+  auto* timed = static_cast<Timed*>(w.solver());
+  auto* ours = dynamic_cast<mlcp::bullet::ConstraintSolver*>(timed->inner());
+  auto* stock = dynamic_cast<sc::StockMlcp*>(timed->inner());
+
+  Row row;
+  double measure = 0, worst = 0;
+  int done = 0;
+  for (; done < steps; ++done) {
+    const double before = timed->seconds;
+    w.step();
+    double m = 0, r = NAN;
+    if (ours) {
+      m = ours->lastStep().measureSeconds;
+      r = ours->lastStep().residual;
+      row.rows = ours->lastStep().rows;
+      row.iterations += ours->lastStep().iterations;
+    } else if (stock) {
+      m = stock->stepMeasureSeconds();
+      r = stock->stepResidual();
+    }
+    measure += m;
+    if (!(r <= worst)) worst = r;
+    if (timed->seconds - before - m > 1.0) {
+      ++done;
+      row.note = "stopped: > 1 s/step";
+      break;
+    }
+  }
+  row.ms = (timed->seconds - measure) * 1e3 / done;
+  row.residual = worst;
+  row.iterations /= done;
+  if (ours) {
+    row.fallbacks = ours->totals().fallbacks;
+    row.assembleMs = ours->totals().assembleSeconds * 1e3 / done;
+  }
+  if (stock) row.fallbacks = stock->fallbacks();
+  return row;
+}
+
+std::vector<int> parseSizes(const std::string& s) {
+  std::vector<int> out;
+  std::size_t p = 0;
+  while (p < s.size()) {
+    std::size_t q = s.find(',', p);
+    if (q == std::string::npos) q = s.size();
+    out.push_back(std::stoi(s.substr(p, q - p)));
+    p = q + 1;
+  }
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Per-step solver time and residual: our solvers vs Bullet's, on box pyramids."};
+  int steps = 20, warmup = 30;
+  std::string sizes = "15,55,210", csvPath;
+  app.add_option("--steps", steps, "timed steps per configuration")->capture_default_str();
+  app.add_option("--warmup", warmup, "SI steps before timing")->capture_default_str();
+  app.add_option("--sizes", sizes, "pyramid sizes (triangular numbers)")->capture_default_str();
+  app.add_option("--csv", csvPath, "also write the table as CSV");
+  CLI11_PARSE(app, argc, argv);
+
+  const std::vector<Config> configs = {
+      {"SI (stock)", "si-stats", false},
+      {"ours pgs", "pgs", false},
+      {"MLCP-PGS (stock)", "mlcp-pgs", false},
+      {"ours dantzig", "dantzig", true},
+      {"MLCP-Dantzig (stock)", "mlcp-dantzig", true},
+      {"ours lemke", "lemke", true},
+      {"MLCP-Lemke (stock)", "mlcp-lemke", true},
+  };
+  std::ofstream csv;
+  if (!csvPath.empty()) {
+    csv.open(csvPath);
+    csv << "boxes,rows,solver,ms_per_step,worst_residual,fallbacks,iterations,assemble_ms,note\n";
+  }
+  std::map<std::string, std::pair<int, double>> previous;  // label -> (rows, ms)
+  for (int boxes : parseSizes(sizes)) {
+    std::map<std::string, Row> rows;
+    int n = 0;
+    std::printf(
+        "\npyramid of %d boxes (%d warm-up SI steps, %d timed steps, dt 1/60, "
+        "10 iterations, globalCfm 1e-5)\n",
+        boxes, warmup, steps);
+    std::printf("%-22s %10s %12s %10s %10s %12s  %s\n", "solver", "ms/step", "residual",
+                "fallbacks", "iter/step", "assemble ms", "note");
+    for (const Config& c : configs) {
+      Row r;
+      auto prev = previous.find(c.label);
+      const double predicted =
+          (c.pivoting && prev != previous.end() && n > 0)
+              ? prev->second.second * std::pow(double(n) / prev->second.first, 3) / 1e3
+              : 0;
+      if (prev != previous.end() && prev->second.second < 0) {
+        r.note = "skipped: smaller size already > 1 s/step";
+      } else if (predicted > 1.0) {
+        char buf[96];
+        std::snprintf(buf, sizeof buf, "skipped: predicted %.0f s/step (> 1 s)", predicted);
+        r.note = buf;
+      } else {
+        r = run(c, boxes, warmup, steps);
+      }
+      if (r.rows > 0) n = r.rows;
+      previous[c.label] = {std::max(n, 1),
+                           r.note.rfind("skipped", 0) == 0 || r.ms > 1e3 ? -1.0 : r.ms};
+      rows[c.label] = r;
+      std::printf("%-22s %10.3f %12.2e %10d %10d %12.3f  %s\n", c.label.c_str(), r.ms, r.residual,
+                  r.fallbacks, r.iterations, r.assembleMs, r.note.c_str());
+      std::fflush(stdout);
+      if (csv)
+        csv << boxes << ',' << n << ',' << c.label << ',' << r.ms << ',' << r.residual << ','
+            << r.fallbacks << ',' << r.iterations << ',' << r.assembleMs << ",\"" << r.note
+            << "\"\n";
+    }
+    std::printf("rows per step: %d\n", n);
+    const Row& si = rows["SI (stock)"];
+    const Row& pgs = rows["ours pgs"];
+    const Row& dz = rows["ours dantzig"];
+    const Row& sdz = rows["MLCP-Dantzig (stock)"];
+    std::printf("ratio ours pgs / SI time (same 10 sweeps): %.2fx (target <= 1.0x)\n",
+                pgs.ms / si.ms);
+    if (std::isfinite(sdz.ms) && std::isfinite(dz.ms))
+      std::printf("speed-up ours dantzig vs stock MLCP-Dantzig: %.1fx (target >= 20x at 55)\n",
+                  sdz.ms / dz.ms);
+  }
+  return 0;
+}

@@ -1,0 +1,249 @@
+// The drop-in and the bridge against Bullet's own solvers on the same scenes.
+#include <BulletDynamics/MLCPSolvers/btDantzigSolver.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "mlcp/bullet/constraint_solver.hpp"
+#include "mlcp/bullet/mlcp_bridge.hpp"
+#include "mlcp/registry.hpp"
+#include "mlcp/residual.hpp"
+#include "scenes.hpp"
+
+namespace {
+
+namespace sc = mlcp::bullet::scenes;
+using mlcp::bullet::ConstraintSolver;
+using mlcp::bullet::Settings;
+
+double stateDifference(sc::World& a, sc::World& b) {
+  double d = 0;
+  const auto& ba = a.dynamicBodies();
+  const auto& bb = b.dynamicBodies();
+  for (std::size_t k = 0; k < ba.size(); ++k) {
+    d = std::max(d, (ba[k]->getCenterOfMassPosition() - bb[k]->getCenterOfMassPosition()).length());
+    d = std::max(d, (ba[k]->getLinearVelocity() - bb[k]->getLinearVelocity()).length());
+    d = std::max(d, (ba[k]->getAngularVelocity() - bb[k]->getAngularVelocity()).length());
+    d = std::max(d, (ba[k]->getOrientation() - bb[k]->getOrientation()).length());
+  }
+  return d;
+}
+
+// The stock btMLCPSolver's matrix: globalCfm / dt on every row. With globalCfm 1e-5 (Bullet's
+// setting for direct solvers) the face contacts' matrix is not singular, so the stock Dantzig
+// rarely falls back and the answers are unique.
+Settings stockLike(const std::string& solver) {
+  Settings s;
+  s.solver = solver;
+  s.cfm = mlcp::bullet::CfmModel::StockMlcp;
+  return s;
+}
+
+// Steps the stock btMLCPSolver + btDantzigSolver and our "dantzig" side by side from the same
+// scene; returns how many steps were compared (until the stock solver first fell back).
+int compareWithStockDantzig(void (*scene)(sc::World&), int steps) {
+  sc::World stock, ours;
+  stock.info().m_globalCfm = 1e-5;
+  ours.info().m_globalCfm = 1e-5;
+  auto stockSolver = sc::makeBulletSolver("mlcp-dantzig");
+  auto* probe = static_cast<sc::StockMlcp*>(stockSolver.get());
+  stock.setSolver(std::move(stockSolver));
+  ours.setSolver(std::make_unique<ConstraintSolver>(stockLike("dantzig")));
+  auto* mine = static_cast<ConstraintSolver*>(ours.solver());
+  scene(stock);
+  scene(ours);
+  int compared = 0;
+  for (int i = 0; i < steps; ++i) {
+    stock.step();
+    ours.step();
+    if (probe->fallbacks() > 0) break;
+    EXPECT_EQ(mine->lastStep().fallbacks, 0) << "step " << i << ": " << mine->lastStep().message;
+    const double d = stateDifference(stock, ours);
+    EXPECT_LT(d, 1e-6) << "step " << i;
+    if (d >= 1e-6) break;
+    ++compared;
+  }
+  return compared;
+}
+
+TEST(BulletPlumbing, FrictionlessContactsMatchStockDantzig) {
+  const int compared = compareWithStockDantzig(&sc::frictionlessDrop, 300);
+  EXPECT_GE(compared, 100) << "the stock solver fell back too early to compare";
+}
+
+TEST(BulletPlumbing, JointsMatchStockDantzig) {
+  const int compared = compareWithStockDantzig(&sc::joints, 300);
+  EXPECT_EQ(compared, 300);
+}
+
+// With friction the stock Dantzig fixes the friction bounds from an intermediate normal impulse;
+// ours iterates them to the final one. Both answers are measured on the same problem.
+TEST(BulletPlumbing, FrictionResidualNoWorseThanStock) {
+  sc::World w(1.0 / 60.0, true);
+  w.info().m_globalCfm = 1e-5;
+  Settings s = stockLike("dantzig");
+  s.keepIslands = true;
+  s.acceptResidual = 1e-9;
+  w.setSolver(std::make_unique<ConstraintSolver>(s));
+  auto* mine = static_cast<ConstraintSolver*>(w.solver());
+  sc::stack(w, 3);
+  btTransform pose;
+  pose.setIdentity();
+  pose.setOrigin(btVector3(3, 0.6, 0));
+  w.addBox(btVector3(0.5, 0.5, 0.5), 1.0, pose)->setLinearVelocity(btVector3(2, 0, 1));
+
+  btDantzigSolver stock;
+  int measured = 0, stockViolations = 0;
+  for (int step = 0; step < 120; ++step) {
+    w.step();
+    for (const mlcp::bullet::IslandRecord& rec : mine->islands()) {
+      if (rec.split) continue;
+      const mlcp::Problem p = rec.system.assemble(false);
+      const int n = p.size();
+      btMatrixXu A(n, n);
+      A.setZero();
+      btVectorXu b(n), x(n), lo(n), hi(n);
+      btAlignedObjectArray<int> dep;
+      dep.resize(n);
+      for (int i = 0; i < n; ++i) {
+        for (int j = 0; j < n; ++j)
+          if (p.denseA()(i, j) != 0) A.setElem(i, j, p.denseA()(i, j));
+        b[i] = -p.b[i];
+        lo[i] = p.lo[i];
+        hi[i] = p.hi[i];
+        x[i] = rec.start[i];
+        dep[i] = p.findex[i];
+      }
+      if (!stock.solveMLCP(A, b, x, lo, hi, dep, 10)) continue;  // stock fell back
+      mlcp::Vector xs(n);
+      for (int i = 0; i < n; ++i) xs[i] = x[i];
+      const double stockResidual = mlcp::accuracy(p, xs).residual;
+      const double ourResidual = mlcp::accuracy(p, rec.x).residual;
+      EXPECT_LE(ourResidual, stockResidual + 1e-12) << "step " << step << " (" << rec.solver << ")";
+      if (stockResidual > 1e-6) ++stockViolations;
+      ++measured;
+    }
+  }
+  EXPECT_GT(measured, 60);
+  // Not a requirement, but the reason for the test: record how often stock was inexact.
+  RecordProperty("stock_steps_above_1e-6", stockViolations);
+}
+
+TEST(BulletPlumbing, BridgeRunsInsideStockMlcpSolver) {
+  sc::World w(1.0 / 60.0, true);
+  w.setSolver(std::make_unique<sc::StockMlcp>(
+      std::unique_ptr<btMLCPSolverInterface>(new mlcp::bullet::MlcpBridge("dantzig"))));
+  auto* stock = static_cast<sc::StockMlcp*>(w.solver());
+  w.info().m_globalCfm = 1e-5;
+  sc::stack(w, 3);
+  double worst = 0;
+  for (int i = 0; i < 120; ++i) {
+    w.step();
+    if (stock->fallbacks() == 0) worst = std::max(worst, stock->stepResidual());
+  }
+  EXPECT_EQ(stock->fallbacks(), 0);
+  EXPECT_LT(worst, 1e-6);
+  EXPECT_NEAR(w.dynamicBodies().back()->getCenterOfMassPosition().y(), 2.5, 0.01);
+}
+
+TEST(BulletPlumbing, UnknownSolverNameIsAClearError) {
+  Settings s;
+  s.solver = "no-such-solver";
+  try {
+    ConstraintSolver solver(s);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown solver 'no-such-solver'"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("pgs"), std::string::npos) << e.what();
+  }
+  s.solver = "pgs";
+  s.fallback = "nope";
+  EXPECT_THROW(ConstraintSolver{s}, std::invalid_argument);
+  EXPECT_THROW(mlcp::bullet::MlcpBridge("nope"), std::invalid_argument);
+  EXPECT_THROW(sc::makeBulletSolver("nope"), std::invalid_argument);
+}
+
+// Bullet batches small islands into one group; we split them again.
+TEST(BulletPlumbing, GroupsAreSplitIntoConnectedComponents) {
+  sc::World w;
+  Settings s;
+  s.solver = "pgs";
+  w.setSolver(std::make_unique<ConstraintSolver>(s));
+  auto* mine = static_cast<ConstraintSolver*>(w.solver());
+  sc::stack(w, 2);
+  btTransform pose;
+  pose.setIdentity();
+  for (int k = 0; k < 2; ++k) {
+    pose.setOrigin(btVector3(4.0 + 3 * k, 0.5, 0));
+    w.addBox(btVector3(0.5, 0.5, 0.5), 1.0, pose);
+  }
+  w.step(5);
+  const mlcp::bullet::StepStats& st = mine->lastStep();
+  EXPECT_EQ(st.groups, 1);
+  EXPECT_EQ(st.islands, 3);
+  EXPECT_GT(st.rows, 0);
+  EXPECT_EQ(st.fallbacks, 0);
+  EXPECT_LE(st.residual, 1e-6);
+}
+
+TEST(BulletPlumbing, RejectedAnswersFallBackAndAreCounted) {
+  sc::World w;
+  Settings s;
+  s.solver = "pgs";
+  s.options.maxIterations = 1;  // one sweep cannot reach the acceptance limit
+  s.acceptResidual = 1e-8;
+  s.fallback = "dantzig";
+  w.setSolver(std::make_unique<ConstraintSolver>(s));
+  auto* mine = static_cast<ConstraintSolver*>(w.solver());
+  sc::stack(w, 3);
+  w.step(10);
+  EXPECT_GT(mine->totals().fallbacks, 0);
+  EXPECT_FALSE(mine->lastStep().message.empty());
+  EXPECT_LE(mine->lastStep().residual, 1e-8) << mine->lastStep().message;
+}
+
+TEST(BulletPlumbing, RollingFrictionRowsAreSolvedNotDropped) {
+  auto run = [](double rolling, int& rows) {
+    sc::World w;
+    Settings s;
+    s.solver = "pgs";
+    w.setSolver(std::make_unique<ConstraintSolver>(s));
+    auto* mine = static_cast<ConstraintSolver*>(w.solver());
+    w.addGround(1.0);  // combined rolling friction = ball's rolling x ground's friction
+    btRigidBody* ball = w.addSphere(0.5, 1.0, btVector3(0, 0.5, 0), 1.0);
+    ball->setRollingFriction(rolling);
+    ball->setSpinningFriction(rolling);
+    ball->setLinearVelocity(btVector3(2, 0, 0));
+    w.step(2);
+    rows = mine->lastStep().rows;  // one contact point yet: 1 normal, 1 friction, 3 rolling
+    for (int i = 0; i < 58; ++i) {
+      w.step();
+      EXPECT_LE(mine->lastStep().residual, 1e-6);
+    }
+    return ball->getLinearVelocity().length();
+  };
+  int plainRows = 0, rollingRows = 0;
+  const double plain = run(0.0, plainRows);
+  const double rolled = run(0.05, rollingRows);
+  EXPECT_EQ(plainRows, 2);
+  EXPECT_EQ(rollingRows, 5);
+  EXPECT_LT(rolled, plain - 0.1) << "rolling friction should slow the ball down";
+}
+
+TEST(BulletPlumbing, SiThroughTheDropInMatchesStockSi) {
+  sc::World stock, ours;
+  stock.setSolver(sc::makeBulletSolver("si"));
+  ours.setSolver(sc::makeBulletSolver("si-stats"));
+  sc::pyramid(stock, 15);
+  sc::pyramid(ours, 15);
+  for (int i = 0; i < 60; ++i) {
+    stock.step();
+    ours.step();
+  }
+  EXPECT_EQ(stateDifference(stock, ours), 0.0);
+  const auto* mine = static_cast<ConstraintSolver*>(ours.solver());
+  EXPECT_EQ(mine->lastStep().iterations, 10);
+  EXPECT_TRUE(std::isfinite(mine->lastStep().residual));
+}
+
+}  // namespace
