@@ -569,13 +569,20 @@ Outcome DantzigSolver::Workspace::pass(bool fixedOnce, bool reuseFactors) {
     x = xStart;
     std::fill(set.begin(), set.end(), Set::Unprocessed);
   }
+  bool boundsFixed = false;
   for (int p = 0; p < n; ++p) {
     if (set[p] != Set::Unprocessed) continue;
-    if (fixedOnce && findex[p] >= 0) {
-      normal[p] = std::abs(x[findex[p]]);
-      lo[p] = muLo[p] * normal[p];
-      hi[p] = muHi[p] * normal[p];
-      x[p] = std::clamp(x[p], lo[p], hi[p]);
+    if (fixedOnce && !boundsFixed && findex[p] >= 0) {
+      // As ODE's dSolveLCP: on reaching the first friction row, the bounds of every friction
+      // row still to come are fixed at once from the normal values of this moment.
+      boundsFixed = true;
+      for (int q = p; q < n; ++q) {
+        if (set[q] != Set::Unprocessed || findex[q] < 0) continue;
+        normal[q] = std::abs(x[findex[q]]);
+        lo[q] = muLo[q] * normal[q];
+        hi[q] = muHi[q] * normal[q];
+        x[q] = std::clamp(x[q], lo[q], hi[q]);
+      }
     }
     w[p] = b[p] + rowDot(p, x, n);
     if (lo[p] == hi[p]) {

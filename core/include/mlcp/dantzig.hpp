@@ -52,8 +52,9 @@
 // at most a cold solve plus the block work. An all-zero x is a cold start.
 //
 // Friction (findex). Options::frictionBounds:
-//   FixedOnce - stock ODE/Bullet behaviour: friction rows are processed last and their bounds
-//     are fixed to +-mu |x_normal| from the normal's value at the moment the row is reached.
+//   FixedOnce - stock ODE/Bullet behaviour: friction rows are processed last, and when the
+//     first of them is reached the bounds of all of them are fixed at once to +-mu |x_normal|
+//     from the normal values of that moment (ODE's dSolveLCP, lcp.cpp).
 //     Later pivots may change the normal, so the answer may violate the final bounds; the
 //     base class then reports Failed with the true residual. Friction rows start at x = 0.
 //   Exact (default) - a fixed point over the bounds: after each pass the friction bounds are
