@@ -62,7 +62,7 @@ struct Config {
 struct Row {
   double ms = NAN, residual = NAN;
   int rows = 0, fallbacks = 0, iterations = 0;
-  double assembleMs = NAN;
+  double assembleMs = NAN, solveMs = NAN;  // solveMs: our stages 2-7 (SI: its iterations)
   std::string note;
 };
 
@@ -115,6 +115,7 @@ Row run(const Config& cfg, int boxes, int warmup, int steps) {
   if (ours) {
     row.fallbacks = ours->totals().fallbacks;
     row.assembleMs = ours->totals().assembleSeconds * 1e3 / done;
+    row.solveMs = ours->totals().seconds * 1e3 / done;
   }
   if (stock) row.fallbacks = stock->fallbacks();
   return row;
@@ -137,11 +138,12 @@ std::vector<int> parseSizes(const std::string& s) {
 int main(int argc, char** argv) {
   CLI::App app{"Per-step solver time and residual: our solvers vs Bullet's, on box pyramids."};
   int steps = 20, warmup = 30;
-  std::string sizes = "15,55,210", csvPath;
+  std::string sizes = "15,55,210", csvPath, only;
   app.add_option("--steps", steps, "timed steps per configuration")->capture_default_str();
   app.add_option("--warmup", warmup, "SI steps before timing")->capture_default_str();
   app.add_option("--sizes", sizes, "pyramid sizes (triangular numbers)")->capture_default_str();
   app.add_option("--csv", csvPath, "also write the table as CSV");
+  app.add_option("--only", only, "run only configurations whose label contains this");
   CLI11_PARSE(app, argc, argv);
 
   const std::vector<Config> configs = {
@@ -156,7 +158,8 @@ int main(int argc, char** argv) {
   std::ofstream csv;
   if (!csvPath.empty()) {
     csv.open(csvPath);
-    csv << "boxes,rows,solver,ms_per_step,worst_residual,fallbacks,iterations,assemble_ms,note\n";
+    csv << "boxes,rows,solver,ms_per_step,solve_ms,worst_residual,fallbacks,iterations,"
+           "assemble_ms,note\n";
   }
   std::map<std::string, std::pair<int, double>> previous;  // label -> (rows, ms)
   for (int boxes : parseSizes(sizes)) {
@@ -166,9 +169,10 @@ int main(int argc, char** argv) {
         "\npyramid of %d boxes (%d warm-up SI steps, %d timed steps, dt 1/60, "
         "10 iterations, globalCfm 1e-5)\n",
         boxes, warmup, steps);
-    std::printf("%-22s %10s %12s %10s %10s %12s  %s\n", "solver", "ms/step", "residual",
-                "fallbacks", "iter/step", "assemble ms", "note");
+    std::printf("%-22s %10s %10s %12s %10s %10s %12s  %s\n", "solver", "ms/step", "solve ms",
+                "residual", "fallbacks", "iter/step", "assemble ms", "note");
     for (const Config& c : configs) {
+      if (c.label.find(only) == std::string::npos) continue;
       Row r;
       auto prev = previous.find(c.label);
       const double predicted =
@@ -188,13 +192,13 @@ int main(int argc, char** argv) {
       previous[c.label] = {std::max(n, 1),
                            r.note.rfind("skipped", 0) == 0 || r.ms > 1e3 ? -1.0 : r.ms};
       rows[c.label] = r;
-      std::printf("%-22s %10.3f %12.2e %10d %10d %12.3f  %s\n", c.label.c_str(), r.ms, r.residual,
-                  r.fallbacks, r.iterations, r.assembleMs, r.note.c_str());
+      std::printf("%-22s %10.3f %10.3f %12.2e %10d %10d %12.3f  %s\n", c.label.c_str(), r.ms,
+                  r.solveMs, r.residual, r.fallbacks, r.iterations, r.assembleMs, r.note.c_str());
       std::fflush(stdout);
       if (csv)
-        csv << boxes << ',' << n << ',' << c.label << ',' << r.ms << ',' << r.residual << ','
-            << r.fallbacks << ',' << r.iterations << ',' << r.assembleMs << ",\"" << r.note
-            << "\"\n";
+        csv << boxes << ',' << n << ',' << c.label << ',' << r.ms << ',' << r.solveMs << ','
+            << r.residual << ',' << r.fallbacks << ',' << r.iterations << ',' << r.assembleMs
+            << ",\"" << r.note << "\"\n";
     }
     std::printf("rows per step: %d\n", n);
     const Row& si = rows["SI (stock)"];

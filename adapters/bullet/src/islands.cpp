@@ -171,7 +171,13 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
       s.lo[r] = bound(c.m_lowerLimit);
       s.hi[r] = bound(c.m_upperLimit);
     }
-    isl.start[r] = warmStart ? static_cast<double>(c.m_appliedImpulse) : 0.0;
+    // SI starts contacts and friction from the cached impulse times m_warmstartingFactor
+    // (0.85); a solver that can use a guess gets the cached impulse itself.
+    const double unscale =
+        (i >= nj && info.m_warmstartingFactor > 0 && (info.m_solverMode & SOLVER_USE_WARMSTARTING))
+            ? 1.0 / info.m_warmstartingFactor
+            : 1.0;
+    isl.start[r] = warmStart ? unscale * static_cast<double>(c.m_appliedImpulse) : 0.0;
     isl.splitStart[r] = warmStart ? static_cast<double>(c.m_appliedPushImpulse) : 0.0;
   }
 }
