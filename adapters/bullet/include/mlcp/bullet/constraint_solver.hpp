@@ -25,9 +25,10 @@
 //       bounds     joints as given; contacts [0, inf); friction [-mu, mu] with findex = its
 //                  contact row; rolling friction the same with its own coefficient (SI also
 //                  caps it at mu_r in absolute terms, which is not a complementarity bound).
-//  4. warm start — x0 = Bullet's applied impulses (the cached impulse times the warm-starting
-//     factor for contacts and friction, 0 for joints), already applied to the solver bodies by
-//     SI's setup.
+//  4. warm start — x0 = last step's impulses: for contacts and friction the cached impulse
+//     (Bullet's applied impulse divided by m_warmstartingFactor, 0.85: SI's setup has already
+//     applied the scaled impulse to the solver bodies, and the write-back below only applies
+//     the difference), 0 for joints (SI does not warm-start them).
 //  5. solve — "pgs" runs on the rows themselves (mlcp::RowPgs, O(nnz J) per sweep, no matrix);
 //     every other core solver gets A = J M^-1 J^T + diag(cfm) assembled from the body graph,
 //     dense for small islands and sparse above Settings::denseMaxRows.
