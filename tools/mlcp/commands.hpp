@@ -16,6 +16,7 @@ using Runner = std::function<int()>;
 Runner addSolveCommand(CLI::App& app);
 Runner addTableCommand(CLI::App& app);
 Runner addTraceCommand(CLI::App& app);
+Runner addRunCommand(CLI::App& app);
 
 // Shared by subcommands that take solver settings.
 struct SolverSettings {

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   add(&mlcp::cli::addSolveCommand);
   add(&mlcp::cli::addTableCommand);
   add(&mlcp::cli::addTraceCommand);
+  add(&mlcp::cli::addRunCommand);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,51 @@
+// mlcp/bullet/scene_loader.hpp: an mlcp-scene/1 scene as a stock btDiscreteDynamicsWorld.
+//
+//     auto world = mlcp::bullet::loadWorld(scene, mlcp::scene::RunSettings::fromScene(scene));
+//
+// How the scene maps onto Bullet:
+// - shapes: plane btStaticPlaneShape(normal, offset), box btBoxShape(size / 2), sphere
+//   btSphereShape, capsule btCapsuleShapeZ(radius, length) (along the body's z axis);
+// - mass and the scene's inertia (never Bullet's own approximation, which is a box for
+//   capsules); pose, velocities; sleeping only when the scene allows it;
+// - materials: Bullet multiplies the two bodies' friction, so each body gets sqrt(mu) and a
+//   pair gets sqrt(mu_a mu_b) exactly; restitution is combined by max(e_a, e_b) through
+//   Bullet's global gCalculateCombinedRestitutionCallback, which the loader installs (it is
+//   process-wide; every world of this process then combines restitution by max);
+// - joints through frames at the anchor whose z axis is the joint axis (x for the slider):
+//   ball btPoint2PointConstraint, hinge btHingeConstraint (limits with softness 1, motor
+//   impulse max_force * dt), slider btSliderConstraint (rotation locked; linear limits and
+//   motor), fixed btFixedConstraint; joints to the world use btTypedConstraint::getFixedBody().
+//   Bullet measures the hinge angle of its body A relative to B, as the scene does, but the
+//   slider offset of B relative to A: the slider's frame axis is reversed so that its limits
+//   and motor keep the scene's signs (world_test checks both by driving the motors into the
+//   upper limits);
+// - settings: gravity, one fixed step of time_step per step (no substeps), m_erp = m_erp2 =
+//   erp, m_globalCfm = cfm, m_numIterations = iterations, minimumSolverBatchSize 1 (islands
+//   solved one by one, as the direct solvers want). max_contacts_per_pair is 4 in Bullet's
+//   manifolds whatever the scene says.
+//
+// Solver names: any mlcp::solverNames() name runs through mlcp::bullet::ConstraintSolver (its
+// statistics fill the measures); the stock ones are
+//   bullet-si            btSequentialImpulseConstraintSolver
+//   bullet-nncg          btNNCGConstraintSolver
+//   bullet-mlcp-pgs, bullet-mlcp-dantzig, bullet-mlcp-lemke
+//                        btMLCPSolver with Bullet's PGS / Dantzig / Lemke (residual measured on
+//                        the problem it assembled; fallbacks are its fallbacks to SI)
+// Stock SI and NNCG report no residual (NaN), `iterations` sweeps and status max-iterations.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "mlcp/scene/world.hpp"
+
+namespace mlcp::bullet {
+
+// Throws std::invalid_argument for an unknown solver name (the message lists the known ones).
+std::unique_ptr<scene::World> loadWorld(const scene::Scene& scene,
+                                        const scene::RunSettings& settings);
+
+// Every solver name loadWorld accepts, comma separated.
+std::string worldSolverNames();
+
+}  // namespace mlcp::bullet

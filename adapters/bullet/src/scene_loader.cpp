@@ -1,0 +1,300 @@
+// An mlcp-scene/1 scene in a stock btDiscreteDynamicsWorld (see scene_loader.hpp).
+#include "mlcp/bullet/scene_loader.hpp"
+
+#include <BulletDynamics/ConstraintSolver/btNNCGConstraintSolver.h>
+#include <btBulletDynamicsCommon.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+#include "mlcp/registry.hpp"
+#include "scenes.hpp"
+
+namespace mlcp::bullet {
+
+namespace {
+
+using scene::Vec3;
+
+btVector3 bt(const Vec3& v) { return btVector3(v[0], v[1], v[2]); }
+Vec3 vec(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
+
+double now() {
+  using Clock = std::chrono::steady_clock;
+  return std::chrono::duration<double>(Clock::now().time_since_epoch()).count();
+}
+
+// The scene's restitution rule, max(e_a, e_b), in place of Bullet's product.
+btScalar maxRestitution(const btCollisionObject* a, const btCollisionObject* b) {
+  return std::max(a->getRestitution(), b->getRestitution());
+}
+
+// Forwards to the real solver and times its solveGroup calls (stock solvers have no timer).
+class TimedSolver : public btConstraintSolver {
+ public:
+  explicit TimedSolver(std::unique_ptr<btConstraintSolver> inner) : inner_(std::move(inner)) {}
+  void prepareSolve(int numBodies, int numManifolds) override {
+    inner_->prepareSolve(numBodies, numManifolds);
+  }
+  btScalar solveGroup(btCollisionObject** bodies, int numBodies, btPersistentManifold** manifolds,
+                      int numManifolds, btTypedConstraint** constraints, int numConstraints,
+                      const btContactSolverInfo& info, btIDebugDraw* debugDrawer,
+                      btDispatcher* dispatcher) override {
+    const double t0 = now();
+    const btScalar r = inner_->solveGroup(bodies, numBodies, manifolds, numManifolds, constraints,
+                                          numConstraints, info, debugDrawer, dispatcher);
+    seconds += now() - t0;
+    return r;
+  }
+  void allSolved(const btContactSolverInfo& info, btIDebugDraw* debugDrawer) override {
+    inner_->allSolved(info, debugDrawer);
+  }
+  void reset() override { inner_->reset(); }
+  btConstraintSolverType getSolverType() const override { return inner_->getSolverType(); }
+
+  btConstraintSolver* inner() const { return inner_.get(); }
+  double seconds = 0;
+
+ private:
+  std::unique_ptr<btConstraintSolver> inner_;
+};
+
+// Frame at `anchor` whose `axisColumn` column is `axis` (world), right-handed.
+btTransform jointFrame(const Vec3& anchor, const Vec3& axis, int axisColumn) {
+  btVector3 a = bt(axis).normalized(), p, q;
+  btPlaneSpace1(a, p, q);  // p, q, a right-handed
+  btMatrix3x3 m;
+  if (axisColumn == 2)
+    m.setValue(p.x(), q.x(), a.x(), p.y(), q.y(), a.y(), p.z(), q.z(), a.z());
+  else  // x = a, y = p, z = q
+    m.setValue(a.x(), p.x(), q.x(), a.y(), p.y(), q.y(), a.z(), p.z(), q.z());
+  return btTransform(m, bt(anchor));
+}
+
+class BulletWorld : public scene::World {
+ public:
+  BulletWorld(const scene::Scene& s, const scene::RunSettings& run) : scene::World(s) {
+    std::unique_ptr<btConstraintSolver> solver;
+    const std::string& name = run.solver;
+    if (name == "bullet-si") {
+      solver = std::make_unique<btSequentialImpulseConstraintSolver>();
+      fixedSweeps_ = true;
+    } else if (name == "bullet-nncg") {
+      solver = std::make_unique<btNNCGConstraintSolver>();
+      fixedSweeps_ = true;
+    } else if (name.rfind("bullet-mlcp-", 0) == 0) {
+      solver = scenes::makeBulletSolver(name.substr(7));
+      stock_ = static_cast<scenes::StockMlcp*>(solver.get());
+      pivoting_ = name != "bullet-mlcp-pgs";
+    } else if (!makeSolver(name)) {
+      throw std::invalid_argument("unknown solver '" + name +
+                                  "' for Bullet (known: " + worldSolverNames() + ")");
+    } else {
+      Settings settings;
+      settings.options.maxIterations = run.iterations;
+      settings.options.tolerance = run.tolerance;
+      settings.warmStart = run.warmStart;
+      settings.fallback = run.fallback;
+      settings.acceptResidual = run.fallbackResidual;
+      solver = scenes::makeBulletSolver(name, settings);  // throws for unknown names
+      ours_ = static_cast<ConstraintSolver*>(solver.get());
+    }
+    iterations_ = run.iterations;
+    tolerance_ = run.tolerance;
+    timed_ = std::make_unique<TimedSolver>(std::move(solver));
+
+    gCalculateCombinedRestitutionCallback = &maxRestitution;
+    config_ = std::make_unique<btDefaultCollisionConfiguration>();
+    dispatcher_ = std::make_unique<btCollisionDispatcher>(config_.get());
+    broadphase_ = std::make_unique<btDbvtBroadphase>();
+    world_ = std::make_unique<btDiscreteDynamicsWorld>(dispatcher_.get(), broadphase_.get(),
+                                                       timed_.get(), config_.get());
+    world_->setGravity(bt(s.gravity));
+    btContactSolverInfo& info = world_->getSolverInfo();
+    info.m_timeStep = s.settings.timeStep;
+    info.m_erp = info.m_erp2 = s.settings.erp;
+    info.m_globalCfm = s.settings.cfm;
+    info.m_numIterations = run.iterations;
+    info.m_minimumSolverBatchSize = 1;
+    if (!run.warmStart) info.m_solverMode &= ~SOLVER_USE_WARMSTARTING;
+
+    for (const scene::Body& b : s.bodies) addBody(s, b);
+    for (const scene::Joint& j : s.joints) addJoint(s, j);
+  }
+
+  ~BulletWorld() override {
+    for (auto& c : constraints_) world_->removeConstraint(c.get());
+    for (auto& b : bodies_) world_->removeRigidBody(b.get());
+    world_.reset();
+  }
+
+  std::vector<scene::BodyState> states() const override {
+    std::vector<scene::BodyState> out(bodies_.size());
+    for (std::size_t i = 0; i < bodies_.size(); ++i) {
+      const btRigidBody& b = *bodies_[i];
+      const btTransform& t = b.getCenterOfMassTransform();
+      const btQuaternion q = t.getRotation();
+      out[i].position = vec(t.getOrigin());
+      out[i].orientation = {q.w(), q.x(), q.y(), q.z()};
+      out[i].velocity = vec(b.getLinearVelocity());
+      out[i].angularVelocity = vec(b.getAngularVelocity());
+    }
+    return out;
+  }
+  const char* engine() const override { return "bullet"; }
+
+ protected:
+  void stepEngine(scene::StepMeasures& m) override {
+    timed_->seconds = 0;
+    const int fallbacksBefore = stock_ ? stock_->fallbacks() : 0;
+    world_->stepSimulation(scene().settings.timeStep, 0, scene().settings.timeStep);
+    m.solverMs = 1e3 * timed_->seconds;
+    if (ours_) {
+      const StepStats& st = ours_->lastStep();
+      m.solverMs = 1e3 * (st.seconds);
+      m.residual = st.residual;
+      m.iterations = st.iterations;
+      m.status = toString(st.status);
+      m.fallbacks = st.fallbacks;
+    } else if (stock_) {
+      m.solverMs -= 1e3 * stock_->stepMeasureSeconds();
+      m.residual = stock_->stepResidual();
+      m.fallbacks = stock_->fallbacks() - fallbacksBefore;
+      m.iterations = pivoting_ ? 0 : iterations_;
+      m.status = m.residual <= tolerance_ ? "converged" : pivoting_ ? "failed" : "max-iterations";
+    } else {
+      m.iterations = iterations_;
+      m.status = "max-iterations";
+    }
+    double deepest = 0;
+    int contacts = 0;
+    for (int i = 0; i < dispatcher_->getNumManifolds(); ++i) {
+      const btPersistentManifold* pm = dispatcher_->getManifoldByIndexInternal(i);
+      for (int k = 0; k < pm->getNumContacts(); ++k) {
+        ++contacts;
+        deepest = std::max(deepest, -double(pm->getContactPoint(k).getDistance()));
+      }
+    }
+    m.contacts = contacts;
+    m.maxPenetration = deepest;
+  }
+
+ private:
+  void addBody(const scene::Scene& s, const scene::Body& b) {
+    std::unique_ptr<btCollisionShape> shape;
+    switch (b.shape.type) {
+      case scene::ShapeType::Plane:
+        shape = std::make_unique<btStaticPlaneShape>(bt(b.shape.normal), b.shape.offset);
+        break;
+      case scene::ShapeType::Box:
+        shape = std::make_unique<btBoxShape>(0.5 * bt(b.shape.size));
+        break;
+      case scene::ShapeType::Sphere: shape = std::make_unique<btSphereShape>(b.shape.radius); break;
+      case scene::ShapeType::Capsule:
+        shape = std::make_unique<btCapsuleShapeZ>(b.shape.radius, b.shape.length);
+        break;
+    }
+    btTransform pose;
+    pose.setIdentity();
+    if (b.shape.type != scene::ShapeType::Plane) {
+      pose.setOrigin(bt(b.position));
+      pose.setRotation(
+          btQuaternion(b.orientation.x, b.orientation.y, b.orientation.z, b.orientation.w));
+    }
+    motion_.push_back(std::make_unique<btDefaultMotionState>(pose));
+    btRigidBody::btRigidBodyConstructionInfo ci(b.mass, motion_.back().get(), shape.get(),
+                                                bt(b.inertia));
+    const scene::Material& mat = s.materials[b.material];
+    ci.m_friction = std::sqrt(mat.friction);
+    ci.m_restitution = mat.restitution;
+    bodies_.push_back(std::make_unique<btRigidBody>(ci));
+    btRigidBody* body = bodies_.back().get();
+    if (!b.isStatic()) {
+      body->setLinearVelocity(bt(b.velocity));
+      body->setAngularVelocity(bt(b.angularVelocity));
+      if (!s.settings.sleeping) body->setActivationState(DISABLE_DEACTIVATION);
+    }
+    shapes_.push_back(std::move(shape));
+    world_->addRigidBody(body);
+  }
+
+  void addJoint(const scene::Scene& s, const scene::Joint& j) {
+    btRigidBody& a = *bodies_[j.body0];
+    btRigidBody& b = j.body1 >= 0 ? *bodies_[j.body1] : btTypedConstraint::getFixedBody();
+    (void)s;
+    const btTransform ta = a.getCenterOfMassTransform().inverse();
+    const btTransform tb = b.getCenterOfMassTransform().inverse();
+    // Bullet's slider offset is B's relative to A (its hinge angle is A's relative to B, as the
+    // scene's): the reversed axis gives the slider A's offset relative to B.
+    const Vec3 reversed{-j.axis[0], -j.axis[1], -j.axis[2]};
+    std::unique_ptr<btTypedConstraint> c;
+    const double dt = scene().settings.timeStep;
+    switch (j.type) {
+      case scene::JointType::Ball:
+        c = std::make_unique<btPoint2PointConstraint>(a, b, ta * bt(j.anchor), tb * bt(j.anchor));
+        break;
+      case scene::JointType::Hinge: {
+        const btTransform f = jointFrame(j.anchor, j.axis, 2);
+        auto h = std::make_unique<btHingeConstraint>(a, b, ta * f, tb * f);
+        if (j.limits.enabled) h->setLimit(j.limits.lower, j.limits.upper, 1.0, 0.3, 1.0);
+        if (j.motor.enabled) h->enableAngularMotor(true, j.motor.velocity, j.motor.maxForce * dt);
+        c = std::move(h);
+        break;
+      }
+      case scene::JointType::Slider: {
+        const btTransform f = jointFrame(j.anchor, reversed, 0);
+        auto sl = std::make_unique<btSliderConstraint>(a, b, ta * f, tb * f, true);
+        if (j.limits.enabled) {
+          sl->setLowerLinLimit(j.limits.lower);
+          sl->setUpperLinLimit(j.limits.upper);
+        }
+        if (j.motor.enabled) {
+          sl->setPoweredLinMotor(true);
+          sl->setTargetLinMotorVelocity(j.motor.velocity);
+          sl->setMaxLinMotorForce(j.motor.maxForce);
+        }
+        c = std::move(sl);
+        break;
+      }
+      case scene::JointType::Fixed: {
+        const btTransform f = jointFrame(j.anchor, {0, 0, 1}, 2);
+        c = std::make_unique<btFixedConstraint>(a, b, ta * f, tb * f);
+        break;
+      }
+    }
+    world_->addConstraint(c.get(), !j.collideConnected);
+    constraints_.push_back(std::move(c));
+  }
+
+  std::unique_ptr<TimedSolver> timed_;
+  ConstraintSolver* ours_ = nullptr;
+  scenes::StockMlcp* stock_ = nullptr;
+  bool fixedSweeps_ = false, pivoting_ = false;
+  int iterations_ = 0;
+  double tolerance_ = 0;
+  std::unique_ptr<btDefaultCollisionConfiguration> config_;
+  std::unique_ptr<btCollisionDispatcher> dispatcher_;
+  std::unique_ptr<btBroadphaseInterface> broadphase_;
+  std::unique_ptr<btDiscreteDynamicsWorld> world_;
+  std::vector<std::unique_ptr<btCollisionShape>> shapes_;
+  std::vector<std::unique_ptr<btMotionState>> motion_;
+  std::vector<std::unique_ptr<btRigidBody>> bodies_;
+  std::vector<std::unique_ptr<btTypedConstraint>> constraints_;
+};
+
+}  // namespace
+
+std::string worldSolverNames() {
+  return solverNames() +
+         ", bullet-si, bullet-nncg, bullet-mlcp-pgs, bullet-mlcp-dantzig, bullet-mlcp-lemke";
+}
+
+std::unique_ptr<scene::World> loadWorld(const scene::Scene& scene,
+                                        const scene::RunSettings& settings) {
+  return std::make_unique<BulletWorld>(scene, settings);
+}
+
+}  // namespace mlcp::bullet

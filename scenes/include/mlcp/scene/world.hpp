@@ -1,0 +1,131 @@
+// mlcp/scene/world.hpp: a scene loaded into an engine, behind one engine-free interface.
+//
+//     mlcp::scene::Scene scene = mlcp::scene::loadScene("scenes/stack_10.json");
+//     auto world = mlcp::bullet::loadWorld(scene, RunSettings::fromScene(scene));  // or ode::
+//     for (int i = 0; i < 100; ++i) {
+//       world->step();
+//       const StepMeasures& m = world->last();   // solver ms, residual, energy, ...
+//     }
+//
+// The engine loaders (adapters/bullet, adapters/ode) subclass World; `mlcp run`, the scene
+// tests and the sweeps see only this header. Measures that depend on the engine's solver
+// (time, residual, iterations, status, fallbacks) and on its contacts (penetration) come from
+// the engine; the others are computed here from the body states alone, so both engines are
+// measured by the same code:
+//   energy        sum over dynamic bodies of 1/2 m |v|^2 + 1/2 w^T R I R^T w - m g . p  (J)
+//   momentum      |sum m v|  (kg m/s)
+//   max_speed     max |v| over dynamic bodies  (m/s)
+//   joint_error   max over joints of the drift of the joint's anchor: the anchor is fixed in
+//                 each body's frame at creation; the error is the distance between its two
+//                 world positions now (for a slider only the part perpendicular to the axis,
+//                 which is free to slide); orientation drift is not measured  (m)
+#pragma once
+
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mlcp/scene/scene.hpp"
+
+namespace mlcp::scene {
+
+// What a run uses: the solver and its limits. fromScene() takes the scene's `solver` defaults.
+struct RunSettings {
+  // A core registry name (through our adapters) or an engine's stock solver name ("bullet-si",
+  // "ode-world", ...; each loader lists its own). Default "pgs".
+  std::string solver = "pgs";
+  // Sweeps (iterative) or outer iterations (pivoting); stock iterative solvers' iteration count.
+  // Default 50.
+  int iterations = 50;
+  // Options::tolerance, scaled natural-map residual. Default 1e-6.
+  double tolerance = 1e-6;
+  // Start each step from the last step's impulses. Default true.
+  bool warmStart = true;
+  // Core solver run when the primary's answer is rejected, "" for none (core solvers only).
+  // Default "pgs" (the adapters' default, with the core's default options).
+  std::string fallback = "pgs";
+  // Scaled residual above which the primary's answer goes to the fallback. Default 1e-3. The
+  // adapters differ here: Bullet's drop-in rejects any answer above it (Settings::
+  // acceptResidual), ODE's stepper only unusable or Failed ones (StepperOptions::
+  // fallbackResidual), not answers that merely ran out of iterations.
+  double fallbackResidual = 1e-3;
+
+  static RunSettings fromScene(const Scene& scene);
+};
+
+struct BodyState {
+  Vec3 position{0, 0, 0};         // centre of mass, world, m
+  Quat orientation;               // body to world
+  Vec3 velocity{0, 0, 0};         // m/s
+  Vec3 angularVelocity{0, 0, 0};  // world, rad/s
+};
+
+inline constexpr double kNotMeasured = std::numeric_limits<double>::quiet_NaN();
+
+// One step's measures (the columns of `mlcp run`'s CSV).
+struct StepMeasures {
+  double solverMs = 0;  // wall time of the constraint solve(s), ms
+  double stepMs = 0;    // wall time of the whole step (collision, solve, integration), ms
+  // Worst scaled natural-map residual of the step's problems; NaN when the solver's answer is
+  // not measured (stock iterative solvers).
+  double residual = kNotMeasured;
+  int iterations = 0;  // summed over islands (stock iterative solvers: the fixed count)
+  // Worst status over islands, mlcp::toString names ("converged", "max-iterations", ...).
+  std::string status = "converged";
+  int fallbacks = 0;
+  int contacts = 0;           // contact points this step
+  double maxPenetration = 0;  // deepest contact of this step (before integration), m, >= 0
+  double jointError = 0;      // m, see above
+  double energy = 0;          // J
+  double momentum = 0;        // kg m/s
+  double maxSpeed = 0;        // m/s
+};
+
+class World {
+ public:
+  explicit World(const Scene& scene);
+  virtual ~World();
+  World(const World&) = delete;
+  World& operator=(const World&) = delete;
+
+  // One fixed step of scene().settings.timeStep; then last() holds its measures.
+  void step();
+  const StepMeasures& last() const { return last_; }
+  int stepsTaken() const { return steps_; }
+  const Scene& scene() const { return scene_; }
+
+  // Every scene body (static ones included) in scene order.
+  virtual std::vector<BodyState> states() const = 0;
+  // "bullet" or "ode".
+  virtual const char* engine() const = 0;
+
+ protected:
+  // Advances the engine by one step and fills the engine's measures (solver time, residual,
+  // iterations, status, fallbacks, contacts, maxPenetration); the rest is filled by step().
+  virtual void stepEngine(StepMeasures& m) = 0;
+
+ private:
+  Scene scene_;
+  StepMeasures last_;
+  int steps_ = 0;
+  // Per joint: the anchor in body0's frame and in body1's frame (or the world).
+  std::vector<std::pair<Vec3, Vec3>> anchors_;
+};
+
+// The body-state measures of a World (energy, momentum, max speed, joint error), exposed for
+// tests. `anchors` as kept by World.
+void measureStates(const Scene& scene, const std::vector<BodyState>& states,
+                   const std::vector<std::pair<Vec3, Vec3>>& anchors, StepMeasures& m);
+
+// Whether every number of the state is finite (a blown-up simulation is not).
+bool isFinite(const BodyState& b);
+bool isFinite(const std::vector<BodyState>& states);
+
+// The rotation angle (rad) of q about the unit axis: 2 atan2(v . axis, w) of q = (w, v), in
+// (-pi, pi]. For a body turning about one axis, the angle it has turned.
+double twistAngle(const Quat& q, const Vec3& axis);
+// q a^-1: the rotation taking orientation a to orientation q.
+Quat relative(const Quat& q, const Quat& a);
+
+}  // namespace mlcp::scene
