@@ -119,6 +119,8 @@ class BulletWorld : public scene::World {
     info.m_globalCfm = s.settings.cfm;
     info.m_numIterations = run.iterations;
     info.m_minimumSolverBatchSize = 1;
+    // Two friction rows per contact, as ODE's dContactApprox1 (a friction pyramid).
+    info.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
     if (!run.warmStart) info.m_solverMode &= ~SOLVER_USE_WARMSTARTING;
 
     for (const scene::Body& b : s.bodies) addBody(s, b);
