@@ -2,7 +2,6 @@
 
 #include <Eigen/OrderingMethods>
 #include <algorithm>
-#include <climits>
 #include <cmath>
 #include <sstream>
 
@@ -12,11 +11,27 @@
 namespace mlcp::detail {
 
 namespace {
+constexpr double kMinStep = 1.0 / 1024;  // shortest line-search step before the stage gives up
+// Proximal weight of a Newton step, times max |A_ii| and min(1, ||H||): damps the null-space
+// part of nearly singular clamped blocks far from the answer, vanishes near it.
+constexpr double kProximal = 1e-2;
+constexpr int kUphill = 2;  // full steps in a row taken without descent before handing over
 bool isFriction(const Problem& pb, int i) { return !pb.findex.empty() && pb.findex[i] >= 0; }
 double signOf(double v) { return v < 0 ? -1.0 : 1.0; }
 // The value a non-clamped, uncoupled row is held at.
 double heldValue(double lo, double hi, bool atHi) { return atHi ? hi : lo; }
 }  // namespace
+
+// ||H(x)||^2 with H_i = x_i - clamp(x_i - w_i, lo'_i, hi'_i): zero exactly at a solution.
+double BlockPivoting::meritAt(const Problem& pb, const Vector& x, const Vector& w) const {
+  double sum = 0;
+  for (int i = 0; i < pb.size(); ++i) {
+    const double lo = pb.effectiveLo(i, x), hi = pb.effectiveHi(i, x);
+    const double h = x[i] - std::clamp(x[i] - w[i], lo, hi);
+    sum += h * h;
+  }
+  return sum;
+}
 
 double BlockPivoting::frictionBound(const Problem& pb, int t, Set s, const Vector& x) const {
   return (s == Set::AtHi ? pb.hi[t] : pb.lo[t]) * std::abs(x[pb.findex[t]]);
@@ -59,10 +74,12 @@ void BlockPivoting::guess(const Problem& pb, const Vector& x0, bool cold) {
 //   clamped rows:         (A x + b)_i = 0
 //   uncoupled at a bound: x_i = lo_i or hi_i
 //   friction at a bound:  x_t = mu_t s_j x_j (s_j = sign of the normal, mu_t = lo_t or hi_t)
-// Substituting the sliding rows (normal clamped) gives K y = r with K = A_CC + U V^T, U the
-// sliding columns scaled by their coefficients, V selecting their normals; A_CC is factored
-// (sparse LDL^T in a fill-reducing order of A) and the rank-|T| term is handled by Woodbury.
-bool BlockPivoting::solveClamped(const Problem& pb, Vector& x, std::string& why) {
+// with a proximal term: clamped rows solve w_i + rho (x_i - prev_i) = 0 (rho = 0: the exact
+// equations). Substituting the sliding rows (normal clamped) gives K y = r with K = A_CC + rho I
+// plus the sliding columns scaled by their coefficients added to their normals' columns: sparse
+// LDL^T without sliding rows, sparse LU with them (factorClamped / factorCoupled).
+bool BlockPivoting::solveClamped(const Problem& pb, Vector& x, const Vector& prev, double rho,
+                                 std::string& why) {
   const int n = pb.size();
   const SparseMatrix& A = *a_;
   order_.clear();
@@ -94,18 +111,61 @@ bool BlockPivoting::solveClamped(const Problem& pb, Vector& x, std::string& why)
 
   const int m = static_cast<int>(order_.size());
   Vector r(m);
-  for (int c = 0; c < m; ++c) r[c] = -(pb.b[order_[c]] + A.row(order_[c]).dot(x));
-  // The upper triangle of A_CC, column by column in the order of byRank_.
+  for (int c = 0; c < m; ++c)
+    r[c] = -(pb.b[order_[c]] + A.row(order_[c]).dot(x)) + rho * prev[order_[c]];
+  const int s = static_cast<int>(sliding_.size());
+  useLu_ = s > 0 && m > 0;
+  if (useLu_) {
+    if (!factorCoupled(rho, why)) return false;
+  } else if (m > 0) {
+    if (!factorClamped(rho, why)) return false;
+  }
+  auto place = [&](const Vector& y, bool add) {
+    for (int c = 0; c < m; ++c) x[order_[c]] = (add ? x[order_[c]] : 0.0) + y[c];
+    for (int k = 0; k < s; ++k) x[sliding_[k]] = coeff_[k] * x[pb.findex[sliding_[k]]];
+  };
+  if (m == 0) return true;
+  Vector y = r;
+  applySolve(y);
+  place(y, false);
+  // One step of iterative refinement: the clamped rows' w is the residual of K y = r.
+  for (int c = 0; c < m; ++c)
+    y[c] = -(pb.b[order_[c]] + A.row(order_[c]).dot(x)) - rho * (x[order_[c]] - prev[order_[c]]);
+  applySolve(y);
+  place(y, true);
+  if (!x.allFinite()) {
+    why = "the clamped system with its sliding rows is singular";
+    return false;
+  }
+  return true;
+}
+
+void BlockPivoting::applySolve(Vector& y) const {
+  if (useLu_)
+    y = lu_.solve(y);
+  else
+    y = ldlt_.solve(y);
+}
+
+// Factors the symmetric A_CC + rho I (no sliding rows): sparse LDL^T of its upper triangle,
+// column by column in the order of byRank_; the symbolic analysis only when the pattern changed.
+bool BlockPivoting::factorClamped(double rho, std::string& why) {
+  const SparseMatrix& A = *a_;
+  const int m = static_cast<int>(order_.size());
   K_.resize(m, m);
   std::vector<std::pair<int, double>> column;
   std::vector<int> outer(m + 1, 0), inner;
   std::vector<double> values;
   for (int c = 0; c < m; ++c) {
     column.clear();
+    bool diagonal = false;
     for (SparseMatrix::InnerIterator it(A, order_[c]); it; ++it) {
       const int q = pos_[it.index()];
-      if (q >= 0 && q <= c) column.emplace_back(q, it.value());
+      if (q < 0 || q > c) continue;
+      diagonal |= q == c;
+      column.emplace_back(q, it.value() + (q == c ? rho : 0.0));
     }
+    if (rho > 0 && !diagonal) column.emplace_back(c, rho);
     std::sort(column.begin(), column.end());
     for (const auto& [q, v] : column) {
       inner.push_back(q);
@@ -117,95 +177,46 @@ bool BlockPivoting::solveClamped(const Problem& pb, Vector& x, std::string& why)
   std::copy(outer.begin(), outer.end(), K_.outerIndexPtr());
   std::copy(inner.begin(), inner.end(), K_.innerIndexPtr());
   std::copy(values.begin(), values.end(), K_.valuePtr());
-
-  if (m > 0) {
-    if (!kPattern_.same(K_)) {
-      ldlt_.analyzePattern(K_);
-      kPattern_.remember(K_);
-    }
-    ldlt_.factorize(K_);
-    if (ldlt_.info() != Eigen::Success || !(ldlt_.vectorD().cwiseAbs().minCoeff() > pivTol_)) {
-      why = "the clamped block is singular";
-      return false;
-    }
+  if (!kPattern_.same(K_)) {
+    ldlt_.analyzePattern(K_);
+    kPattern_.remember(K_);
   }
-  const int s = static_cast<int>(sliding_.size());
-  if (s > 0 && m > 0) {
-    DenseMatrix U = DenseMatrix::Zero(m, s);
-    for (int k = 0; k < s; ++k)
-      for (SparseMatrix::InnerIterator it(A, sliding_[k]); it; ++it)
-        if (pos_[it.index()] >= 0) U(pos_[it.index()], k) = coeff_[k] * it.value();
-    Z_ = ldlt_.solve(U);
-    DenseMatrix S = DenseMatrix::Identity(s, s);
-    for (int k = 0; k < s; ++k) S.row(k) += Z_.row(pos_[pb.findex[sliding_[k]]]);
-    capacitance_.compute(S);
-  }
-  auto place = [&](const Vector& y, bool add) {
-    for (int c = 0; c < m; ++c) x[order_[c]] = (add ? x[order_[c]] : 0.0) + y[c];
-    for (int k = 0; k < s; ++k) x[sliding_[k]] = coeff_[k] * x[pb.findex[sliding_[k]]];
-  };
-  if (m == 0) return true;
-  Vector y = r;
-  applyWoodbury(y);
-  place(y, false);
-  // One step of iterative refinement: the clamped rows' w is the residual of K y = r.
-  for (int c = 0; c < m; ++c) y[c] = -(pb.b[order_[c]] + A.row(order_[c]).dot(x));
-  applyWoodbury(y);
-  place(y, true);
-  if (!x.allFinite()) {
-    why = "the clamped system with its sliding rows is singular";
+  ldlt_.factorize(K_);
+  if (ldlt_.info() != Eigen::Success || !(ldlt_.vectorD().cwiseAbs().minCoeff() > pivTol_)) {
+    why = "the clamped block is singular";
     return false;
   }
   return true;
 }
 
-void BlockPivoting::applyWoodbury(Vector& y) const {
-  y = ldlt_.solve(y);
-  const int s = static_cast<int>(sliding_.size());
-  if (s == 0) return;
-  Vector v(s);
-  for (int k = 0; k < s; ++k) v[k] = y[pos_[problemFindex_[sliding_[k]]]];
-  y -= Z_ * capacitance_.solve(v);
-}
-
-// Index sets of the next step at x (w = A x + b): a clamped row outside its bounds (friction
-// bounds at x) goes to the bound it crossed, a row at a bound whose w has the wrong sign
-// becomes clamped; both only beyond eps_, so that degenerate rows (x at a bound and w = 0 up
-// to rounding) do not flip back and forth. Friction rows whose normal is held at 0 are fixed
-// at 0, and clamped when it comes back. Returns the number of rows that changed set.
-int BlockPivoting::setsAt(const Problem& pb, const Vector& x, const Vector& w) {
-  const int n = pb.size();
-  int changed = 0;
-  auto move = [&](int i, double lo, double hi) {
-    const Set old = set_[i];
-    switch (old) {
-      case Set::Clamped:
-        if (x[i] < lo - eps_) set_[i] = Set::AtLo;
-        if (x[i] > hi + eps_) set_[i] = Set::AtHi;
-        break;
-      case Set::AtLo:
-        if (w[i] < -eps_) set_[i] = Set::Clamped;
-        break;
-      case Set::AtHi:
-        if (w[i] > eps_) set_[i] = Set::Clamped;
-        break;
-      case Set::Fixed: set_[i] = Set::Clamped; break;
-    }
-    changed += set_[i] != old;
-  };
-  for (int i = 0; i < n; ++i)
-    if (!isFriction(pb, i) && set_[i] != Set::Fixed) move(i, pb.lo[i], pb.hi[i]);
-  for (int t = 0; t < n; ++t) {
-    if (!isFriction(pb, t) || pb.lo[t] == pb.hi[t]) continue;
-    const int j = pb.findex[t];
-    if (set_[j] != Set::Clamped && heldValue(pb.lo[j], pb.hi[j], set_[j] == Set::AtHi) == 0) {
-      changed += set_[t] != Set::Fixed;
-      set_[t] = Set::Fixed;
-      continue;
-    }
-    move(t, frictionBound(pb, t, Set::AtLo, x), frictionBound(pb, t, Set::AtHi, x));
+// Factors K = A_CC + rho I with each sliding row's column c_t A_{C,t} added to its normal's
+// column. The friction coupling makes K nonsymmetric, but a contact's friction and normal rows
+// touch the same bodies, so K keeps A_CC's pattern and a sparse LU in the inherited
+// fill-reducing order stays cheap.
+bool BlockPivoting::factorCoupled(double rho, std::string& why) {
+  const SparseMatrix& A = *a_;
+  const int m = static_cast<int>(order_.size());
+  triplets_.clear();
+  for (int c = 0; c < m; ++c) {
+    for (SparseMatrix::InnerIterator it(A, order_[c]); it; ++it)
+      if (pos_[it.index()] >= 0) triplets_.emplace_back(pos_[it.index()], c, it.value());
+    if (rho > 0) triplets_.emplace_back(c, c, rho);
   }
-  return changed;
+  for (size_t k = 0; k < sliding_.size(); ++k) {
+    const int c = pos_[problemFindex_[sliding_[k]]];
+    for (SparseMatrix::InnerIterator it(A, sliding_[k]); it; ++it)
+      if (pos_[it.index()] >= 0)
+        triplets_.emplace_back(pos_[it.index()], c, coeff_[k] * it.value());
+  }
+  Kfull_.resize(m, m);
+  Kfull_.setFromTriplets(triplets_.begin(), triplets_.end());
+  lu_.analyzePattern(Kfull_);
+  lu_.factorize(Kfull_);
+  if (lu_.info() != Eigen::Success) {
+    why = "the clamped system with its sliding rows is singular";
+    return false;
+  }
+  return true;
 }
 
 BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Options& opt,
@@ -235,56 +246,94 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
   double dMax = 0;
   for (int i = 0; i < n; ++i) dMax = std::max(dMax, std::abs(pb.diagonal(i)));
   pivTol_ = opt.pivotTolerance * (dMax > 0 ? dMax : 1.0);
-  eps_ = 0.01 * opt.tolerance * (1 + pb.b.lpNorm<Eigen::Infinity>());
   pos_.assign(n, -1);
   const bool cold = x.isZero(0.0);
   guess(pb, x, cold);
 
-  // Full Newton (block principal pivoting) steps: the point that solves the equations of the
-  // current sets, then the sets at that point. Near the answer one step settles it; far from
-  // it the sets may oscillate, so the stage stops after `patience` steps that did not reduce
-  // the number of rows that changed set, and hands over the iterate with the fewest changes.
-  constexpr int patience = 2;
-  int best = INT_MAX, stalled = 0;
-  Vector w = *a_ * x + pb.b, bestX = x;
+  // Newton steps on the natural map with a backtracking line search: the sets come from the
+  // natural map at the current x, the point that solves their equations gives the direction,
+  // and the step is shortened until the merit ||H(x)||^2 (H_i = x_i - clamp(x_i - w_i, lo', hi'))
+  // decreases by the Armijo rule. A full step is block principal pivoting; the line search keeps
+  // degenerate scenes (coplanar contacts: nearly singular clamped blocks whose equations throw
+  // the null-space part far away) from jumping between set guesses. When no step length
+  // decreases the merit the stage hands over the last (best) iterate.
+  Vector w = *a_ * x + pb.b, xOld(n), wOld(n), wNew(n);
+  const double regularization = kProximal * (dMax > 0 ? dMax : 1.0);
+  double merit = meritAt(pb, x, w), bestRes = kInf;
+  int uphill = 0;
+  Vector bestX = x;
   const double start = nowSeconds();
   std::ostringstream os;
   for (;;) {
-    const double res = accuracy(pb, x, w).residual;
+    double res = accuracy(pb, x, w).residual;
     if (res <= opt.tolerance) {
+      // Short steps leave rows within the tolerance of their bounds but not on them: project
+      // (friction after its normal) and keep the projection when it is still within tolerance.
+      Vector p = x;
+      for (int i = 0; i < n; ++i)
+        if (!isFriction(pb, i)) p[i] = std::clamp(p[i], pb.lo[i], pb.hi[i]);
+      for (int t = 0; t < n; ++t)
+        if (isFriction(pb, t)) p[t] = std::clamp(p[t], pb.effectiveLo(t, p), pb.effectiveHi(t, p));
+      Vector wp = *a_ * p + pb.b;
+      const double resP = accuracy(pb, p, wp).residual;
+      if (resP <= opt.tolerance) {
+        x = p;
+        res = resP;
+      }
       rep.settled = true;
       os << "block pivoting settled after " << rep.steps << " step" << (rep.steps != 1 ? "s" : "");
       break;
     }
-    if (rep.steps >= maxSteps || stalled >= patience) {
-      os << "residual " << res << " after " << rep.steps << " block steps";
+    if (res < bestRes) {
+      bestRes = res;
+      bestX = x;
+    }
+    if (rep.steps >= maxSteps) {
       x = bestX;
+      os << "residual " << bestRes << " after " << rep.steps << " block steps";
       break;
     }
     if (opt.timeBudget > 0 && nowSeconds() - start > opt.timeBudget) {
-      os << "time budget spent after " << rep.steps << " block steps";
       x = bestX;
+      os << "time budget spent after " << rep.steps << " block steps";
       break;
     }
-    const int changed = rep.steps > 0 ? setsAt(pb, x, w) : 0;
-    if (rep.steps > 0) {
-      if (changed < best) {
-        best = changed;
-        bestX = x;
-        stalled = 0;
-      } else {
-        ++stalled;
-      }
-    }
+    if (rep.steps > 0) guess(pb, x, false);
     ++rep.steps;
+    xOld = x;
+    wOld = w;
     std::string why;
-    if (!solveClamped(pb, x, why)) {
+    const double rho = regularization * std::min(1.0, std::sqrt(merit));
+    if (!solveClamped(pb, x, xOld, rho, why)) {
       os << why << " (block step " << rep.steps << ")";
       x = bestX;
       break;
     }
-    w.noalias() = *a_ * x;
-    w += pb.b;
+    wNew.noalias() = *a_ * x;
+    wNew += pb.b;
+    const Vector dx = x - xOld;
+    double alpha = 1, trial = kInf;
+    for (; alpha >= kMinStep; alpha *= 0.5) {
+      x = xOld + alpha * dx;
+      w = wOld + alpha * (wNew - wOld);
+      trial = meritAt(pb, x, w);
+      if (trial <= (1 - 2e-4 * alpha) * merit) break;
+    }
+    if (!(trial <= (1 - 2e-4 * alpha) * merit)) {
+      // Watchdog: at a kink no short step descends, but the full step (the block pivoting
+      // exchange) often settles the sets; take it a few times in a row, keeping the best point.
+      if (++uphill > kUphill) {
+        x = bestX;
+        os << "residual " << bestRes << " after " << rep.steps << " block steps (no descent)";
+        break;
+      }
+      x = xOld + dx;
+      w = wNew;
+      trial = meritAt(pb, x, w);
+    } else {
+      uphill = 0;
+    }
+    merit = trial;
   }
   rep.message = os.str();
   return rep;

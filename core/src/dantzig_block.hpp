@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/SparseCholesky>
+#include <Eigen/SparseLU>
 #include <string>
 #include <vector>
 
@@ -32,9 +33,11 @@ class BlockPivoting {
   using Ldlt = Eigen::SimplicialLDLT<ColMajor, Eigen::Upper, Eigen::NaturalOrdering<int>>;
 
   void guess(const Problem& pb, const Vector& x0, bool cold);
-  bool solveClamped(const Problem& pb, Vector& x, std::string& why);
-  void applyWoodbury(Vector& y) const;
-  int setsAt(const Problem& pb, const Vector& x, const Vector& w);
+  bool solveClamped(const Problem& pb, Vector& x, const Vector& prev, double rho, std::string& why);
+  bool factorClamped(double rho, std::string& why);
+  bool factorCoupled(double rho, std::string& why);
+  void applySolve(Vector& y) const;
+  double meritAt(const Problem& pb, const Vector& x, const Vector& w) const;
   double frictionBound(const Problem& pb, int t, Set s, const Vector& x) const;
 
   SparseMatrix A_;  // row-major copy when the problem is stored dense
@@ -47,9 +50,11 @@ class BlockPivoting {
   std::vector<double> coeff_;               // sliding row t: x_t = coeff_ * x_normal
   ColMajor K_;  // upper triangle of the clamped block in the order of byRank_
   Ldlt ldlt_;
-  DenseMatrix Z_;  // A_CC^-1 U for the sliding rows (Woodbury)
-  Eigen::PartialPivLU<DenseMatrix> capacitance_;
-  double eps_ = 0, pivTol_ = 0;
+  bool useLu_ = false;  // sliding rows present: K is nonsymmetric and factored by lu_
+  std::vector<Eigen::Triplet<double>> triplets_;
+  ColMajor Kfull_;  // all of K (sliding rows substituted), for lu_
+  Eigen::SparseLU<ColMajor, Eigen::NaturalOrdering<int>> lu_;
+  double pivTol_ = 0;
 };
 
 }  // namespace mlcp::detail

@@ -70,30 +70,33 @@
 //     about 5% of cases end in MaxIterations.
 //
 // Block stage (DantzigParams::blockStage; sparse symmetric problems, Exact friction only). Before
-// the incremental pivoting, whole index sets are guessed and exchanged at once (block principal
-// pivoting, Kostreva / Judice-Pires; equivalently full active-set Newton steps on the natural
-// map). Each row is clamped (w_i = 0), held at lo or hi, or fixed; a friction row at a bound is
-// the linear equation x_t = mu_t s_j x_j coupling it to its normal j (s_j the normal's sign),
-// so findex is exact without fixed-point passes, and friction rows whose normal is held at 0
-// are fixed at 0. One step solves those equations: A_CC is factored by a sparse LDL^T
-// (SimplicialLDLT in a fill-reducing AMD order of the whole A, computed once per pattern of A
-// and inherited by every clamped block; the symbolic analysis is redone only when the clamped
-// block's pattern changes), and the sliding rows (at a bound, normal clamped) enter as a
-// rank-|T| correction through the Woodbury formula, so the nonsymmetric system needs no LU.
-// One step of iterative refinement follows. Then every row is checked: a clamped row beyond its
-// (friction) bound goes to that bound, a held row whose w has the wrong sign becomes clamped
-// (both beyond 0.01 tolerance (1 + |b|), so degenerate rows do not flip on rounding). Warm
-// starts take the first sets from the natural map at the guess (z = x0 - w0 against the
-// bounds); cold starts clamp every row. The stage ends when the residual (residual.hpp) is
-// within Options::tolerance (then it is the answer: Result::iterations counts its steps), or
-// after 2 steps that did not reduce the number of exchanged rows (sets oscillating),
-// DantzigParams::maxBlockSteps, a singular block or the time budget: then the iterate with
-// the fewest exchanges is handed to the incremental pivoting below as its warm start, so the
-// result is never worse than without the stage. Measured on box pyramids (core_bench): a warm
-// start from the previous time step settles in 1-2 steps (55 boxes, n = 1200: about 8 ms per
-// step including assembly, against 36 ms for the dense path); from a cold start the sets
-// oscillate on these degenerate scenes (4 contacts per face, small cfm) and the stage only
-// costs time, so Auto uses it for warm starts only.
+// the incremental pivoting, whole index sets are guessed and exchanged at once: semismooth Newton
+// steps on the natural map H(x) = x - clamp(x - w, lo', hi') (block principal pivoting, Kostreva /
+// Judice-Pires, when every step is full). Each row is clamped (w_i = 0), held at lo or hi, or
+// fixed, as the natural map at the current x says; a friction row at a bound is the linear
+// equation x_t = mu_t s_j x_j coupling it to its normal j (s_j the normal's sign), so findex is
+// exact without fixed-point passes, and friction rows whose normal is held at 0 are fixed at 0.
+// One step solves those equations with a proximal term rho (x_C - x_C,prev) on the clamped rows
+// (rho = 1e-2 max|A_ii| min(1, ||H||): coplanar contacts make clamped blocks nearly singular, and
+// far from the answer their exact equations throw the null-space part far away). Without sliding
+// rows A_CC + rho I is factored by a sparse LDL^T (SimplicialLDLT in a fill-reducing AMD order of
+// the whole A, computed once per pattern of A and inherited by every clamped block); sliding rows
+// (at a bound, normal clamped) are substituted, which makes the matrix nonsymmetric with A_CC's
+// pattern, factored by a sparse LU in the same order. One step of iterative refinement follows.
+// The step towards that point is shortened by backtracking until ||H||^2 decreases (Armijo);
+// when no step length descends (a kink) the full step is taken up to 2 times in a row. Warm
+// starts take the first sets from the natural map at the guess; cold starts clamp every row. The
+// stage ends when the residual (residual.hpp) is within Options::tolerance (then it is the
+// answer, projected onto the bounds when that keeps it within tolerance: Result::iterations
+// counts its steps), or after DantzigParams::maxBlockSteps, no descent, a singular block or the
+// time budget: then the best iterate is handed to the incremental pivoting below as its warm
+// start, so the result is never worse than without the stage. Measured on the Bullet adapter's
+// 55-box pyramid (n = 1160, warm start from the cached impulses, globalCfm 1e-5): full steps
+// alone diverge (residual 0.2 -> 25 in 4 steps) and the hand-over cost 1.2 s of pivoting; the
+// damped steps reach residual ~1e-3 in 40 steps (~1.6 ms each) and the total is ~120-160 ms
+// On synthetic box
+// pyramids a warm start settles in 1-2 full steps (55 boxes, n = 1200: about 8 ms per step
+// including assembly); from a cold start Auto does not use the stage.
 //
 // Result::iterations counts pivots (direction computations: each row added or exchanged)
 // summed over all passes; Options::maxPivots (0: 50 n + 100) limits them per pass
