@@ -7,12 +7,20 @@
 // The residual of each answer (mlcp::residual, checked independently) is a counter; so are
 // the solver's iterations (sweeps or pivots) and whether it converged. Compare times within
 // one run: the machines are noisy.
+//
+// Captured engine islands (not in the repository): MLCP_BENCH_ISLANDS=base1,base2,... names
+// problems saved as base.json (mlcp-problem/1) with their warm start in base.start.json
+// (mlcp::io::readVectorJson); each is solved by dantzig (Auto and Never block stage) cold and
+// warm, with pivots, block steps and the residual as counters.
 #include <benchmark/benchmark.h>
 
+#include <cstdlib>
 #include <random>
+#include <sstream>
 
 #include "../common/contact_scenes.hpp"
 #include "mlcp/dantzig.hpp"
+#include "mlcp/io.hpp"
 #include "mlcp/pgs.hpp"
 #include "mlcp/registry.hpp"
 #include "mlcp/residual.hpp"
@@ -167,11 +175,49 @@ void registerPyramids() {
   }
 }
 
+void islandSolve(benchmark::State& state, const Problem& p, const Vector& start,
+                 DantzigParams::BlockStage stage, bool warm) {
+  DantzigSolver solver;
+  solver.params().blockStage = stage;
+  Result r;
+  Vector x;
+  for (auto _ : state) {
+    r = warm ? solver.solveWithGuess(p, start, x) : solver.solve(p, x);
+  }
+  state.counters["n"] = p.size();
+  state.counters["residual"] = residual(p, x);
+  state.counters["converged"] = r.converged();
+  state.counters["iterations"] = r.iterations;
+  state.counters["block_steps"] = solver.blockSteps();
+}
+
+void registerIslands() {
+  const char* list = std::getenv("MLCP_BENCH_ISLANDS");
+  if (!list) return;
+  std::stringstream names(list);
+  std::string base;
+  while (std::getline(names, base, ',')) {
+    if (base.empty()) continue;
+    const Problem p = io::readProblemJson(base + ".json");
+    const Vector start = io::readVectorJson(base + ".start.json");
+    for (auto [stage, tag] : {std::pair{DantzigParams::BlockStage::Auto, "auto"},
+                              std::pair{DantzigParams::BlockStage::Never, "never"}})
+      for (bool warm : {false, true}) {
+        const std::string label =
+            "dantzig-" + std::string(tag) + "/" + base + (warm ? "/warm" : "/cold");
+        benchmark::RegisterBenchmark(label.c_str(), [=](benchmark::State& st) {
+          islandSolve(st, p, start, stage, warm);
+        })->Unit(benchmark::kMillisecond);
+      }
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   registerAll();
   registerPyramids();
+  registerIslands();
   benchmark::Initialize(&argc, argv);
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
