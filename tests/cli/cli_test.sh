@@ -3,21 +3,7 @@
 # messages naming the file, JSON output. Prints "N passed, N failed".
 set -u
 mlcp=$1 data=$2 siconos=$3
-passed=0 failed=0
-check() {  # check NAME EXPECTED_CODE PATTERN -- command...
-  local name=$1 want=$2 pattern=$3
-  shift 4
-  local out code
-  out=$("$@" 2>&1)
-  code=$?
-  if [ "$code" -eq "$want" ] && grep -qE -- "$pattern" <<< "$out"; then
-    passed=$((passed + 1))
-  else
-    failed=$((failed + 1))
-    echo "FAIL $name: exit $code (want $want), output lacks /$pattern/:"
-    sed 's/^/    /' <<< "$out" | head -20
-  fi
-}
+source "$(dirname "${BASH_SOURCE[0]}")/check.sh"
 check help 0 'pgs' -- "$mlcp" --help
 check solve-help 0 'lemke|pgs' -- "$mlcp" solve --help
 check spd 0 'converged' -- "$mlcp" solve "$data/spd.json" --solver pgs --tol 1e-9

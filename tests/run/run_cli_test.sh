@@ -5,21 +5,7 @@ set -u
 mlcp=$1 scenes=$2
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-passed=0 failed=0
-check() {  # check NAME EXPECTED_CODE PATTERN -- command...
-  local name=$1 want=$2 pattern=$3
-  shift 4
-  local out code
-  out=$("$@" 2>&1)
-  code=$?
-  if [ "$code" -eq "$want" ] && grep -qE -- "$pattern" <<< "$out"; then
-    passed=$((passed + 1))
-  else
-    failed=$((failed + 1))
-    echo "FAIL $name: exit $code (want $want), output lacks /$pattern/:"
-    sed 's/^/    /' <<< "$out" | head -20
-  fi
-}
+source "$(dirname "${BASH_SOURCE[0]}")/../cli/check.sh"
 header='scene,engine,solver,step,solver_ms,step_ms,residual,iterations,status,fallbacks,max_penetration,joint_error,energy,momentum,max_speed'
 csv_ok() {  # csv_ok NAME FILE ROWS ENGINE SOLVER
   local name=$1 file=$2 rows=$3 engine=$4 solver=$5
