@@ -219,6 +219,46 @@ bool BlockPivoting::factorCoupled(double rho, std::string& why) {
   return true;
 }
 
+// Index sets of the next step at x (w = A x + b): a clamped row outside its bounds (friction
+// bounds at x) goes to the bound it crossed, a row at a bound whose w has the wrong sign
+// becomes clamped; both only beyond eps_, so that degenerate rows (x at a bound and w = 0 up
+// to rounding) do not flip back and forth. Friction rows whose normal is held at 0 are fixed
+// at 0, and clamped when it comes back. Returns the number of rows that changed set.
+int BlockPivoting::setsAt(const Problem& pb, const Vector& x, const Vector& w) {
+  const int n = pb.size();
+  int changed = 0;
+  auto move = [&](int i, double lo, double hi) {
+    const Set old = set_[i];
+    switch (old) {
+      case Set::Clamped:
+        if (x[i] < lo - eps_) set_[i] = Set::AtLo;
+        if (x[i] > hi + eps_) set_[i] = Set::AtHi;
+        break;
+      case Set::AtLo:
+        if (w[i] < -eps_) set_[i] = Set::Clamped;
+        break;
+      case Set::AtHi:
+        if (w[i] > eps_) set_[i] = Set::Clamped;
+        break;
+      case Set::Fixed: set_[i] = Set::Clamped; break;
+    }
+    changed += set_[i] != old;
+  };
+  for (int i = 0; i < n; ++i)
+    if (!isFriction(pb, i) && set_[i] != Set::Fixed) move(i, pb.lo[i], pb.hi[i]);
+  for (int t = 0; t < n; ++t) {
+    if (!isFriction(pb, t) || pb.lo[t] == pb.hi[t]) continue;
+    const int j = pb.findex[t];
+    if (set_[j] != Set::Clamped && heldValue(pb.lo[j], pb.hi[j], set_[j] == Set::AtHi) == 0) {
+      changed += set_[t] != Set::Fixed;
+      set_[t] = Set::Fixed;
+      continue;
+    }
+    move(t, frictionBound(pb, t, Set::AtLo, x), frictionBound(pb, t, Set::AtHi, x));
+  }
+  return changed;
+}
+
 BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Options& opt,
                                          int maxSteps) {
   Report rep;
@@ -246,21 +286,24 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
   double dMax = 0;
   for (int i = 0; i < n; ++i) dMax = std::max(dMax, std::abs(pb.diagonal(i)));
   pivTol_ = opt.pivotTolerance * (dMax > 0 ? dMax : 1.0);
+  eps_ = 0.01 * opt.tolerance * (1 + pb.b.lpNorm<Eigen::Infinity>());
   pos_.assign(n, -1);
   const bool cold = x.isZero(0.0);
   guess(pb, x, cold);
 
-  // Newton steps on the natural map with a backtracking line search: the sets come from the
-  // natural map at the current x, the point that solves their equations gives the direction,
-  // and the step is shortened until the merit ||H(x)||^2 (H_i = x_i - clamp(x_i - w_i, lo', hi'))
-  // decreases by the Armijo rule. A full step is block principal pivoting; the line search keeps
-  // degenerate scenes (coplanar contacts: nearly singular clamped blocks whose equations throw
-  // the null-space part far away) from jumping between set guesses. When no step length
-  // decreases the merit the stage hands over the last (best) iterate.
+  // Full steps (block principal pivoting) while they keep finding new lowest merits
+  // ||H(x)||^2 (H_i = x_i - clamp(x_i - w_i, lo', hi')); then damped Newton steps on the natural
+  // map: a proximal term in the equations and backtracking until the merit decreases (Armijo),
+  // which keeps degenerate scenes (coplanar contacts: nearly singular clamped blocks whose
+  // equations throw the null-space part far away) from jumping between set guesses. When no
+  // step length descends the stage hands over the best iterate.
   Vector w = *a_ * x + pb.b, xOld(n), wOld(n), wNew(n);
   const double regularization = kProximal * (dMax > 0 ? dMax : 1.0);
   double merit = meritAt(pb, x, w), bestRes = kInf;
   int uphill = 0;
+  bool damped = false;
+  double fullBest = merit;
+  Vector fullBestX = x;
   Vector bestX = x;
   const double start = nowSeconds();
   std::ostringstream os;
@@ -298,19 +341,48 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
       os << "time budget spent after " << rep.steps << " block steps";
       break;
     }
-    if (rep.steps > 0) guess(pb, x, false);
+    if (rep.steps > 0) {
+      if (damped)
+        guess(pb, x, false);
+      else
+        setsAt(pb, x, w);
+    }
     ++rep.steps;
     xOld = x;
     wOld = w;
     std::string why;
-    const double rho = regularization * std::min(1.0, std::sqrt(merit));
+    const double rho = damped ? regularization * std::min(1.0, std::sqrt(merit)) : 0.0;
     if (!solveClamped(pb, x, xOld, rho, why)) {
+      if (!damped) {  // a singular block: the proximal term regularizes it
+        x = fullBestX;
+        w = *a_ * x + pb.b;
+        merit = fullBest;
+        damped = true;
+        continue;
+      }
       os << why << " (block step " << rep.steps << ")";
       x = bestX;
       break;
     }
     wNew.noalias() = *a_ * x;
     wNew += pb.b;
+    if (!damped) {
+      // Block principal pivoting: full steps; the merit may rise for a step or two.
+      w = wNew;
+      merit = meritAt(pb, x, w);
+      if (merit < fullBest) {
+        fullBest = merit;
+        fullBestX = x;
+        uphill = 0;
+      } else if (++uphill > kUphill) {  // no new best: damped steps from the best point
+        x = fullBestX;
+        w = *a_ * x + pb.b;
+        merit = fullBest;
+        uphill = 0;
+        damped = true;
+      }
+      continue;
+    }
     const Vector dx = x - xOld;
     double alpha = 1, trial = kInf;
     for (; alpha >= kMinStep; alpha *= 0.5) {

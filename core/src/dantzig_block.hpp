@@ -37,6 +37,7 @@ class BlockPivoting {
   bool factorClamped(double rho, std::string& why);
   bool factorCoupled(double rho, std::string& why);
   void applySolve(Vector& y) const;
+  int setsAt(const Problem& pb, const Vector& x, const Vector& w);
   double meritAt(const Problem& pb, const Vector& x, const Vector& w) const;
   double frictionBound(const Problem& pb, int t, Set s, const Vector& x) const;
 
@@ -54,7 +55,7 @@ class BlockPivoting {
   std::vector<Eigen::Triplet<double>> triplets_;
   ColMajor Kfull_;  // all of K (sliding rows substituted), for lu_
   Eigen::SparseLU<ColMajor, Eigen::NaturalOrdering<int>> lu_;
-  double pivTol_ = 0;
+  double eps_ = 0, pivTol_ = 0;
 };
 
 }  // namespace mlcp::detail

@@ -76,27 +76,33 @@
 // fixed, as the natural map at the current x says; a friction row at a bound is the linear
 // equation x_t = mu_t s_j x_j coupling it to its normal j (s_j the normal's sign), so findex is
 // exact without fixed-point passes, and friction rows whose normal is held at 0 are fixed at 0.
-// One step solves those equations with a proximal term rho (x_C - x_C,prev) on the clamped rows
+// One step solves those equations. Without sliding rows A_CC is factored by a sparse LDL^T
+// (SimplicialLDLT in a fill-reducing AMD order of the whole A, computed once per pattern of A and
+// inherited by every clamped block); sliding rows (at a bound, normal clamped) are substituted,
+// which makes the matrix nonsymmetric with A_CC's pattern, factored by a sparse LU in the same
+// order. One step of iterative refinement follows. First the steps are full (block principal
+// pivoting; the next sets change only rows violated beyond 0.01 tolerance (1 + |b|), so that
+// degenerate rows do not flip on rounding). When 3 full steps in a row bring no new lowest merit
+// ||H||^2 (or a block is singular), the stage goes back to the best point and continues damped:
+// sets from the natural map at x, a proximal term rho (x_C - x_C,prev) on the clamped rows
 // (rho = 1e-2 max|A_ii| min(1, ||H||): coplanar contacts make clamped blocks nearly singular, and
-// far from the answer their exact equations throw the null-space part far away). Without sliding
-// rows A_CC + rho I is factored by a sparse LDL^T (SimplicialLDLT in a fill-reducing AMD order of
-// the whole A, computed once per pattern of A and inherited by every clamped block); sliding rows
-// (at a bound, normal clamped) are substituted, which makes the matrix nonsymmetric with A_CC's
-// pattern, factored by a sparse LU in the same order. One step of iterative refinement follows.
-// The step towards that point is shortened by backtracking until ||H||^2 decreases (Armijo);
-// when no step length descends (a kink) the full step is taken up to 2 times in a row. Warm
-// starts take the first sets from the natural map at the guess; cold starts clamp every row. The
-// stage ends when the residual (residual.hpp) is within Options::tolerance (then it is the
-// answer, projected onto the bounds when that keeps it within tolerance: Result::iterations
-// counts its steps), or after DantzigParams::maxBlockSteps, no descent, a singular block or the
-// time budget: then the best iterate is handed to the incremental pivoting below as its warm
-// start, so the result is never worse than without the stage. Measured on the Bullet adapter's
-// 55-box pyramid (n = 1160, warm start from the cached impulses, globalCfm 1e-5): full steps
-// alone diverge (residual 0.2 -> 25 in 4 steps) and the hand-over cost 1.2 s of pivoting; the
-// damped steps reach residual ~1e-3 in 40 steps (~1.6 ms each) and the total is ~120-160 ms
-// On synthetic box
-// pyramids a warm start settles in 1-2 full steps (55 boxes, n = 1200: about 8 ms per step
-// including assembly); from a cold start Auto does not use the stage.
+// far from the answer their exact equations throw the null-space part far away), and the step
+// shortened by backtracking until ||H||^2 decreases (Armijo); at a kink where no step length
+// descends the full step is taken up to 2 times in a row. Warm starts take the first sets from
+// the natural map at the guess; cold starts clamp every row. The stage ends when the residual
+// (residual.hpp) is within Options::tolerance (then it is the answer, projected onto the bounds
+// when that keeps it within tolerance: Result::iterations counts its steps), or after
+// DantzigParams::maxBlockSteps, no descent, a singular damped block or the time budget: then the
+// best iterate is handed to the incremental pivoting below as its warm start.
+// Measured (CPU time, captured islands, tests/bench/core_bench.cpp with MLCP_BENCH_ISLANDS):
+// Bullet adapter's 55-box pyramid (n = 1160, warm start from the cached impulses, globalCfm
+// 1e-5): full steps alone diverge (residual 0.2 -> 25 in 4 steps) and the hand-over cost 0.7-0.85
+// s of pivoting; the damped steps reach residual ~1e-3 in 40 steps (~1.6 ms each), total 80-115
+// ms. ODE 6-base pile (n = 432): full steps settle in 1-2 steps cold (~1.2 ms) and 7-8 warm
+// (~9 ms), against ~10-12 ms for the incremental pivoting (Auto leaves the stage off there: A
+// holds 14% nonzeros). Synthetic box pyramids: a warm start settles in 1-2 full steps (55 boxes,
+// n = 1200: about 8 ms per step including assembly); from a cold start Auto does not use the
+// stage.
 //
 // Result::iterations counts pivots (direction computations: each row added or exchanged)
 // summed over all passes; Options::maxPivots (0: 50 n + 100) limits them per pass
