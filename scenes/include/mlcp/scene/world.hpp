@@ -74,6 +74,9 @@ struct StepMeasures {
   // Worst status over islands, mlcp::toString names ("converged", "max-iterations", ...).
   std::string status = "converged";
   int fallbacks = 0;
+  // Which solver answered each island, counted: e.g. "dantzig:3 ldlt:1 none:2" (islands with
+  // no rows are "none"); "" when the engine does not say (stock solvers).
+  std::string choice;
   int contacts = 0;           // contact points this step
   double maxPenetration = 0;  // deepest contact of this step (before integration), m, >= 0
   double jointError = 0;      // m, see above
@@ -99,6 +102,16 @@ class World {
   virtual std::vector<BodyState> states() const = 0;
   // "bullet" or "ode".
   virtual const char* engine() const = 0;
+
+  // Asks the engine to write, during the next step(), each island's MLCP as an mlcp-problem/1
+  // file in `folder` (named <scene>-<engine>-step<N>-island<K>.json). Returns false when this
+  // engine/solver cannot (stock solvers): nothing is written then. The files written are
+  // listed by capturedFiles() after that step.
+  virtual bool captureNextStep(const std::string& folder) {
+    (void)folder;
+    return false;
+  }
+  virtual std::vector<std::string> capturedFiles() const { return {}; }
 
  protected:
   // Advances the engine by one step and fills the engine's measures (solver time, residual,
