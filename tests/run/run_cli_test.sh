@@ -6,13 +6,13 @@ mlcp=$1 scenes=$2
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 source "$(dirname "${BASH_SOURCE[0]}")/../cli/check.sh"
-header='scene,engine,solver,step,solver_ms,step_ms,residual,iterations,status,fallbacks,max_penetration,joint_error,energy,momentum,max_speed'
+header='scene,engine,solver,step,solver_ms,step_ms,residual,iterations,status,fallbacks,choice,contacts,max_penetration,joint_error,energy,momentum,max_speed'
 csv_ok() {  # csv_ok NAME FILE ROWS ENGINE SOLVER
   local name=$1 file=$2 rows=$3 engine=$4 solver=$5
   if [ "$(head -1 "$file")" = "$header" ] && [ "$(($(wc -l < "$file") - 1))" -eq "$rows" ] &&
      awk -F, -v e="$engine" -v s="$solver" -v n="$rows" '
-       NR > 1 { if ($1 != "stack_10" || $2 != e || $3 != s || $4 != NR - 2 || NF != 15) bad = 1
-                for (i = 5; i <= 15; ++i) if (i != 9 && i != 7 && $i !~ /^-?[0-9.e+-]+$/) bad = 1 }
+       NR > 1 { if ($1 != "stack_10" || $2 != e || $3 != s || $4 != NR - 2 || NF != 17) bad = 1
+                for (i = 5; i <= 17; ++i) if (i != 9 && i != 7 && i != 11 && $i !~ /^-?[0-9.e+-]+$/) bad = 1 }
        END { exit bad || NR != n + 1 }' "$file"; then
     passed=$((passed + 1))
   else

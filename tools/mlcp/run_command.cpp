@@ -10,12 +10,7 @@
 #include "commands.hpp"
 #include "mlcp/scene/scene.hpp"
 #include "mlcp/scene/world.hpp"
-#ifdef MLCP_HAVE_BULLET
-#include "mlcp/bullet/scene_loader.hpp"
-#endif
-#ifdef MLCP_HAVE_ODE
-#include "mlcp/ode/scene_loader.hpp"
-#endif
+#include "scene_runs.hpp"
 
 namespace mlcp::cli {
 
@@ -33,34 +28,6 @@ struct RunArgs {
   double fallbackResidual = -1;
   std::string csv;
 };
-
-const char* kHeader =
-    "scene,engine,solver,step,solver_ms,step_ms,residual,iterations,status,fallbacks,"
-    "max_penetration,joint_error,energy,momentum,max_speed";
-
-std::string engines() {
-  std::string s;
-#ifdef MLCP_HAVE_BULLET
-  s += "bullet";
-#endif
-#ifdef MLCP_HAVE_ODE
-  s += s.empty() ? "ode" : ", ode";
-#endif
-  return s.empty() ? "none (built without engine adapters)" : s;
-}
-
-std::unique_ptr<scene::World> makeWorld(const std::string& engine, const scene::Scene& s,
-                                        const scene::RunSettings& run) {
-#ifdef MLCP_HAVE_BULLET
-  if (engine == "bullet") return bullet::loadWorld(s, run);
-#endif
-#ifdef MLCP_HAVE_ODE
-  if (engine == "ode") return ode::loadWorld(s, run);
-#endif
-  (void)s;
-  (void)run;
-  throw std::invalid_argument("unknown engine '" + engine + "' (known: " + engines() + ")");
-}
 
 int runScene(const RunArgs& args) {
   scene::Scene s;
@@ -93,45 +60,25 @@ int runScene(const RunArgs& args) {
       std::cerr << "mlcp run: cannot write " << args.csv << "\n";
       return kInvalidInput;
     }
-    csv << kHeader << "\n" << std::setprecision(9);
+    csv << kStepCsvHeader << "\n" << std::setprecision(9);
   }
 
-  double solverMs = 0, stepMs = 0, worstResidual = 0, deepest = 0, jointError = 0;
-  int fallbacks = 0, unconverged = 0, done = 0;
-  bool finite = true;
-  for (int i = 0; i < steps && finite; ++i) {
-    world->step();
-    const scene::StepMeasures& m = world->last();
-    if (csv.is_open())
-      csv << s.name << ',' << world->engine() << ',' << run.solver << ',' << i << ',' << m.solverMs
-          << ',' << m.stepMs << ',' << m.residual << ',' << m.iterations << ',' << m.status << ','
-          << m.fallbacks << ',' << m.maxPenetration << ',' << m.jointError << ',' << m.energy << ','
-          << m.momentum << ',' << m.maxSpeed << "\n";
-    solverMs += m.solverMs;
-    stepMs += m.stepMs;
-    if (!(m.residual <= worstResidual)) worstResidual = m.residual;  // NaN-propagating max
-    deepest = std::max(deepest, m.maxPenetration);
-    jointError = std::max(jointError, m.jointError);
-    fallbacks += m.fallbacks;
-    if (m.status != "converged") ++unconverged;
-    finite = scene::isFinite(world->states());
-    ++done;
-  }
-
-  const double n = std::max(done, 1);
-  std::cout << s.name << " in " << world->engine() << " with " << run.solver << ": " << done
+  const RunSummary sum = runWorld(*world, steps, [&](const scene::World& w, int i) {
+    if (csv.is_open()) writeStepCsv(csv, w, run.solver, i);
+  });
+  std::cout << s.name << " in " << world->engine() << " with " << run.solver << ": " << sum.steps
             << " steps of " << s.settings.timeStep << " s, " << s.dynamicBodyCount()
             << " dynamic bodies, " << s.joints.size() << " joints\n"
-            << "  step " << stepMs / n << " ms, solver " << solverMs / n
-            << " ms (means); worst residual " << worstResidual << ", " << unconverged
-            << " steps not converged, " << fallbacks << " fallbacks\n"
-            << "  max penetration " << deepest << " m, max joint error " << jointError
-            << " m; energy " << world->last().energy << " J, max speed " << world->last().maxSpeed
-            << " m/s\n";
+            << "  step " << sum.meanStepMs << " ms, solver " << sum.meanSolverMs
+            << " ms (means); worst residual " << sum.worstResidual << ", " << sum.unconverged
+            << " steps not converged, " << sum.fallbacks << " fallbacks\n"
+            << "  max penetration " << sum.maxPenetration << " m, max joint error "
+            << sum.maxJointError << " m; energy " << world->last().energy << " J, max speed "
+            << world->last().maxSpeed << " m/s\n";
   if (!args.csv.empty()) std::cout << "  wrote " << args.csv << "\n";
-  if (!finite) {
-    std::cerr << "mlcp run: the simulation blew up (non-finite body state) at step " << done - 1
-              << "\n";
+  if (!sum.finite) {
+    std::cerr << "mlcp run: the simulation blew up (non-finite body state) at step "
+              << sum.steps - 1 << "\n";
     return kNotSolved;
   }
   return kSolved;
@@ -145,11 +92,11 @@ Runner addRunCommand(CLI::App& app) {
       "run",
       "Step a scene file (mlcp-scene/1) in an engine and write one CSV row of measures per "
       "step: " +
-          std::string(kHeader) +
+          std::string(kStepCsvHeader) +
           ". Exit 0: all steps ran; 1: the simulation blew up (non-finite state); 2: bad "
           "scene file, engine or solver.");
   cmd->add_option("scene", args->scene, "scene file (.json, mlcp-scene/1)")->required();
-  cmd->add_option("--engine", args->engine, "engine: " + engines())->required();
+  cmd->add_option("--engine", args->engine, "engine: " + engineNames())->required();
   cmd->add_option("--solver", args->solver,
                   "a core solver name (through our adapters) or a stock one: bullet-si, "
                   "bullet-nncg, bullet-mlcp-pgs, bullet-mlcp-dantzig, bullet-mlcp-lemke, "

@@ -1,0 +1,51 @@
+// Scene runs shared by the scene commands (run, sweep, stability, diff): a world in the engine
+// asked for, stepped N times, with the per-step CSV row and the run's summary computed once.
+#pragma once
+
+#include <functional>
+#include <iosfwd>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mlcp/scene/scene.hpp"
+#include "mlcp/scene/world.hpp"
+
+namespace mlcp::cli {
+
+// Engines this build can run ("bullet, ode"), for help texts and errors.
+std::string engineNames();
+std::vector<std::string> engineList();
+
+// The scene loaded into `engine`; throws std::invalid_argument for an unknown engine or solver
+// (the message lists the valid names).
+std::unique_ptr<scene::World> makeWorld(const std::string& engine, const scene::Scene& s,
+                                        const scene::RunSettings& run);
+
+// The per-step CSV columns of `mlcp run` (see mlcp/scene/world.hpp for each measure).
+extern const char* const kStepCsvHeader;
+// One CSV row for the world's last step; `solver` is the name the run was asked for.
+void writeStepCsv(std::ostream& out, const scene::World& world, const std::string& solver,
+                  int step);
+
+// A run's summary over its steps.
+struct RunSummary {
+  int steps = 0;            // steps taken
+  double meanSolverMs = 0;  // means over the steps taken
+  double meanStepMs = 0;
+  double worstResidual = 0;   // NaN when any step's residual was not measured
+  double maxPenetration = 0;  // m
+  double maxJointError = 0;   // m
+  double maxSpeed = 0;        // m/s, over all steps
+  int fallbacks = 0;          // summed
+  int unconverged = 0;        // steps whose status is not "converged"
+  int failedSteps = 0;        // steps with a failed / numerical-issue / unsupported status
+  bool finite = true;         // false: the body states became non-finite (the run stopped)
+};
+
+// Steps `world` up to `steps` times (stops early once a body state is non-finite), calling
+// onStep(world, i) after each step. Returns the summary.
+RunSummary runWorld(scene::World& world, int steps,
+                    const std::function<void(const scene::World&, int)>& onStep = {});
+
+}  // namespace mlcp::cli
