@@ -49,16 +49,17 @@ import statistics
 import sys
 from collections import OrderedDict, defaultdict
 
-import matplotlib
-
-matplotlib.use("Agg")  # headless: CI has no display
-# pyplot and friends are imported by load_pyplot() once the input has been checked: they take
-# a second or two to load, which a bad file should not have to wait for.
+# matplotlib is imported by load_pyplot() once the input has been checked: it takes a second
+# or two to load, which a bad file should not have to wait for; and tools/report.py imports
+# this module's CSV reading with the standard library only.
 plt = ListedColormap = Line2D = Patch = FuncFormatter = LogLocator = NullFormatter = None
 
 
 def load_pyplot():
     global plt, ListedColormap, Line2D, Patch, FuncFormatter, LogLocator, NullFormatter
+    import matplotlib
+
+    matplotlib.use("Agg")  # headless: CI has no display
     import matplotlib.pyplot as plt
     from matplotlib.colors import ListedColormap
     from matplotlib.lines import Line2D

@@ -1,0 +1,85 @@
+#!/usr/bin/env bash
+# `mlcp sweep` and `mlcp chart` as a user runs them: the tidy CSV's header, rows and columns;
+# stock solvers that ignore the swept setting run once; exit 2 with a clear message on bad
+# arguments; charts drawn from the sweep when the venv exists. Prints "N passed, N failed".
+#   sweep_cli_test.sh MLCP SCENES_DIR REPO
+set -u
+mlcp=$1 scenes=$2 repo=$3
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+source "$(dirname "${BASH_SOURCE[0]}")/../cli/check.sh"
+header='setting,value,setting_applies,scene,engine,solver,step,solver_ms,step_ms,residual,iterations,status,fallbacks,choice,contacts,max_penetration,joint_error,energy,momentum,max_speed'
+engines=$("$mlcp" sweep --help | sed -n 's/.*all built: \([a-z, ]*\)).*/\1/p' | head -1 | tr -d ' ')
+n_engines=$(tr ',' '\n' <<< "$engines" | grep -c .)
+
+# sweep_ok NAME FILE ROWS AWK_CHECK: header, row count, 20 fields per row, numeric columns, and
+# an awk condition on each row ($1 setting, $2 value, $3 applies, $5 engine, $6 solver, $7 step).
+sweep_ok() {
+  local name=$1 file=$2 rows=$3 cond=$4
+  if [ "$(head -1 "$file")" = "$header" ] &&
+     awk -F, -v n="$rows" '
+       NR > 1 { if (NF != 20 || $4 != "resting_box" || !('"$cond"')) bad = 1
+                for (i = 8; i <= 20; ++i) if (i != 12 && i != 14 && $i !~ /^-?([0-9.e+-]+|nan)$/) bad = 1 }
+       END { exit bad || NR != n + 1 }' "$file"; then
+    passed=$((passed + 1))
+  else
+    failed=$((failed + 1))
+    echo "FAIL $name: $file ($(($(wc -l < "$file") - 1)) rows, want $rows):"; head -3 "$file" | sed 's/^/    /'
+  fi
+}
+
+# 2 solvers x 2 values x 3 steps in every engine built.
+check sweep-runs 0 "wrote $tmp/a.csv: $((4 * n_engines)) runs, $((12 * n_engines)) rows" -- \
+  "$mlcp" sweep "$scenes/resting_box.json" --solvers pgs,dantzig --setting iterations \
+  --values 5,10 --steps 3 --csv "$tmp/a.csv"
+sweep_ok sweep-csv "$tmp/a.csv" $((12 * n_engines)) \
+  '$1 == "iterations" && ($2 == 5 || $2 == 10) && $3 == 1 && ($6 == "pgs" || $6 == "dantzig") && $7 >= 0 && $7 <= 2'
+# Each (engine, solver, value) has steps 0, 1, 2.
+if [ "$(cut -d, -f2,5,6,7 "$tmp/a.csv" | sort -u | wc -l)" -eq $((12 * n_engines + 1)) ]; then
+  passed=$((passed + 1))
+else
+  failed=$((failed + 1)); echo "FAIL sweep-distinct: repeated (value, engine, solver, step) rows"
+fi
+
+if [ "$engines" = "bullet,ode" ]; then
+  # Stock solvers ignore the tolerance: one run each, marked; the other engine's are skipped.
+  check sweep-stock-skipped 0 'skipped \(not a solver of that engine\): bullet-si in ode, ode-world in bullet' -- \
+    "$mlcp" sweep "$scenes/resting_box.json" --solvers bullet-si,ode-world --setting tolerance \
+    --values 1e-3,1e-6 --steps 3 --csv "$tmp/b.csv"
+  sweep_ok sweep-stock-csv "$tmp/b.csv" 6 '$1 == "tolerance" && $2 == 0.001 && $3 == 0'
+  # ode-quick takes the iteration count: one run per value.
+  check sweep-stock-iterations 0 "wrote $tmp/c.csv: 2 runs, 4 rows" -- \
+    "$mlcp" sweep "$scenes/resting_box.json" --solvers ode-quick --values 3,7 --steps 2 --csv "$tmp/c.csv"
+fi
+
+bad() {  # bad NAME PATTERN sweep-arguments...
+  local name=$1 pattern=$2; shift 2
+  check "$name" 2 "$pattern" -- "$mlcp" sweep "$scenes/resting_box.json" --steps 1 --csv "$tmp/bad.csv" "$@"
+}
+bad unknown-solver "unknown solver 'nosuch'" --solvers pgs,nosuch --values 5
+bad unknown-engine "unknown engine 'physx'" --engines physx --values 5
+bad unknown-setting "--setting: .*relaxation" --setting relaxation --values 5
+bad empty-values "--values: an empty value" --values ""
+bad fractional-iterations "'2.5' is not a whole number of iterations" --values 5,2.5
+bad negative-tolerance "'-1e-6' is not a positive tolerance" --setting tolerance --values -1e-6
+bad missing-values "--values is required" --solvers pgs
+check missing-scene 2 'nope.json' -- "$mlcp" sweep "$tmp/nope.json" --values 5 --csv "$tmp/bad.csv"
+
+# mlcp chart: a clear message without Python; bad CSVs pass through as exit 2; charts drawn.
+check chart-no-python 1 'run tools/setup.sh' -- env MLCP_PYTHON="$tmp/no-python" \
+  "$mlcp" chart work-precision "$tmp/a.csv" -o "$tmp/charts"
+check chart-no-mode 2 'give a mode' -- "$mlcp" chart
+if [ -x "$repo/.venv/bin/python" ]; then
+  check chart-work-precision 0 "resting_box.png" -- \
+    "$mlcp" chart work-precision "$tmp/a.csv" -o "$tmp/charts"
+  for f in "$tmp/charts/resting_box.png" "$tmp/charts/resting_box.svg"; do
+    if [ -s "$f" ]; then passed=$((passed + 1)); else failed=$((failed + 1)); echo "FAIL chart-file: $f missing"; fi
+  done
+  printf 'scene,engine\nx,y\n' > "$tmp/bad-sweep.csv"
+  check chart-bad-csv 2 'missing column\(s\) solver' -- \
+    "$mlcp" chart work-precision "$tmp/bad-sweep.csv" -o "$tmp/charts"
+else
+  echo "SKIP chart drawing: $repo/.venv/bin/python is missing (run tools/setup.sh)"
+fi
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]

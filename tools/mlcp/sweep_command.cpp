@@ -1,0 +1,288 @@
+// mlcp sweep SCENES... --engines E --solvers S --setting iterations|tolerance --values V,...:
+// every scene x engine x solver x value of one solver setting, stepped through the shared run
+// loop (scene_runs.hpp) into one tidy CSV, one row per step. tools/chart.py reads it.
+//
+// Design notes
+// - A combination that cannot exist (a stock solver of the other engine: bullet-* in ODE,
+//   ode-* in Bullet) is skipped and listed once on stderr. A name no engine knows is an error.
+// - A stock solver that ignores the swept setting runs ONCE, at the first value, and its rows
+//   say setting_applies = 0: repeating an identical run per value would only measure timer
+//   noise and cost time. What the stock solvers ignore (see the engine loaders):
+//     tolerance   every stock solver (bullet-*, ode-*): none has a tolerance; the value only
+//                 decides whether the scene loader labels a stock MLCP step "converged"
+//     iterations  ode-world (dWorldStep's pivoting has no iteration count); bullet-si/-nncg,
+//                 ode-quick and bullet-mlcp-* use it (btMLCPSolver's PGS and its SI fallback)
+//   Core solvers (through our adapters) take both settings and run at every value.
+// - A run that blows up (non-finite body state) keeps its rows up to and including the step
+//   that blew up; the sweep goes on and exits 1 at the end, listing those runs.
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "commands.hpp"
+#include "mlcp/scene/scene.hpp"
+#include "mlcp/scene/world.hpp"
+#include "progress.hpp"
+#include "scene_runs.hpp"
+
+namespace mlcp::cli {
+
+namespace {
+
+const char* const kSweepColumns = "setting,value,setting_applies,";
+
+struct SweepArgs {
+  std::vector<std::string> scenes;
+  std::vector<std::string> engines;
+  std::vector<std::string> solvers{"pgs", "dantzig", "auto", "bullet-si", "ode-quick"};
+  std::string setting = "iterations";
+  std::vector<std::string> values;
+  int steps = -1;  // -1: each scene's settings.steps
+  bool noWarmStart = false;
+  std::string fallback = "pgs";
+  std::string csv;
+};
+
+bool isStock(const std::string& solver) {
+  return solver.rfind("bullet-", 0) == 0 || solver.rfind("ode-", 0) == 0;
+}
+
+bool settingApplies(const std::string& solver, const std::string& setting) {
+  if (!isStock(solver)) return true;
+  return setting == "iterations" && solver != "ode-world";
+}
+
+// The values as numbers: iterations are whole and >= 1, tolerances > 0.
+bool parseValues(const SweepArgs& args, std::vector<double>& out, std::string& error) {
+  for (const std::string& text : args.values) {
+    if (text.empty()) {
+      error = "--values: an empty value (give e.g. --values 5,10,20)";
+      return false;
+    }
+    std::size_t used = 0;
+    double v = std::nan("");
+    try {
+      v = std::stod(text, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    const bool whole = std::isfinite(v) && v == std::floor(v) && v >= 1 && v <= 1e9;
+    if (used == 0 || used != text.size() || !std::isfinite(v) ||
+        (args.setting == "iterations" ? !whole : v <= 0)) {
+      error = "--values: '" + text + "' is not " +
+              (args.setting == "iterations" ? "a whole number of iterations >= 1"
+                                            : "a positive tolerance");
+      return false;
+    }
+    out.push_back(v);
+  }
+  if (out.empty()) error = "--values: give at least one value (e.g. --values 5,10,20)";
+  return !out.empty();
+}
+
+std::string fmtValue(double v) {
+  std::ostringstream s;
+  s << std::setprecision(6) << v;
+  return s.str();
+}
+
+std::string minutes(double s) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%d:%02d", static_cast<int>(s) / 60, static_cast<int>(s) % 60);
+  return buf;
+}
+
+scene::RunSettings runSettings(const SweepArgs& args, const scene::Scene& s,
+                               const std::string& solver) {
+  scene::RunSettings run = scene::RunSettings::fromScene(s);
+  run.solver = solver;
+  run.warmStart = !args.noWarmStart;
+  run.fallback = args.fallback == "none" ? "" : args.fallback;
+  return run;
+}
+
+struct Combo {
+  std::size_t scene;
+  std::string engine, solver;
+  double value;
+  bool applies;
+};
+
+int runSweep(const SweepArgs& args) {
+  const std::string me = "mlcp sweep: ";
+  std::vector<double> values;
+  std::string error;
+  if (!parseValues(args, values, error)) {
+    std::cerr << me << error << "\n";
+    return kInvalidInput;
+  }
+  const std::vector<std::string> known = engineList();
+  const std::vector<std::string> engines = args.engines.empty() ? known : args.engines;
+  for (const std::string& e : engines)
+    if (std::find(known.begin(), known.end(), e) == known.end()) {
+      std::cerr << me << "unknown engine '" << e << "' (known: " << engineNames() << ")\n";
+      return kInvalidInput;
+    }
+  if (args.solvers.empty()) {
+    std::cerr << me << "--solvers: give at least one solver\n";
+    return kInvalidInput;
+  }
+  std::vector<scene::Scene> scenes;
+  for (const std::string& path : args.scenes) {
+    try {
+      scenes.push_back(scene::loadScene(path));
+    } catch (const scene::FormatError& e) {
+      std::cerr << me << e.what() << "\n";
+      return kInvalidInput;
+    }
+  }
+
+  // Which engine takes which solver, asked of the engines themselves on the smallest scene.
+  const scene::Scene& probe = *std::min_element(scenes.begin(), scenes.end(),
+                                                [](const scene::Scene& a, const scene::Scene& b) {
+                                                  return a.bodies.size() < b.bodies.size();
+                                                });
+  std::vector<std::pair<std::string, std::string>> runnable;  // (engine, solver)
+  std::string skipped;
+  for (const std::string& solver : args.solvers) {
+    std::string lastError;
+    bool anywhere = false;
+    for (const std::string& engine : engines) {
+      scene::RunSettings run = runSettings(args, probe, solver);
+      try {
+        makeWorld(engine, probe, run);
+        runnable.emplace_back(engine, solver);
+        anywhere = true;
+      } catch (const std::invalid_argument& e) {
+        lastError = e.what();
+        skipped += (skipped.empty() ? "" : ", ") + solver + " in " + engine;
+      }
+    }
+    if (!anywhere) {
+      std::cerr << me << lastError << "\n";
+      return kInvalidInput;
+    }
+  }
+  if (!skipped.empty())
+    std::cerr << me << "skipped (not a solver of that engine): " << skipped << "\n";
+
+  std::vector<Combo> combos;
+  for (std::size_t s = 0; s < scenes.size(); ++s)
+    for (const std::string& engine : engines)
+      for (const auto& [e, solver] : runnable) {
+        if (e != engine) continue;
+        const bool applies = settingApplies(solver, args.setting);
+        for (std::size_t k = 0; k < (applies ? values.size() : 1); ++k)
+          combos.push_back({s, engine, solver, values[k], applies});
+      }
+
+  std::ofstream csv(args.csv);
+  if (!csv) {
+    std::cerr << me << "cannot write " << args.csv << "\n";
+    return kInvalidInput;
+  }
+  csv << kSweepColumns << kStepCsvHeader << "\n" << std::setprecision(9);
+
+  const bool tty = isatty(fileno(stderr)) != 0;
+  // On a terminal the bar redraws in place; elsewhere (CI, logs) one line per combination.
+  Progress bar("sweep", static_cast<int>(combos.size()), !tty);
+  std::vector<std::string> blownUp;
+  std::size_t rows = 0;
+  for (std::size_t c = 0; c < combos.size(); ++c) {
+    const Combo& combo = combos[c];
+    const scene::Scene& sc = scenes[combo.scene];
+    scene::RunSettings run = runSettings(args, sc, combo.solver);
+    if (args.setting == "iterations")
+      run.iterations = static_cast<int>(combo.value);
+    else
+      run.tolerance = combo.value;
+    const int steps = args.steps >= 0 ? args.steps : sc.settings.steps;
+    const std::string label = sc.name + " " + combo.engine + " " + combo.solver + " " +
+                              args.setting + "=" +
+                              (combo.applies ? fmtValue(combo.value) : "(ignored)");
+    const std::string prefix =
+        args.setting + "," + fmtValue(combo.value) + "," + (combo.applies ? "1" : "0") + ",";
+    bar.start(label);
+    auto world = makeWorld(combo.engine, sc, run);  // the pair was checked above
+    auto lastDraw = std::chrono::steady_clock::now();
+    const RunSummary sum = runWorld(*world, steps, [&](const scene::World& w, int i) {
+      csv << prefix;
+      writeStepCsv(csv, w, combo.solver, i);
+      const auto now = std::chrono::steady_clock::now();
+      if (tty && now - lastDraw > std::chrono::milliseconds(200)) {
+        bar.start(label + " step " + std::to_string(i + 1) + "/" + std::to_string(steps));
+        lastDraw = now;
+      }
+    });
+    csv.flush();
+    rows += sum.steps;
+    if (!sum.finite) blownUp.push_back(label + " at step " + std::to_string(sum.steps - 1));
+    bar.done();
+    if (!tty) {
+      const double s = bar.seconds();
+      const double eta = s / double(c + 1) * double(combos.size() - c - 1);
+      std::cerr << "sweep " << c + 1 << "/" << combos.size() << " " << label << ": " << sum.steps
+                << " steps, solver " << std::setprecision(3) << sum.meanSolverMs
+                << " ms/step, worst residual " << sum.worstResidual
+                << (sum.finite ? "" : ", BLEW UP") << " (" << minutes(s) << " elapsed, ETA "
+                << minutes(eta) << ")\n";
+    }
+  }
+  bar.finish();
+  std::cout << "wrote " << args.csv << ": " << combos.size() << " runs, " << rows << " rows in "
+            << std::fixed << std::setprecision(1) << bar.seconds() << " s\n";
+  if (!blownUp.empty()) {
+    std::cerr << me << blownUp.size() << " run(s) blew up (rows kept up to the blow-up):\n";
+    for (const std::string& b : blownUp) std::cerr << "  " << b << "\n";
+    return kNotSolved;
+  }
+  return kSolved;
+}
+
+}  // namespace
+
+Runner addSweepCommand(CLI::App& app) {
+  auto args = std::make_shared<SweepArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "sweep",
+      "Run scenes x engines x solvers x values of one solver setting and write one tidy CSV, "
+      "one row per step: " +
+          std::string(kSweepColumns) + kStepCsvHeader +
+          " (setting_applies 0: a stock solver that ignores the setting, run once at the first "
+          "value). Combinations that cannot exist (bullet-* in ODE, ode-* in Bullet) are "
+          "skipped. Progress on stderr. Exit 0: every run finished; 1: some run blew up "
+          "(its rows up to then are kept); 2: bad scene file, engine, solver, setting or "
+          "value.");
+  cmd->add_option("scenes", args->scenes, "scene files (.json, mlcp-scene/1)")->required();
+  cmd->add_option("--engines", args->engines, "engines (default: all built: " + engineNames() + ")")
+      ->delimiter(',');
+  cmd->add_option("--solvers", args->solvers,
+                  "core solver names and stock ones (bullet-si, bullet-nncg, bullet-mlcp-pgs, "
+                  "bullet-mlcp-dantzig, bullet-mlcp-lemke, ode-world, ode-quick)")
+      ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--setting", args->setting,
+                  "the swept setting: iterations (sweeps / outer iterations per solve) or "
+                  "tolerance (scaled residual)")
+      ->check(CLI::IsMember({"iterations", "tolerance"}))
+      ->capture_default_str();
+  cmd->add_option("--values", args->values, "values of the setting, e.g. 5,10,20,50 or 1e-3,1e-6")
+      ->delimiter(',')
+      ->required();
+  cmd->add_option("--steps", args->steps, "steps per run (default: each scene's settings.steps)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--no-warm-start", args->noWarmStart, "start every solve from zero");
+  cmd->add_option("--fallback", args->fallback,
+                  "core solver run when an answer is rejected, or none (default pgs)");
+  cmd->add_option("--csv", args->csv, "CSV file to write")->required();
+  return [args] { return runSweep(*args); };
+}
+
+}  // namespace mlcp::cli
