@@ -30,6 +30,29 @@ Problem boundsOnly(const RowSystem& s) {
   return p;
 }
 
+// Problem::validate's rules for b, bounds and findex as one predicate without copies: the fast
+// path of RowSystem::validate, called every step by the adapters. When it says no, the shell
+// below gives the message (Problem::validate stays the one statement of the rules' wording).
+bool boundsValid(const RowSystem& s) {
+  const int n = s.size();
+  const bool coupled = !s.findex.empty();
+  if (coupled && static_cast<int>(s.findex.size()) != n) return false;
+  for (int i = 0; i < n; ++i) {
+    const double lo = s.lo[i], hi = s.hi[i];
+    // !(lo <= hi) also catches NaN bounds.
+    if (!std::isfinite(s.b[i]) || !(lo <= hi) || lo == kInf || hi == -kInf) return false;
+    if (!coupled) continue;
+    const int f = s.findex[i];
+    if (f < 0) {
+      if (f != -1) return false;
+      continue;
+    }
+    if (f >= n || f == i || s.findex[f] >= 0) return false;
+    if (!(hi >= 0) || !std::isfinite(hi) || lo != -hi) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 std::string RowSystem::validate() const {
@@ -63,7 +86,8 @@ std::string RowSystem::validate() const {
       return os.str();
     }
   }
-  // Problem::validate checks b, bounds and findex; give it a matching identity-sized shell.
+  if (boundsValid(*this)) return "";
+  // Problem::validate checks b, bounds and findex and says what is wrong; give it a shell.
   Problem shell = boundsOnly(*this);
   shell.setA(SparseMatrix(n, n));
   return shell.validate();
@@ -121,6 +145,15 @@ Problem RowSystem::assemble(bool sparse) const {
   return p;
 }
 
+void RowPgs::slackFromVelocities(const Vector& x) {
+  const int n = static_cast<int>(packed_.size());
+  w_.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const PackedRow& p = packed_[i];
+    w_[i] = p.jA.dot(velocity_[p.a].v) + p.jB.dot(velocity_[p.b].v) + p.cfm * x[i] + p.rhs;
+  }
+}
+
 Result RowPgs::solve(const RowSystem& s, Vector& x) {
   const double t0 = nowSeconds();
   const Options& opt = options_;
@@ -137,28 +170,42 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
   }
   const int n = s.size();
   const int world = static_cast<int>(s.bodies.size());  // the zero-velocity slot
-  Vector xs = (opt.warmStart && x.size() == n && x.allFinite()) ? x : Vector::Zero(n);
+  // The input is valid: x is the iterate from here on (no copy).
+  if (!(opt.warmStart && x.size() == n && x.allFinite())) x.setZero(n);
   const double bNorm = n ? s.b.lpNorm<Eigen::Infinity>() : 0.0;
-  Accuracy last;           // accuracy of xs as it is after the last check
-  bool lastValid = false;  // whether xs is unchanged since
+  Accuracy last;           // accuracy of x as it is after the last check
+  bool lastValid = false;  // whether x is unchanged since
+  auto check = [&]() {
+    slackFromVelocities(x);
+    last = accuracy(x, w_, s.lo, s.hi, s.findex, bNorm);
+    lastValid = true;
+  };
   auto finish = [&]() {
-    if (!lastValid) last = accuracy(xs, s.slack(xs), s.lo, s.hi, s.findex, bNorm);
+    if (!lastValid) check();
     applyAccuracy(result, last, opt.tolerance);
-    x = std::move(xs);
     result.seconds = nowSeconds() - t0;
     return result;
   };
 
   packed_.resize(n);
+  velocity_.resize(world + 1);
+  for (BodyVelocity& v : velocity_) v.v.setZero();
+  // One side of a row: "the world" (-1) becomes the zero-velocity slot with zero blocks.
+  auto packSide = [&](int body, const Vector6& j, int& slot, Vector6& pj, Vector6& mj) {
+    slot = body >= 0 ? body : world;
+    if (body >= 0) {
+      pj = j;
+      mj = applyInverseMass(s.bodies[body], j);
+    } else {
+      pj.setZero();
+      mj.setZero();
+    }
+  };
   for (int i = 0; i < n; ++i) {
     const ConstraintRow& r = s.rows[i];
     PackedRow& p = packed_[i];
-    p.a = r.bodyA >= 0 ? r.bodyA : world;
-    p.b = r.bodyB >= 0 ? r.bodyB : world;
-    p.jA = r.bodyA >= 0 ? r.jA : Vector6::Zero();
-    p.jB = r.bodyB >= 0 ? r.jB : Vector6::Zero();
-    p.mA = r.bodyA >= 0 ? applyInverseMass(s.bodies[r.bodyA], r.jA) : Vector6::Zero();
-    p.mB = r.bodyB >= 0 ? applyInverseMass(s.bodies[r.bodyB], r.jB) : Vector6::Zero();
+    packSide(r.bodyA, r.jA, p.a, p.jA, p.mA);
+    packSide(r.bodyB, r.jB, p.b, p.jB, p.mB);
     p.cfm = s.cfm[i];
     p.rhs = s.b[i];
     p.lo = s.lo[i];
@@ -166,31 +213,38 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
     p.findex = s.findex.empty() ? -1 : s.findex[i];
     const double d = p.jA.dot(p.mA) + p.jB.dot(p.mB) + p.cfm;
     if (!(d > 0)) {
+      // velocity_ does not hold M^-1 J^T x yet: the final check uses the rows themselves.
+      packed_.resize(i);
       std::ostringstream os;
       os << "row " << i << " has A_ii = " << d << ": pgs needs a positive diagonal";
       result.status = Status::Failed;
       result.message = os.str();
+      last = accuracy(x, s.slack(x), s.lo, s.hi, s.findex, bNorm);
+      lastValid = true;
       return finish();
     }
     p.invDiag = 1.0 / d;
+    // v = M^-1 J^T x of the start.
+    if (const double xi = x[i]; xi != 0) {
+      velocity_[p.a].v += p.mA * xi;
+      velocity_[p.b].v += p.mB * xi;
+    }
   }
+  velocity_[world].v.setZero();  // the world never moves (its blocks are zero anyway)
 
-  velocity_.assign(world + 1, Vector6::Zero());
-  for (int i = 0; i < n; ++i) {
-    velocity_[packed_[i].a] += packed_[i].mA * xs[i];
-    velocity_[packed_[i].b] += packed_[i].mB * xs[i];
-  }
-  velocity_[world].setZero();  // the world never moves (its blocks are zero anyway)
   const double omega = opt.relaxation;
   detail::SweepMonitor monitor(opt, result);
   if (n == 0) {
     result.status = Status::Converged;
     result.message = "empty problem";
   }
+  double* xs = x.data();
   for (int sweep = 1; n > 0 && sweep <= opt.maxIterations; ++sweep) {
     for (int i = 0; i < n; ++i) {
       const PackedRow& p = packed_[i];
-      const double wi = p.jA.dot(velocity_[p.a]) + p.jB.dot(velocity_[p.b]) + p.cfm * xs[i] + p.rhs;
+      Vector6& va = velocity_[p.a].v;
+      Vector6& vb = velocity_[p.b].v;
+      const double wi = p.jA.dot(va) + p.jB.dot(vb) + p.cfm * xs[i] + p.rhs;
       double lo = p.lo, hi = p.hi;
       if (p.findex >= 0) {
         const double normal = std::abs(xs[p.findex]);
@@ -200,13 +254,12 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
       const double xi = std::clamp(xs[i] - omega * wi * p.invDiag, lo, hi);
       const double dx = xi - xs[i];
       xs[i] = xi;
-      velocity_[p.a] += p.mA * dx;
-      velocity_[p.b] += p.mB * dx;
+      va += p.mA * dx;
+      vb += p.mB * dx;
     }
     lastValid = false;
     if (!monitor.wantsCheck(sweep)) continue;
-    last = accuracy(xs, s.slack(xs), s.lo, s.hi, s.findex, bNorm);
-    lastValid = true;
+    check();
     if (monitor.stop(sweep, last)) break;
   }
   return finish();

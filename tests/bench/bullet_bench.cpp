@@ -15,9 +15,12 @@
 // previous size for pivoting methods) or measured to take more than 1 s is skipped.
 //
 //   bullet_bench [--steps N] [--warmup N] [--sizes 15,55,210] [--csv file]
+//   bullet_bench --pgs-vs-si [--sweeps 10,50] [--steps N]   (ours pgs / SI, stepped alternately)
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <fstream>
 #include <map>
 
@@ -36,9 +39,10 @@ class Timed : public btConstraintSolver {
   btScalar solveGroup(btCollisionObject** b, int nb, btPersistentManifold** m, int nm,
                       btTypedConstraint** c, int nc, const btContactSolverInfo& info,
                       btIDebugDraw* dd, btDispatcher* d) override {
-    const double t0 = mlcp::nowSeconds();
+    const double t0 = mlcp::nowSeconds(), c0 = cpuNow();
     const btScalar r = inner_->solveGroup(b, nb, m, nm, c, nc, info, dd, d);
     seconds += mlcp::nowSeconds() - t0;
+    cpuSeconds += cpuNow() - c0;
     return r;
   }
   void allSolved(const btContactSolverInfo& info, btIDebugDraw* dd) override {
@@ -48,6 +52,12 @@ class Timed : public btConstraintSolver {
   btConstraintSolverType getSolverType() const override { return inner_->getSolverType(); }
   btConstraintSolver* inner() { return inner_.get(); }
   double seconds = 0;
+  double cpuSeconds = 0;  // this thread's CPU time (robust to other processes' load)
+  static double cpuNow() {
+    timespec t;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return t.tv_sec + 1e-9 * t.tv_nsec;
+  }
 
  private:
   std::unique_ptr<btConstraintSolver> inner_;
@@ -121,6 +131,62 @@ Row run(const Config& cfg, int boxes, int warmup, int steps) {
   return row;
 }
 
+// Ours pgs against SI at the same sweep count (SI's m_numIterations = pgs sweeps; SI's early
+// stop, m_leastSquaresResidualThreshold = 0, needs an exactly zero residual and does not happen
+// here), on copies of the same pyramid stepped alternately so that machine noise hits both
+// alike. Time is the CPU time of whole solveGroup calls (Bullet's row setup, the solve, the
+// write-back; pgs includes its own residual check), median over the steps: on a shared machine
+// wall time mostly measures the other processes. The stock SI solver is timed; SI's residual
+// comes from a third copy running SI inside our drop-in ("si-stats"), untimed.
+struct Pair {
+  double siMs = NAN, pgsMs = NAN, siResidual = 0, pgsResidual = 0;
+  int rows = 0;
+};
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? NAN : v[v.size() / 2];
+}
+
+Pair pgsVersusSi(int boxes, int warmup, int steps, int sweeps) {
+  sc::World si, siStats, ours;
+  for (sc::World* w : {&si, &siStats, &ours}) {
+    w->info().m_globalCfm = 1e-5;
+    w->info().m_numIterations = sweeps;
+    sc::pyramid(*w, boxes);
+    w->step(warmup);
+  }
+  mlcp::bullet::Settings s;
+  s.cfm = mlcp::bullet::CfmModel::StockMlcp;
+  s.bulletIterations = true;
+  s.acceptResidual = INFINITY;
+  s.fallback = "";
+  si.setSolver(std::make_unique<Timed>(sc::makeBulletSolver("si")));
+  siStats.setSolver(sc::makeBulletSolver("si-stats", s));
+  ours.setSolver(std::make_unique<Timed>(sc::makeBulletSolver("pgs", s)));
+  auto* stats = static_cast<mlcp::bullet::ConstraintSolver*>(siStats.solver());
+  auto* timedSi = static_cast<Timed*>(si.solver());
+  auto* timedPgs = static_cast<Timed*>(ours.solver());
+  auto* pgs = static_cast<mlcp::bullet::ConstraintSolver*>(timedPgs->inner());
+  Pair out;
+  std::vector<double> tSi, tPgs;
+  for (int k = 0; k < steps; ++k) {
+    double before = timedSi->cpuSeconds;
+    si.step();
+    tSi.push_back((timedSi->cpuSeconds - before) * 1e3);
+    before = timedPgs->cpuSeconds;
+    ours.step();
+    tPgs.push_back((timedPgs->cpuSeconds - before) * 1e3);
+    siStats.step();
+    out.siResidual = std::max(out.siResidual, stats->lastStep().residual);
+    out.pgsResidual = std::max(out.pgsResidual, pgs->lastStep().residual);
+    out.rows = pgs->lastStep().rows;
+  }
+  out.siMs = median(tSi);
+  out.pgsMs = median(tPgs);
+  return out;
+}
+
 std::vector<int> parseSizes(const std::string& s) {
   std::vector<int> out;
   std::size_t p = 0;
@@ -144,7 +210,25 @@ int main(int argc, char** argv) {
   app.add_option("--sizes", sizes, "pyramid sizes (triangular numbers)")->capture_default_str();
   app.add_option("--csv", csvPath, "also write the table as CSV");
   app.add_option("--only", only, "run only configurations whose label contains this");
+  bool pair = false;
+  std::string sweeps = "10,50";
+  app.add_flag("--pgs-vs-si", pair,
+               "only the table of ours pgs against SI at equal sweeps, stepped alternately");
+  app.add_option("--sweeps", sweeps, "sweep counts of --pgs-vs-si")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  if (pair) {
+    std::printf(
+        "| boxes | rows | sweeps | SI ms/step | ours pgs ms/step | pgs / SI | SI residual | "
+        "pgs residual |\n|---|---|---|---|---|---|---|---|\n");
+    for (int boxes : parseSizes(sizes))
+      for (int n : parseSizes(sweeps)) {
+        const Pair p = pgsVersusSi(boxes, warmup, steps, n);
+        std::printf("| %d | %d | %d | %.3f | %.3f | %.2fx | %.2e | %.2e |\n", boxes, p.rows, n,
+                    p.siMs, p.pgsMs, p.pgsMs / p.siMs, p.siResidual, p.pgsResidual);
+        std::fflush(stdout);
+      }
+    return 0;
+  }
 
   const std::vector<Config> configs = {
       {"SI (stock)", "si-stats", false},

@@ -114,6 +114,26 @@ TEST(RowPgs, WarmStartFromTheAnswerStopsAtOnce) {
   EXPECT_LE(again.iterations, 1);
 }
 
+// RowPgs checks its residual from the body velocities its sweeps maintain; that must be the
+// residual of its x on the assembled problem, at every sweep count (warm and cold).
+TEST(RowPgs, ReportedResidualIsTheAssembledProblemsResidual) {
+  const RowSystem s = stackRows(4, 7);
+  const Problem p = s.assemble(true);
+  RowPgs pgs;
+  for (int sweeps : {1, 3, 10, 200}) {
+    pgs.options().maxIterations = sweeps;
+    for (bool warm : {false, true}) {
+      pgs.options().warmStart = warm;
+      Vector x = Vector::Constant(s.size(), 0.25);
+      const Result r = pgs.solve(s, x);
+      const Accuracy a = accuracy(p, x);
+      EXPECT_NEAR(r.residual, a.residual, 1e-12 * (1 + a.residual)) << sweeps << " " << warm;
+      EXPECT_NEAR(r.complementarity, a.complementarity, 1e-12 * (1 + a.complementarity));
+      EXPECT_EQ(r.iterations, sweeps);
+    }
+  }
+}
+
 TEST(RowPgs, RejectsBadRows) {
   RowSystem s = stackRows(2, 4);
   s.rows[3].bodyA = 7;
