@@ -82,6 +82,13 @@ OUTCOMES = OrderedDict([  # outcome -> (colour, letter); colour-blind-safe-ish, 
 ENGINE_STYLE = {"bullet": ("-", "o"), "ode": ("--", "s")}
 OTHER_STYLES = [(":", "^"), ("-.", "D"), ((0, (5, 1)), "v")]
 LOG_FLOOR = 1e-17  # where zeros go on a log axis
+AXIS_NAMES = {  # setting name -> axis label with its unit (other names are shown as they are)
+    "time_step": "time step [s]",
+    "mass_ratio": "mass ratio (top / bottom box)",
+    "height": "stack height [boxes]",
+    "iterations": "iterations per solve",
+    "tolerance": "tolerance (scaled residual)",
+}
 
 
 class InputError(Exception):
@@ -195,6 +202,7 @@ def aggregate(path, rows, stat):
     for (scene, engine, solver, setting, value), members in groups.items():
         p = {"scene": scene, "engine": engine, "solver": solver, "setting": setting,
              "value": value, "steps": len(members),
+             "applies": any(r.get("setting_applies", "1").strip() != "0" for r in members),
              "failed": sum(r["status"].strip() in FAILED for r in members)}
         for column in ["solver_ms"] + [m[0] for m in METRICS]:
             vals = [number(path, r, column) for r in members]
@@ -215,56 +223,96 @@ def work_precision(args):
     return written
 
 
+def solver_order(solvers):
+    """Ours first (registry names), then the stock ones (bullet-*, ode-*), each alphabetical."""
+    return sorted(solvers, key=lambda s: (s.startswith(("bullet-", "ode-")), s))
+
+
+def value_labels(xy, every):
+    """(x, y, text) labels for a line's points: points that would overprint one another (within
+    ~6% on both log axes) share one label such as "5, 10"; with `every` False only the first
+    and last label of the line are kept."""
+    groups = []
+    for x, y, p in xy:
+        if groups and abs(math.log10(x / groups[-1][0])) < 0.025 and \
+                abs(math.log10(y / groups[-1][1])) < 0.025:
+            groups[-1][2].append(p["value"])
+        else:
+            groups.append([x, y, [p["value"]]])
+    if not every and len(groups) > 2:
+        groups = [groups[0], groups[-1]]
+    return [(x, y, ", ".join(fmt_value(v) for v in vals)) for x, y, vals in groups]
+
+
 def work_precision_chart(scene, points, stat, outdir):
     engines = sorted({p["engine"] for p in points})
-    solvers = sorted({p["solver"] for p in points})
+    solvers = solver_order({p["solver"] for p in points})
     several_settings = len({p["setting"] for p in points}) > 1
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     # The residual panel always; a side panel for each other metric that has something to show.
     metrics = [m for m in METRICS
                if m[0] == "residual" or any(math.isfinite(p[m[0]]) and p[m[0]] > 0
                                             for p in points)]
-    fig, axes = plt.subplots(1, len(metrics), figsize=(6.2 * len(metrics), 4.8), squeeze=False)
+    fig, axes = plt.subplots(1, len(metrics), figsize=(6.2 * len(metrics), 4.9), squeeze=False)
     axes = axes[0]
     lines = defaultdict(list)
     for p in points:
         lines[(p["engine"], p["solver"], p["setting"])].append(p)
-    many = len(lines) > 6 or max(len(v) for v in lines.values()) > 8
+    every_label = len(lines) <= 6
     clipped = False
-    for (engine, solver, setting), pts in sorted(lines.items()):
-        pts.sort(key=lambda p: p["value"])
+    legend = OrderedDict()  # label -> handle, over every panel (a line may miss some panels)
+    no_residual = set()
+    order = sorted(lines, key=lambda k: (solvers.index(k[1]), k[0], k[2]))
+    for rank, (engine, solver, setting) in enumerate(order):
+        pts = sorted(lines[(engine, solver, setting)], key=lambda p: p["value"])
         style, marker = engine_style(engine, engines)
         colour = colours[solvers.index(solver) % len(colours)]
-        label = f"{engine} / {solver}" + (f" ({setting})" if several_settings else "")
+        # Earlier lines get bigger markers, so that points on top of one another (auto choosing
+        # dantzig, say) show as rings instead of hiding each other.
+        size = 9 - 4 * rank / max(len(order) - 1, 1)
+        fixed = all(not p["applies"] for p in pts)
+        label = f"{engine} / {solver}"
+        if fixed:
+            label += f" (ignores {setting})"
+        elif len(pts) == 1:  # one point: its value goes in the legend, not next to it
+            label += f" ({setting} {fmt_value(pts[0]['value'])})"
+        elif several_settings:
+            label += f" ({setting})"
         for ax, (column, _, _) in zip(axes, metrics):
             xy = [(p["solver_ms"], p[column], p) for p in pts
                   if math.isfinite(p["solver_ms"]) and math.isfinite(p[column])]
             if not xy:
+                if column == "residual":
+                    no_residual.add(solver)
                 continue
             clipped |= any(x <= 0 or y <= 0 for x, y, _ in xy)
             xs = [max(x, LOG_FLOOR) for x, _, _ in xy]
             ys = [max(y, LOG_FLOOR) for _, y, _ in xy]
-            ax.plot(xs, ys, linestyle=style, color=colour, linewidth=1.4, marker=marker,
-                    markersize=6, label=label)
+            (handle,) = ax.plot(xs, ys, linestyle=style, color=colour, linewidth=1.4,
+                                marker=marker, markersize=size, label=label, zorder=2 + rank)
+            legend.setdefault(label, handle)
             for x, y, (_, _, p) in zip(xs, ys, xy):
                 if p["failed"]:
-                    ax.plot([x], [y], marker=marker, color=colour, markersize=6,
-                            markerfacecolor="white", linestyle="none")
-                if not many:
-                    ax.annotate(fmt_value(p["value"]), (x, y), textcoords="offset points",
-                                xytext=(5, 4), fontsize=7, color=colour)
+                    ax.plot([x], [y], marker=marker, color=colour, markersize=size,
+                            markerfacecolor="white", linestyle="none", zorder=2 + rank)
+            if fixed or len(pts) == 1:
+                continue
+            for x, y, text in value_labels(list(zip(xs, ys, (p for _, _, p in xy))),
+                                           every_label):
+                ax.annotate(text, (x, y), textcoords="offset points", xytext=(5, 4),
+                            fontsize=7, color=colour, zorder=30)
     steps = sorted({p["steps"] for p in points})
     for ax, (column, ylabel, title) in zip(axes, metrics):
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_xlabel(f"solver time per step [ms] ({stat})")
-        ax.set_ylabel(f"{ylabel} ({stat})")
+        ax.set_xlabel(f"solver time per step [ms] ({stat} over the steps)")
+        ax.set_ylabel(f"{ylabel}, {stat}")
         ax.set_title(title, fontsize=10)
         tidy_log_axis(ax.xaxis, *ax.get_xlim())
         tidy_log_axis(ax.yaxis, *ax.get_ylim())
         ax.grid(True, which="major", alpha=0.35)
         ax.grid(True, which="minor", alpha=0.12)
-    handles, labels = axes[0].get_legend_handles_labels()
+    handles, labels = list(legend.values()), list(legend)
     if any(p["failed"] for p in points):
         handles.append(Line2D([], [], marker="o", color="grey", markerfacecolor="white",
                               linestyle="none"))
@@ -274,11 +322,14 @@ def work_precision_chart(scene, points, stat, outdir):
     settings = sorted({p["setting"] for p in points})
     note = (f"{stat} over {steps[0] if len(steps) == 1 else f'{steps[0]}-{steps[-1]}'} steps; "
             f"points labelled with {', '.join(settings)}; lower left is better")
+    if no_residual:
+        note += (f"\nno residual for {', '.join(solver_order(no_residual))} (stock iterative "
+                 "solvers do not expose their impulses): right-hand panels only")
     if clipped:
         note += f"; zeros drawn at {LOG_FLOOR:g}"
-    fig.suptitle(f"{scene}: work-precision", fontsize=13, fontweight="bold")
+    fig.suptitle(f"{scene}: solver time against accuracy", fontsize=13, fontweight="bold")
     fig.text(0.5, 0.005, note, ha="center", va="bottom", fontsize=8, color="dimgrey")
-    fig.tight_layout(rect=(0, 0.03, 1, 0.97))
+    fig.tight_layout(rect=(0, 0.06 if no_residual else 0.035, 1, 0.97))
     return save(fig, outdir, safe_name(scene))
 
 
@@ -306,16 +357,22 @@ def heatmap(args):
 
 
 def heatmap_chart(scene, x_name, y_name, cells, outdir, stem):
-    panels = sorted({(c["engine"], c["solver"]) for c in cells})
     xs = sorted({c["x"] for c in cells})
     ys = sorted({c["y"] for c in cells})
-    engines = sorted({e for e, _ in panels})
-    solvers = sorted({s for _, s in panels})
-    if len(panels) == len(engines) * len(solvers) and len(solvers) <= 4:
-        nrows, ncols = len(engines), len(solvers)  # engines down, solvers across
+    engines = sorted({c["engine"] for c in cells})
+    per_engine = [solver_order({c["solver"] for c in cells if c["engine"] == e}) for e in engines]
+    # One row per engine, its solvers across (ours first, in the same order in every row, so a
+    # solver's panels line up); a square grid when an engine has too many solvers for a row.
+    if max(len(s) for s in per_engine) <= 5:
+        nrows, ncols = len(engines), max(len(s) for s in per_engine)
+        slots = {(e, s): r * ncols + k for r, (e, ss) in enumerate(zip(engines, per_engine))
+                 for k, s in enumerate(ss)}
     else:
-        ncols = math.ceil(math.sqrt(len(panels)))
-        nrows = math.ceil(len(panels) / ncols)
+        flat = [(e, s) for e, ss in zip(engines, per_engine) for s in ss]
+        ncols = math.ceil(math.sqrt(len(flat)))
+        nrows = math.ceil(len(flat) / ncols)
+        slots = {panel: i for i, panel in enumerate(flat)}
+    panels = sorted(slots, key=slots.get)
     cw = max(3.2, 0.55 * len(xs) + 1.6)
     ch = max(2.6, 0.42 * len(ys) + 1.3)
     fig, axes = plt.subplots(nrows, ncols, figsize=(cw * ncols, ch * nrows + 0.9),
@@ -323,9 +380,11 @@ def heatmap_chart(scene, x_name, y_name, cells, outdir, stem):
     names = list(OUTCOMES)
     cmap = ListedColormap([OUTCOMES[n][0] for n in names])
     cmap.set_bad("#eeeeee")
-    for ax in axes.flat[len(panels):]:
-        ax.set_visible(False)
-    for ax, (engine, solver) in zip(axes.flat, panels):
+    used = set(slots.values())
+    for i, ax in enumerate(axes.flat):
+        ax.set_visible(i in used)
+    for engine, solver in panels:
+        ax = axes.flat[slots[(engine, solver)]]
         grid = [[math.nan] * len(xs) for _ in ys]
         for c in cells:
             if (c["engine"], c["solver"]) == (engine, solver):
@@ -341,15 +400,17 @@ def heatmap_chart(scene, x_name, y_name, cells, outdir, stem):
         ax.set_xticks(range(len(xs)), [fmt_value(x) for x in xs], rotation=45 if len(xs) > 6
                       else 0, fontsize=8)
         ax.set_yticks(range(len(ys)), [fmt_value(y) for y in ys], fontsize=8)
-        ax.set_xlabel(x_name)
-        ax.set_ylabel(y_name)
+        ax.set_xlabel(AXIS_NAMES.get(x_name, x_name))
+        ax.set_ylabel(AXIS_NAMES.get(y_name, y_name))
         ax.set_title(f"{engine} / {solver}", fontsize=10)
     legend = [Patch(facecolor=OUTCOMES[n][0], label=f"{OUTCOMES[n][1]}  {n}") for n in names]
     legend.append(Patch(facecolor="#eeeeee", label="   not run"))
     fig.legend(handles=legend, loc="lower center", ncol=len(legend), fontsize=8,
                frameon=False)
-    title = f"{scene}: stability" if scene else "stability"
-    fig.suptitle(f"{title} ({y_name} against {x_name})", fontsize=13, fontweight="bold")
+    title = f"{scene}: stability map" if scene else "Stability map"
+    fig.suptitle(f"{title}, {AXIS_NAMES.get(y_name, y_name).split(' [')[0]} against "
+                 f"{AXIS_NAMES.get(x_name, x_name).split(' [')[0]}", fontsize=13,
+                 fontweight="bold")
     fig.tight_layout(rect=(0, 0.07, 1, 0.95))
     return save(fig, outdir, stem)
 

@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
-# The main job: set-up, build, then every solver on the seed's worked example and the Siconos
-# LCP corpus, one line per (problem, solver).
+# The main job: set-up, build, then the comparison report (tools/report.sh): a few small scenes
+# in Bullet and ODE with stock and our solvers, work-precision charts per scene, the stability
+# map, the seed + Siconos solver table, summary.md and index.html. Prints where the report is.
+#   tools/main.sh [REPORT_DIR]     (default build/report)
 set -euo pipefail
 repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 "$repo/tools/setup.sh"
 "$repo/tools/build.sh" "$repo/build" > /dev/null
-siconos=${MLCP_SICONOS_DIR:-$repo/../shared/data/siconos}
-"$repo/build/bin/mlcp" table "$repo/tests/data/seed_lemke.json" "$repo/tests/data/spd.json" \
-  "$repo/tests/data/boxed.json" "$repo/tests/data/findex.json" "$siconos"/lcp/*.dat
+MLCP="$repo/build/bin/mlcp" "$repo/tools/report.sh" "${1:-$repo/build/report}"

@@ -52,6 +52,14 @@ if [ "$engines" = "bullet,ode" ]; then
     "$mlcp" sweep "$scenes/resting_box.json" --solvers ode-quick --values 3,7 --steps 2 --csv "$tmp/c.csv"
 fi
 
+# --append adds rows under the same header; a file of another kind is refused.
+check sweep-append 0 "appended to $tmp/a.csv: $((2 * n_engines)) runs" -- \
+  "$mlcp" sweep "$scenes/resting_box.json" --solvers pgs --values 7,8 --steps 3 --append --csv "$tmp/a.csv"
+sweep_ok sweep-append-csv "$tmp/a.csv" $((18 * n_engines)) '$3 == 1 && $7 <= 2'
+printf 'scene,engine\n' > "$tmp/other.csv"
+check sweep-append-other 2 "other.csv is not a sweep CSV" -- \
+  "$mlcp" sweep "$scenes/resting_box.json" --values 5 --steps 1 --append --csv "$tmp/other.csv"
+
 bad() {  # bad NAME PATTERN sweep-arguments...
   local name=$1 pattern=$2; shift 2
   check "$name" 2 "$pattern" -- "$mlcp" sweep "$scenes/resting_box.json" --steps 1 --csv "$tmp/bad.csv" "$@"

@@ -48,6 +48,7 @@ struct SweepArgs {
   bool noWarmStart = false;
   std::string fallback = "pgs";
   std::string csv;
+  bool append = false;
 };
 
 bool isStock(const std::string& solver) {
@@ -183,12 +184,27 @@ int runSweep(const SweepArgs& args) {
           combos.push_back({s, engine, solver, values[k], applies});
       }
 
-  std::ofstream csv(args.csv);
+  const std::string header = std::string(kSweepColumns) + kStepCsvHeader;
+  bool fresh = true;
+  if (args.append) {
+    std::ifstream old(args.csv);
+    std::string first;
+    if (old && std::getline(old, first)) {
+      if (first != header) {
+        std::cerr << me << "--append: " << args.csv
+                  << " is not a sweep CSV of this version (its header differs)\n";
+        return kInvalidInput;
+      }
+      fresh = false;
+    }
+  }
+  std::ofstream csv(args.csv, fresh ? std::ios::trunc : std::ios::app);
   if (!csv) {
     std::cerr << me << "cannot write " << args.csv << "\n";
     return kInvalidInput;
   }
-  csv << kSweepColumns << kStepCsvHeader << "\n" << std::setprecision(9);
+  if (fresh) csv << header << "\n";
+  csv << std::setprecision(9);
 
   const bool tty = isatty(fileno(stderr)) != 0;
   // On a terminal the bar redraws in place; elsewhere (CI, logs) one line per combination.
@@ -236,8 +252,8 @@ int runSweep(const SweepArgs& args) {
     }
   }
   bar.finish();
-  std::cout << "wrote " << args.csv << ": " << combos.size() << " runs, " << rows << " rows in "
-            << std::fixed << std::setprecision(1) << bar.seconds() << " s\n";
+  std::cout << (fresh ? "wrote " : "appended to ") << args.csv << ": " << combos.size() << " runs, "
+            << rows << " rows in " << std::fixed << std::setprecision(1) << bar.seconds() << " s\n";
   if (!blownUp.empty()) {
     std::cerr << me << blownUp.size() << " run(s) blew up (rows kept up to the blow-up):\n";
     for (const std::string& b : blownUp) std::cerr << "  " << b << "\n";
@@ -282,6 +298,9 @@ Runner addSweepCommand(CLI::App& app) {
   cmd->add_option("--fallback", args->fallback,
                   "core solver run when an answer is rejected, or none (default pgs)");
   cmd->add_option("--csv", args->csv, "CSV file to write")->required();
+  cmd->add_flag("--append", args->append,
+                "add the rows to an existing sweep CSV (e.g. a second sweep with other solvers "
+                "or values) instead of replacing it");
   return [args] { return runSweep(*args); };
 }
 

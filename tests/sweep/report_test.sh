@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# report_test.sh MLCP REPO OUT: the main job's report pipeline (tools/report.sh) in its quick mode
+# (MLCP_REPORT_QUICK=1: 2 scenes, 5 steps) writes every file of the report folder. Skips (exit
+# 77) when the chart venv is missing; tools/setup.sh builds it.
+set -euo pipefail
+mlcp=$1 repo=$2 out=$3
+if [ ! -x "$repo/.venv/bin/python" ]; then
+  echo "SKIP: $repo/.venv/bin/python is missing; run tools/setup.sh to build the chart venv"
+  exit 77
+fi
+fail() { echo "FAIL: $*"; exit 1; }
+rm -rf "$out"
+MLCP="$mlcp" MLCP_REPORT_QUICK=1 "$repo/tools/report.sh" "$out" > "$out.log" 2>&1 ||
+  { cat "$out.log"; fail "tools/report.sh exited non-zero"; }
+grep -q "report: $out/index.html" "$out.log" || fail "the report's place is not printed"
+for f in sweep.csv summary.md index.html charts/stack_10.png charts/stack_10.svg \
+         charts/pendulum_chain.png charts/pendulum_chain.svg; do
+  [ -s "$out/$f" ] || fail "$out/$f is missing or empty"
+done
+# The sweep: 2 scenes, 5 steps each run; both scenes have a summary table and a chart on the page.
+[ "$(awk -F, 'NR > 1 && $7 == 4' "$out/sweep.csv" | wc -l)" -gt 0 ] || fail "no step 4 rows in sweep.csv"
+for s in stack_10 pendulum_chain; do
+  grep -q "^## $s" "$out/summary.md" || fail "summary.md has no table for $s"
+  grep -q "src='charts/$s.png'" "$out/index.html" || fail "index.html does not show charts/$s.png"
+done
+grep -q "^| engine | solver | iterations |" "$out/summary.md" || fail "summary.md lacks the table header"
+if grep -qE '^ +stability' <<< "$("$mlcp" --help)"; then
+  [ -s "$out/stability.csv" ] || fail "stability.csv is missing"
+  ls "$out"/stability/*.png > /dev/null 2>&1 || fail "no stability heat map"
+  grep -q "src='stability/" "$out/index.html" || fail "index.html does not show the stability map"
+fi
+echo "report_test: ok"

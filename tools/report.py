@@ -1,0 +1,300 @@
+#!/usr/bin/env python3
+"""The report folder's summary.md and index.html, from what tools/report.sh put there.
+
+Usage: python3 tools/report.py REPORT_DIR [--note TEXT]...   (standard library only)
+
+Reads from REPORT_DIR:
+  sweep.csv           `mlcp sweep` rows (columns: see tools/chart.py); required
+  charts/*.png|svg    work-precision charts (`mlcp chart work-precision`), one per scene
+  stability.csv       `mlcp stability` cells, and stability/*.png|svg heat maps; optional
+  table.md            `mlcp table --markdown` on the seed and Siconos problems; optional
+Writes summary.md (Markdown) and index.html (charts and tables), and prints their paths.
+
+summary.md has one table per scene, one row per engine + solver, taken at the sweep's most
+accurate value (the largest iteration count or the smallest tolerance; a stock solver that
+ignores the setting has its one run): mean solver time per step, worst residual, max
+penetration and joint error, fallbacks, steps by status, and which solvers answered. A run
+that blew up (non-finite state) at any value of the sweep is flagged.
+"""
+
+import argparse
+import html
+import math
+import os
+import re
+import sys
+from collections import Counter, OrderedDict, defaultdict
+
+from chart import SWEEP_COLUMNS, InputError, read_rows
+
+STATUS_SHORT = OrderedDict([("converged", "conv"), ("max-iterations", "max-it"),
+                            ("time-limit", "time"), ("failed", "FAILED"),
+                            ("numerical-issue", "NUMERICAL"), ("unsupported", "UNSUPPORTED"),
+                            ("invalid-input", "INVALID")])
+
+
+def num(text):
+    try:
+        return float(text)
+    except ValueError:
+        return math.nan
+
+
+def fmt(v, digits=2):
+    if v is None or (isinstance(v, float) and math.isnan(v)):
+        return "—"
+    if v == 0:
+        return "0"
+    if abs(v) >= 1000 or abs(v) < 0.01:
+        return f"{v:.{digits - 1}e}".replace("e-0", "e-").replace("e+0", "e")
+    return f"{v:.{digits + 1}g}"
+
+
+def finite_max(values):
+    vals = [v for v in values if math.isfinite(v)]
+    return max(vals) if vals else math.nan
+
+
+def summarise(rows):
+    """scene -> list of row dicts for the summary tables, and the sweep's setting text."""
+    runs = defaultdict(list)  # (scene, engine, solver, value) -> rows
+    for r in rows:
+        runs[(r["scene"], r["engine"], r["solver"], num(r["value"]))].append(r)
+    settings = sorted({r["setting"] for r in rows})
+    setting = settings[0] if len(settings) == 1 else "/".join(settings)
+    smaller_is_accurate = setting == "tolerance"
+    max_steps = defaultdict(int)
+    for (scene, _, _, _), members in runs.items():
+        max_steps[scene] = max(max_steps[scene], len(members))
+
+    by_solver = defaultdict(dict)  # (scene, engine, solver) -> value -> rows
+    for (scene, engine, solver, value), members in runs.items():
+        by_solver[(scene, engine, solver)][value] = members
+    tables = defaultdict(list)
+    for (scene, engine, solver), per_value in sorted(by_solver.items()):
+        values = sorted(per_value)
+        ref = values[0] if smaller_is_accurate else values[-1]
+        members = per_value[ref]
+        applies = members[0].get("setting_applies", "1").strip() != "0"
+        statuses = Counter(r["status"].strip() for r in members)
+        answered = Counter()
+        for r in members:
+            for token in (r.get("choice") or "").split():
+                name, _, count = token.rpartition(":")
+                if name and name != "none":
+                    answered[name] += int(num(count)) if math.isfinite(num(count)) else 1
+        blew = []
+        for v in values:
+            ms = per_value[v]
+            bad = any(not math.isfinite(num(r.get("max_speed", "0"))) for r in ms)
+            if bad or len(ms) < max_steps[scene]:
+                blew.append(f"{fmt_value(v)} (step {len(ms) - 1})")
+        residuals = [num(r["residual"]) for r in members]
+        tables[scene].append({
+            "engine": engine, "solver": solver,
+            "value": fmt_value(ref) if applies else "ignored",
+            "steps": len(members),
+            "ms": sum(num(r["solver_ms"]) for r in members) / len(members),
+            "residual": (math.nan if all(math.isnan(x) for x in residuals)
+                         else max((x for x in residuals if not math.isnan(x)))),
+            "penetration": finite_max(num(r["max_penetration"]) for r in members),
+            "joint": finite_max(num(r["joint_error"]) for r in members),
+            "fallbacks": sum(int(num(r["fallbacks"])) for r in members
+                             if math.isfinite(num(r["fallbacks"]))),
+            "statuses": ", ".join(f"{STATUS_SHORT.get(s, s)} {n}"
+                                  for s, n in sorted(statuses.items(),
+                                                     key=lambda kv: list(STATUS_SHORT).index(kv[0])
+                                                     if kv[0] in STATUS_SHORT else 99)),
+            "answered": ", ".join(f"{n} {c}" for n, c in answered.most_common(3)),
+            "blew_up": ", ".join(blew),
+        })
+    return tables, setting
+
+
+def fmt_value(v):
+    return format(v, "g")
+
+
+COLUMNS = [  # (key, header, formatter)
+    ("engine", "engine", str),
+    ("solver", "solver", str),
+    ("value", "{setting}", str),
+    ("steps", "steps", str),
+    ("ms", "solver ms/step (mean)", fmt),
+    ("residual", "worst residual", fmt),
+    ("penetration", "max penetration [m]", fmt),
+    ("joint", "max joint error [m]", fmt),
+    ("fallbacks", "fallbacks", str),
+    ("statuses", "steps by status", str),
+    ("answered", "islands answered by", str),
+    ("blew_up", "blew up at", str),
+]
+
+INTRO = ("Each row: one scene run in one engine with one solver at the sweep's most accurate "
+         "{setting} (largest iteration count / smallest tolerance; `ignored`: a stock solver "
+         "that does not use it, run once). Residual: scaled natural-map residual of the "
+         "step's MLCP (— : not measured, stock iterative solvers do not expose their "
+         "impulses). *blew up at*: {setting} values at which the state became non-finite.")
+
+
+def markdown_summary(tables, setting, notes):
+    lines = ["# mlcp comparison: summary", ""]
+    lines += [f"- {n}" for n in notes] + ([""] if notes else [])
+    lines += [INTRO.format(setting=setting), ""]
+    for scene, rows in tables.items():
+        lines += [f"## {scene}", ""]
+        lines.append("| " + " | ".join(h.format(setting=setting) for _, h, _ in COLUMNS) + " |")
+        lines.append("|" + "---|" * len(COLUMNS))
+        for row in rows:
+            lines.append("| " + " | ".join(f(row[k]) for k, _, f in COLUMNS) + " |")
+        lines.append("")
+    return "\n".join(lines)
+
+
+# ----------------------------------------------------------------------------------------------
+# HTML
+
+
+def html_table(header, rows, numeric=()):
+    out = ["<table>", "<thead><tr>" + "".join(f"<th>{html.escape(h)}</th>" for h in header)
+           + "</tr></thead>", "<tbody>"]
+    for row in rows:
+        cells = []
+        for i, c in enumerate(row):
+            cls = ' class="num"' if i in numeric else ""
+            text = html.escape(c)
+            text = re.sub(r"\*\*(.+?)\*\*", r"<strong>\1</strong>", text)
+            if re.search(r"FAILED|NUMERICAL|UNSUPPORTED|INVALID", c) or (
+                    header[i] == "blew up at" and c):
+                cls = ' class="bad"'
+            cells.append(f"<td{cls}>{text}</td>")
+        out.append("<tr>" + "".join(cells) + "</tr>")
+    out += ["</tbody>", "</table>"]
+    return "\n".join(out)
+
+
+def markdown_to_html(text):
+    """The pipe tables, bullet lists and paragraphs `mlcp table --markdown` prints."""
+    out, table, items = [], [], []
+
+    def flush():
+        if table:
+            header = [c.strip() for c in table[0].strip("|").split("|")]
+            body = [[c.strip() for c in line.strip().strip("|").split("|")]
+                    for line in table[2:]]
+            out.append(html_table(header, body, numeric=range(1, len(header))))
+            table.clear()
+        if items:
+            out.append("<ul>" + "".join(f"<li>{html.escape(i)}</li>" for i in items) + "</ul>")
+            items.clear()
+
+    for line in text.splitlines():
+        if line.startswith("|"):
+            table.append(line)
+        elif line.startswith("- "):
+            items.append(line[2:])
+        else:
+            flush()
+            if line.strip():
+                out.append(f"<p>{html.escape(line)}</p>")
+    flush()
+    return "\n".join(out)
+
+
+CSS = """
+body { font-family: system-ui, sans-serif; margin: 2em auto; max-width: 1400px; color: #222;
+       padding: 0 1em; }
+h1 { margin-bottom: 0.2em; } h2 { margin-top: 2em; border-bottom: 1px solid #ccc; }
+table { border-collapse: collapse; font-size: 0.85em; margin: 0.5em 0 1.5em; }
+th, td { border: 1px solid #ddd; padding: 3px 8px; text-align: left; }
+th { background: #f3f3f3; } td.num { text-align: right; font-variant-numeric: tabular-nums; }
+td.bad { background: #fde2e1; } tr:hover td { background: #f7f9ff; }
+img { max-width: 100%; border: 1px solid #eee; margin: 0.5em 0 1.5em; }
+.note { color: #555; font-size: 0.9em; } nav a { margin-right: 1em; }
+"""
+
+
+def figures(out_dir, sub):
+    folder = os.path.join(out_dir, sub)
+    if not os.path.isdir(folder):
+        return []
+    return sorted(f[:-4] for f in os.listdir(folder) if f.endswith(".png"))
+
+
+def index_html(out_dir, tables, setting, notes):
+    parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>mlcp comparison</title>"
+             f"<style>{CSS}</style></head><body>", "<h1>mlcp comparison report</h1>"]
+    parts += [f"<p class='note'>{html.escape(n)}</p>" for n in notes]
+    charts = figures(out_dir, "charts")
+    stability = figures(out_dir, "stability")
+    has_table = os.path.exists(os.path.join(out_dir, "table.md"))
+    nav = [("summary", "Summary"), ("charts", "Work-precision charts")]
+    nav += [("stability", "Stability map")] + ([("siconos", "Siconos table")] if has_table else [])
+    parts.append("<nav>" + "".join(f"<a href='#{a}'>{t}</a>" for a, t in nav) + "</nav>")
+
+    parts.append("<h2 id='summary'>Summary</h2>")
+    parts.append(f"<p class='note'>{html.escape(INTRO.format(setting=setting))} "
+                 "Also as <a href='summary.md'>summary.md</a>; every step is in "
+                 "<a href='sweep.csv'>sweep.csv</a>.</p>")
+    header = [h.format(setting=setting) for _, h, _ in COLUMNS]
+    numeric = [i for i, (k, _, _) in enumerate(COLUMNS)
+               if k in ("steps", "ms", "residual", "penetration", "joint", "fallbacks")]
+    for scene, rows in tables.items():
+        parts.append(f"<h3>{html.escape(scene)}</h3>")
+        parts.append(html_table(header, [[f(r[k]) for k, _, f in COLUMNS] for r in rows],
+                                numeric))
+
+    parts.append("<h2 id='charts'>Work-precision charts</h2>")
+    parts.append("<p class='note'>One chart per scene: x = mean solver time per step, "
+                 "y = mean residual (left) and penetration / joint drift (right); one line per "
+                 f"engine + solver through the {html.escape(setting)} values; lower left is "
+                 "better. Click a chart for its SVG.</p>")
+    for stem in charts:
+        parts.append(f"<h3>{html.escape(stem)}</h3><a href='charts/{stem}.svg'>"
+                     f"<img src='charts/{stem}.png' alt='{html.escape(stem)}'></a>")
+
+    parts.append("<h2 id='stability'>Stability map</h2>")
+    if stability:
+        parts.append("<p class='note'>Cells in <a href='stability.csv'>stability.csv</a>; "
+                     "thresholds in <code>mlcp stability --help</code>.</p>")
+        for stem in stability:
+            parts.append(f"<a href='stability/{stem}.svg'><img src='stability/{stem}.png' "
+                         f"alt='{html.escape(stem)}'></a>")
+    else:
+        parts.append("<p class='note'>Not in this report (no stability.csv: "
+                     "<code>mlcp stability</code> was not run).</p>")
+
+    if has_table:
+        parts.append("<h2 id='siconos'>Seed and Siconos problems</h2>")
+        with open(os.path.join(out_dir, "table.md")) as f:
+            parts.append(markdown_to_html(f.read()))
+    parts.append("</body></html>")
+    return "\n".join(parts)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description="summary.md and index.html of a report folder")
+    parser.add_argument("dir", help="report folder (holds sweep.csv, charts/, ...)")
+    parser.add_argument("--note", action="append", default=[],
+                        help="a line for the top of the report (repeatable)")
+    args = parser.parse_args(argv)
+    try:
+        tables, setting = summarise(read_rows(os.path.join(args.dir, "sweep.csv"),
+                                                SWEEP_COLUMNS))
+    except InputError as e:
+        print(f"report.py: {e}", file=sys.stderr)
+        return 2
+    written = []
+    for name, text in (("summary.md", markdown_summary(tables, setting, args.note)),
+                       ("index.html", index_html(args.dir, tables, setting, args.note))):
+        path = os.path.join(args.dir, name)
+        with open(path, "w") as f:
+            f.write(text + "\n")
+        written.append(path)
+    for p in written:
+        print(p)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
