@@ -3,6 +3,7 @@
 
 Usage (from the repository, after tools/setup.sh has built .venv):
   .venv/bin/python tools/chart.py work-precision SWEEP.csv -o OUTDIR [--stat mean|median|max]
+                                  [--time-stat median|mean|min]
   .venv/bin/python tools/chart.py heatmap STABILITY.csv -o OUTDIR
 
 Both write one PNG and one SVG per scene into OUTDIR and print their paths. A bad file stops
@@ -24,12 +25,14 @@ columns in any order, extra columns ignored):
   fallbacks        number of fallbacks taken in this step
   max_penetration  deepest contact penetration after the step, m
   joint_error      largest joint position error after the step, m
-Each point of a chart is one (scene, engine, solver, setting, value): the statistic (--stat,
-default mean) over its steps of solver_ms (x) and residual (y), plus max_penetration and
-joint_error in the side panels. One line per engine + solver (+ setting) runs through the
-setting's values, each point labelled with its value. Hollow markers: some steps failed
-(failed, unsupported, invalid-input or numerical-issue). Non-finite values are left out;
-zeros are drawn at the bottom of the log axis.
+  setting_applies  optional: 0 when the solver ignores the setting (a stock solver run once)
+Each point of a chart is one (scene, engine, solver, setting, value): over its steps, the
+--time-stat (default median: robust to the odd preempted step on a busy machine) of solver_ms
+(x) and the --stat (default mean) of residual (y), max_penetration and joint_error (side
+panels). One line per engine + solver (+ setting) runs through the setting's values, labelled
+with them (the ends only when there are many lines; a one-point line has its value in the
+legend). Hollow markers: some steps failed (failed, unsupported, invalid-input or
+numerical-issue). Non-finite values are left out; zeros are drawn at the bottom of the log axis.
 
 Stability CSV (`mlcp stability`; one row per cell):
   engine, solver   as above
@@ -190,8 +193,10 @@ METRICS = [  # (column, axis label, panel title)
 ]
 
 
-def aggregate(path, rows, stat):
-    reduce = {"mean": statistics.fmean, "median": statistics.median, "max": max}[stat]
+REDUCE = {"mean": statistics.fmean, "median": statistics.median, "max": max, "min": min}
+
+
+def aggregate(path, rows, stat, time_stat):
     groups = defaultdict(list)
     for row in rows:
         choice(path, row, "status", STATUSES, "status")
@@ -207,19 +212,20 @@ def aggregate(path, rows, stat):
         for column in ["solver_ms"] + [m[0] for m in METRICS]:
             vals = [number(path, r, column) for r in members]
             vals = [v for v in vals if math.isfinite(v)]
+            reduce = REDUCE[time_stat if column == "solver_ms" else stat]
             p[column] = reduce(vals) if vals else math.nan
         points.append(p)
     return points
 
 
 def work_precision(args):
-    points = aggregate(args.csv, read_rows(args.csv, SWEEP_COLUMNS), args.stat)
+    points = aggregate(args.csv, read_rows(args.csv, SWEEP_COLUMNS), args.stat, args.time_stat)
     load_pyplot()
     os.makedirs(args.out, exist_ok=True)
     written = []
     for scene in sorted({p["scene"] for p in points}):
         written += work_precision_chart(scene, [p for p in points if p["scene"] == scene],
-                                        args.stat, args.out)
+                                        args.stat, args.time_stat, args.out)
     return written
 
 
@@ -244,7 +250,7 @@ def value_labels(xy, every):
     return [(x, y, ", ".join(fmt_value(v) for v in vals)) for x, y, vals in groups]
 
 
-def work_precision_chart(scene, points, stat, outdir):
+def work_precision_chart(scene, points, stat, time_stat, outdir):
     engines = sorted({p["engine"] for p in points})
     solvers = solver_order({p["solver"] for p in points})
     several_settings = len({p["setting"] for p in points}) > 1
@@ -305,7 +311,7 @@ def work_precision_chart(scene, points, stat, outdir):
     for ax, (column, ylabel, title) in zip(axes, metrics):
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_xlabel(f"solver time per step [ms] ({stat} over the steps)")
+        ax.set_xlabel(f"solver time per step [ms], {time_stat}")
         ax.set_ylabel(f"{ylabel}, {stat}")
         ax.set_title(title, fontsize=10)
         tidy_log_axis(ax.xaxis, *ax.get_xlim())
@@ -320,7 +326,8 @@ def work_precision_chart(scene, points, stat, outdir):
     axes[-1].legend(handles, labels, fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1),
                     borderaxespad=0, title="engine / solver", title_fontsize=8, frameon=False)
     settings = sorted({p["setting"] for p in points})
-    note = (f"{stat} over {steps[0] if len(steps) == 1 else f'{steps[0]}-{steps[-1]}'} steps; "
+    note = (f"{time_stat} time and {stat} measures over "
+            f"{steps[0] if len(steps) == 1 else f'{steps[0]}-{steps[-1]}'} steps; "
             f"points labelled with {', '.join(settings)}; lower left is better")
     if no_residual:
         note += (f"\nno residual for {', '.join(solver_order(no_residual))} (stock iterative "
@@ -423,7 +430,11 @@ def main(argv=None):
     wp.add_argument("csv", help="tidy sweep CSV (mlcp sweep)")
     wp.add_argument("-o", "--out", required=True, help="folder for the PNG and SVG files")
     wp.add_argument("--stat", choices=["mean", "median", "max"], default="mean",
-                    help="statistic over the steps of each point (default: mean)")
+                    help="statistic over the steps of each point's residual, penetration and "
+                         "joint error (default: mean)")
+    wp.add_argument("--time-stat", choices=["median", "mean", "min"], default="median",
+                    help="statistic over the steps of each point's solver time (default: "
+                         "median)")
     hm = sub.add_parser("heatmap", help="stability grid outcomes")
     hm.add_argument("csv", help="stability CSV (mlcp stability)")
     hm.add_argument("-o", "--out", required=True, help="folder for the PNG and SVG files")

@@ -25,7 +25,7 @@ import re
 import sys
 from collections import Counter, OrderedDict, defaultdict
 
-from chart import SWEEP_COLUMNS, InputError, read_rows
+from chart import SWEEP_COLUMNS, InputError, read_rows, safe_name, solver_order
 
 STATUS_SHORT = OrderedDict([("converged", "conv"), ("max-iterations", "max-it"),
                             ("time-limit", "time"), ("failed", "FAILED"),
@@ -70,8 +70,13 @@ def summarise(rows):
     by_solver = defaultdict(dict)  # (scene, engine, solver) -> value -> rows
     for (scene, engine, solver, value), members in runs.items():
         by_solver[(scene, engine, solver)][value] = members
-    tables = defaultdict(list)
-    for (scene, engine, solver), per_value in sorted(by_solver.items()):
+    # Scenes in the sweep's order; per scene, engines alphabetical, our solvers before stock.
+    scenes = list(OrderedDict.fromkeys(r["scene"] for r in rows))
+    order = solver_order({k[2] for k in by_solver})
+    tables = OrderedDict((scene, []) for scene in scenes)
+    for (scene, engine, solver), per_value in sorted(
+            by_solver.items(), key=lambda kv: (scenes.index(kv[0][0]), kv[0][1],
+                                               order.index(kv[0][2]))):
         values = sorted(per_value)
         ref = values[0] if smaller_is_accurate else values[-1]
         members = per_value[ref]
@@ -134,7 +139,13 @@ INTRO = ("Each row: one scene run in one engine with one solver at the sweep's m
          "{setting} (largest iteration count / smallest tolerance; `ignored`: a stock solver "
          "that does not use it, run once). Residual: scaled natural-map residual of the "
          "step's MLCP (— : not measured, stock iterative solvers do not expose their "
-         "impulses). *blew up at*: {setting} values at which the state became non-finite.")
+         "impulses). *blew up at* (only when something did): {setting} values at which the state "
+         "became non-finite, and the step.")
+
+
+def columns(rows):
+    """COLUMNS, without "blew up at" when nothing blew up."""
+    return [c for c in COLUMNS if c[0] != "blew_up" or any(r["blew_up"] for r in rows)]
 
 
 def markdown_summary(tables, setting, notes):
@@ -143,10 +154,11 @@ def markdown_summary(tables, setting, notes):
     lines += [INTRO.format(setting=setting), ""]
     for scene, rows in tables.items():
         lines += [f"## {scene}", ""]
-        lines.append("| " + " | ".join(h.format(setting=setting) for _, h, _ in COLUMNS) + " |")
-        lines.append("|" + "---|" * len(COLUMNS))
+        cols = columns(rows)
+        lines.append("| " + " | ".join(h.format(setting=setting) for _, h, _ in cols) + " |")
+        lines.append("|" + "---|" * len(cols))
         for row in rows:
-            lines.append("| " + " | ".join(f(row[k]) for k, _, f in COLUMNS) + " |")
+            lines.append("| " + " | ".join(f(row[k]) for k, _, f in cols) + " |")
         lines.append("")
     return "\n".join(lines)
 
@@ -225,7 +237,9 @@ def index_html(out_dir, tables, setting, notes):
     parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>mlcp comparison</title>"
              f"<style>{CSS}</style></head><body>", "<h1>mlcp comparison report</h1>"]
     parts += [f"<p class='note'>{html.escape(n)}</p>" for n in notes]
-    charts = figures(out_dir, "charts")
+    found = figures(out_dir, "charts")
+    charts = [safe_name(s) for s in tables if safe_name(s) in found]
+    charts += [c for c in found if c not in charts]
     stability = figures(out_dir, "stability")
     has_table = os.path.exists(os.path.join(out_dir, "table.md"))
     nav = [("summary", "Summary"), ("charts", "Work-precision charts")]
@@ -236,12 +250,13 @@ def index_html(out_dir, tables, setting, notes):
     parts.append(f"<p class='note'>{html.escape(INTRO.format(setting=setting))} "
                  "Also as <a href='summary.md'>summary.md</a>; every step is in "
                  "<a href='sweep.csv'>sweep.csv</a>.</p>")
-    header = [h.format(setting=setting) for _, h, _ in COLUMNS]
-    numeric = [i for i, (k, _, _) in enumerate(COLUMNS)
-               if k in ("steps", "ms", "residual", "penetration", "joint", "fallbacks")]
     for scene, rows in tables.items():
+        cols = columns(rows)
+        header = [h.format(setting=setting) for _, h, _ in cols]
+        numeric = [i for i, (k, _, _) in enumerate(cols)
+                   if k in ("steps", "ms", "residual", "penetration", "joint", "fallbacks")]
         parts.append(f"<h3>{html.escape(scene)}</h3>")
-        parts.append(html_table(header, [[f(r[k]) for k, _, f in COLUMNS] for r in rows],
+        parts.append(html_table(header, [[f(r[k]) for k, _, f in cols] for r in rows],
                                 numeric))
 
     parts.append("<h2 id='charts'>Work-precision charts</h2>")
