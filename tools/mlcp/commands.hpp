@@ -17,6 +17,8 @@ Runner addSolveCommand(CLI::App& app);
 Runner addTableCommand(CLI::App& app);
 Runner addTraceCommand(CLI::App& app);
 Runner addRunCommand(CLI::App& app);
+Runner addStabilityCommand(CLI::App& app);
+Runner addDiffCommand(CLI::App& app);
 Runner addSweepCommand(CLI::App& app);
 Runner addChartCommand(CLI::App& app);
 

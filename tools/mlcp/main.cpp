@@ -19,6 +19,8 @@ int main(int argc, char** argv) {
   add(&mlcp::cli::addTableCommand);
   add(&mlcp::cli::addTraceCommand);
   add(&mlcp::cli::addRunCommand);
+  add(&mlcp::cli::addStabilityCommand);
+  add(&mlcp::cli::addDiffCommand);
   add(&mlcp::cli::addSweepCommand);
   add(&mlcp::cli::addChartCommand);
   try {

@@ -2,6 +2,7 @@
 // row of measures per step (see mlcp/scene/world.hpp for what each column means).
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -11,6 +12,7 @@
 #include "mlcp/scene/scene.hpp"
 #include "mlcp/scene/world.hpp"
 #include "scene_runs.hpp"
+#include "trajectory.hpp"
 
 namespace mlcp::cli {
 
@@ -27,6 +29,9 @@ struct RunArgs {
   std::string fallback = "pgs";
   double fallbackResidual = -1;
   std::string csv;
+  std::string trajectory;
+  int capture = -1;  // -1: no capture
+  std::string captureDir = ".";
 };
 
 int runScene(const RunArgs& args) {
@@ -63,8 +68,42 @@ int runScene(const RunArgs& args) {
     csv << kStepCsvHeader << "\n" << std::setprecision(9);
   }
 
+  std::ofstream trajectory;
+  if (!args.trajectory.empty()) {
+    trajectory.open(args.trajectory);
+    if (!trajectory) {
+      std::cerr << "mlcp run: cannot write " << args.trajectory << "\n";
+      return kInvalidInput;
+    }
+    trajectory << kTrajectoryCsvHeader << "\n" << std::setprecision(17);
+  }
+  if (args.capture >= 0) {
+    if (args.capture >= steps) {
+      std::cerr << "mlcp run: --capture " << args.capture << " is not one of the " << steps
+                << " steps run (0 to " << steps - 1 << ")\n";
+      return kInvalidInput;
+    }
+    std::error_code ec;
+    const bool existed = std::filesystem::is_directory(args.captureDir, ec);
+    std::filesystem::create_directories(args.captureDir, ec);
+    if (ec) {
+      std::cerr << "mlcp run: cannot create " << args.captureDir << ": " << ec.message() << "\n";
+      return kInvalidInput;
+    }
+    // Asked of an unstepped copy first, so that a world that cannot capture fails at once.
+    if (!makeWorld(args.engine, s, run)->captureNextStep(args.captureDir)) {
+      if (!existed) std::filesystem::remove(args.captureDir, ec);
+      std::cerr << "mlcp run: this engine/solver cannot capture (" << args.engine << " with "
+                << run.solver << ")\n";
+      return kInvalidInput;
+    }
+    if (args.capture == 0) world->captureNextStep(args.captureDir);
+  }
+
   const RunSummary sum = runWorld(*world, steps, [&](const scene::World& w, int i) {
     if (csv.is_open()) writeStepCsv(csv, w, run.solver, i);
+    if (trajectory.is_open()) writeTrajectoryCsv(trajectory, w, run.solver, i);
+    if (i + 1 == args.capture) world->captureNextStep(args.captureDir);
   });
   std::cout << s.name << " in " << world->engine() << " with " << run.solver << ": " << sum.steps
             << " steps of " << s.settings.timeStep << " s, " << s.dynamicBodyCount()
@@ -76,6 +115,13 @@ int runScene(const RunArgs& args) {
             << sum.maxJointError << " m; energy " << world->last().energy << " J, max speed "
             << world->last().maxSpeed << " m/s\n";
   if (!args.csv.empty()) std::cout << "  wrote " << args.csv << "\n";
+  if (!args.trajectory.empty()) std::cout << "  wrote " << args.trajectory << "\n";
+  if (args.capture >= 0 && args.capture < sum.steps) {
+    const std::vector<std::string> files = world->capturedFiles();
+    std::cout << "  captured step " << args.capture << ": " << files.size() << " problem file"
+              << (files.size() == 1 ? "" : "s") << " in " << args.captureDir << "\n";
+    for (const std::string& f : files) std::cout << "    " << f << "\n";
+  }
   if (!sum.finite) {
     std::cerr << "mlcp run: the simulation blew up (non-finite body state) at step "
               << sum.steps - 1 << "\n";
@@ -116,6 +162,17 @@ Runner addRunCommand(CLI::App& app) {
                   "scaled residual above which an answer is rejected (default 1e-3)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--csv", args->csv, "CSV file to write (one row per step)");
+  cmd->add_option("--trajectory", args->trajectory,
+                  "trajectory CSV to write, one row per step and dynamic body: " +
+                      std::string(kTrajectoryCsvHeader) + " (for mlcp diff)");
+  cmd->add_option("--capture", args->capture,
+                  "write each island's MLCP of this step (0-based) as mlcp-problem/1 files, "
+                  "which mlcp solve replays (our solvers only; exit 2 where the engine/solver "
+                  "cannot capture)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--capture-dir", args->captureDir,
+                  "folder for the --capture files (created if missing)")
+      ->capture_default_str();
   return [args] { return runScene(*args); };
 }
 

@@ -1,0 +1,148 @@
+#include "trajectory.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <ostream>
+#include <sstream>
+
+namespace mlcp::cli {
+
+const char* const kTrajectoryCsvHeader = "scene,engine,solver,step,body,x,y,z,qw,qx,qy,qz";
+
+void writeTrajectoryCsv(std::ostream& out, const scene::World& world, const std::string& solver,
+                        int step) {
+  const scene::Scene& s = world.scene();
+  const std::vector<scene::BodyState> states = world.states();
+  for (std::size_t i = 0; i < states.size(); ++i) {
+    if (s.bodies[i].isStatic()) continue;
+    const scene::BodyState& b = states[i];
+    out << s.name << ',' << world.engine() << ',' << solver << ',' << step << ','
+        << s.bodies[i].name << ',' << b.position[0] << ',' << b.position[1] << ',' << b.position[2]
+        << ',' << b.orientation.w << ',' << b.orientation.x << ',' << b.orientation.y << ','
+        << b.orientation.z << "\n";
+  }
+}
+
+void Trajectory::record(const scene::World& world, int step) {
+  const scene::Scene& s = world.scene();
+  const std::vector<scene::BodyState> states = world.states();
+  const bool first = steps.empty();
+  std::vector<Pose> row;
+  for (std::size_t i = 0; i < states.size(); ++i) {
+    if (s.bodies[i].isStatic()) continue;
+    if (first) bodies.push_back(s.bodies[i].name);
+    row.push_back({states[i].position, states[i].orientation});
+  }
+  steps.push_back(step);
+  lines.push_back(0);
+  poses.push_back(std::move(row));
+}
+
+namespace {
+
+std::vector<std::string> splitCsv(const std::string& line) {
+  std::vector<std::string> fields;
+  std::stringstream s(line);
+  std::string f;
+  while (std::getline(s, f, ',')) fields.push_back(f);
+  if (!line.empty() && line.back() == ',') fields.emplace_back();
+  return fields;
+}
+
+}  // namespace
+
+Trajectory readTrajectoryCsv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw scene::FormatError(path + ": cannot open");
+  Trajectory t;
+  t.source = path;
+  std::string line;
+  int lineNo = 0;
+  auto fail = [&](const std::string& what) {
+    throw scene::FormatError(path + ": line " + std::to_string(lineNo) + ": " + what);
+  };
+  if (!std::getline(in, line)) throw scene::FormatError(path + ": empty file");
+  ++lineNo;
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  if (line != kTrajectoryCsvHeader)
+    fail("expected the trajectory header '" + std::string(kTrajectoryCsvHeader) + "' (from mlcp " +
+         "run --trajectory), got '" + line + "'");
+  std::size_t bodyInStep = 0;
+  while (std::getline(in, line)) {
+    ++lineNo;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) continue;
+    const std::vector<std::string> f = splitCsv(line);
+    if (f.size() != 12) fail("expected 12 fields, got " + std::to_string(f.size()));
+    double v[7];  // x, y, z, qw, qx, qy, qz
+    for (int k = 0; k < 7; ++k) {
+      std::size_t used = 0;
+      try {
+        v[k] = std::stod(f[5 + k], &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == 0 || used != f[5 + k].size())
+        fail("column " + std::to_string(6 + k) + ": not a number: '" + f[5 + k] + "'");
+    }
+    int step = 0;
+    try {
+      std::size_t used = 0;
+      step = std::stoi(f[3], &used);
+      if (used != f[3].size() || step < 0) throw std::invalid_argument("step");
+    } catch (const std::exception&) {
+      fail("step: not a step index: '" + f[3] + "'");
+    }
+    const bool newStep = t.steps.empty() || step != t.steps.back();
+    if (newStep) {
+      if (!t.steps.empty() && step < t.steps.back())
+        fail("step " + std::to_string(step) + " after step " + std::to_string(t.steps.back()) +
+             " (steps must increase)");
+      if (!t.steps.empty() && bodyInStep != t.bodies.size())
+        fail("step " + std::to_string(t.steps.back()) + " (from line " +
+             std::to_string(t.lines.back()) + ") has " + std::to_string(bodyInStep) +
+             " bodies, the first step " + std::to_string(t.bodies.size()));
+      t.steps.push_back(step);
+      t.lines.push_back(lineNo);
+      t.poses.emplace_back();
+      bodyInStep = 0;
+    }
+    const std::string& body = f[4];
+    if (t.steps.size() == 1) {
+      for (const std::string& b : t.bodies)
+        if (b == body) fail("body '" + body + "' twice in step " + std::to_string(step));
+      t.bodies.push_back(body);
+    } else if (bodyInStep >= t.bodies.size() || t.bodies[bodyInStep] != body) {
+      fail("body '" + body + "' where the first step has " +
+           (bodyInStep < t.bodies.size() ? "'" + t.bodies[bodyInStep] + "'" : "no more bodies"));
+    }
+    ++bodyInStep;
+    t.poses.back().push_back({{v[0], v[1], v[2]}, {v[3], v[4], v[5], v[6]}});
+  }
+  if (t.steps.empty()) throw scene::FormatError(path + ": no data rows");
+  if (bodyInStep != t.bodies.size())
+    fail("the last step " + std::to_string(t.steps.back()) + " has " + std::to_string(bodyInStep) +
+         " bodies, the first step " + std::to_string(t.bodies.size()));
+  return t;
+}
+
+double positionDeviation(const Pose& a, const Pose& b) {
+  return std::hypot(a.position[0] - b.position[0], a.position[1] - b.position[1],
+                    a.position[2] - b.position[2]);
+}
+
+double orientationDeviation(const Pose& a, const Pose& b) {
+  // As 4-vectors, unit quaternions at an angle phi apart rotate by theta = 2 phi relative to
+  // each other, and phi = 2 atan2(|a - b|, |a + b|): exact 0 for equal inputs and accurate for
+  // small angles (unlike acos of the dot product). b is flipped to a's half-space first.
+  const scene::Quat& p = a.orientation;
+  scene::Quat q = b.orientation;
+  if (p.w * q.w + p.x * q.x + p.y * q.y + p.z * q.z < 0) q = {-q.w, -q.x, -q.y, -q.z};
+  const double minus = std::sqrt((p.w - q.w) * (p.w - q.w) + (p.x - q.x) * (p.x - q.x) +
+                                 (p.y - q.y) * (p.y - q.y) + (p.z - q.z) * (p.z - q.z));
+  const double plus = std::sqrt((p.w + q.w) * (p.w + q.w) + (p.x + q.x) * (p.x + q.x) +
+                                (p.y + q.y) * (p.y + q.y) + (p.z + q.z) * (p.z + q.z));
+  return 4 * std::atan2(minus, plus);
+}
+
+}  // namespace mlcp::cli
