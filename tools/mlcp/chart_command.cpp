@@ -29,6 +29,8 @@ std::string envOr(const char* name, const std::string& fallback) {
   return v && *v ? std::string(v) : fallback;
 }
 
+}  // namespace
+
 int runChart(const std::vector<std::string>& passed) {
   const std::string source = envOr("MLCP_SOURCE_DIR", MLCP_SOURCE_DIR);
   const std::string python = envOr("MLCP_PYTHON", source + "/.venv/bin/python");
@@ -64,8 +66,6 @@ int runChart(const std::vector<std::string>& passed) {
   if (waitpid(pid, &status, 0) < 0 || !WIFEXITED(status)) return kNotSolved;
   return WEXITSTATUS(status);  // chart.py: 0 written, 2 bad CSV or arguments
 }
-
-}  // namespace
 
 Runner addChartCommand(CLI::App& app) {
   auto args = std::make_shared<std::vector<std::string>>();

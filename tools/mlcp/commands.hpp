@@ -4,6 +4,8 @@
 
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <string>
+#include <vector>
 
 #include "mlcp/result.hpp"
 
@@ -21,6 +23,9 @@ Runner addStabilityCommand(CLI::App& app);
 Runner addDiffCommand(CLI::App& app);
 Runner addSweepCommand(CLI::App& app);
 Runner addChartCommand(CLI::App& app);
+// Runs tools/chart.py with these arguments (what `mlcp chart` does); returns its exit code
+// (1: no Python or script).
+int runChart(const std::vector<std::string>& args);
 
 // Shared by subcommands that take solver settings.
 struct SolverSettings {

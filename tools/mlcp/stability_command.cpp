@@ -7,6 +7,7 @@
 // Every cell runs the same simulated time (--seconds), so a smaller time step takes more
 // steps. One CSV row per cell, in the format `tools/chart.py heatmap` reads.
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -40,6 +41,7 @@ struct StabilityArgs {
   std::string fallback = "none";
   bool quick = false;
   std::string csv;
+  std::string chart;
   StabilityThresholds thresholds;
 };
 
@@ -72,6 +74,11 @@ int runStability(StabilityArgs args) {
     args.seconds = 1;
   }
   if (args.engines.empty()) args.engines = engineList();
+  if (!args.chart.empty() && args.csv.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(args.chart, ec);
+    args.csv = args.chart + "/stability.csv";
+  }
   const bool massGrid = args.grids.find("mass") != std::string::npos;
   const bool stepGrid = args.grids.find("step") != std::string::npos;
   if (!massGrid && !stepGrid) {
@@ -159,7 +166,10 @@ int runStability(StabilityArgs args) {
   std::cerr << "stability: " << cells.size() << " cells:";
   for (const auto& [outcome, n] : counts) std::cerr << ' ' << toString(outcome) << ' ' << n;
   std::cerr << (args.csv.empty() ? "" : "; wrote " + args.csv) << "\n";
-  return csv ? kSolved : kInvalidInput;
+  if (!csv) return kInvalidInput;
+  if (args.chart.empty()) return kSolved;
+  file.close();
+  return runChart({"heatmap", args.csv, "-o", args.chart}) == 0 ? kSolved : kNotSolved;
 }
 
 }  // namespace
@@ -191,7 +201,8 @@ Runner addStabilityCommand(CLI::App& app) {
           "engine,solver,x_name,x_value,y_name,y_value,outcome,scene and the measures "
           "steps,max_speed (m/s),max_displacement (edges),top_displacement (m),"
           "max_penetration (m),failed_steps,fallback_steps,worst_residual,mean_solver_ms,"
-          "reason. Exit 0: the grid ran; 2: bad arguments.";
+          "reason. Exit 0: the grid ran (and --chart drew it); 1: --chart failed; 2: bad "
+          "arguments.";
   CLI::App* cmd = app.add_subcommand("stability", help.str());
   cmd->add_option("--engines", args->engines,
                   "engines, comma separated (default: all built: " + engineNames() + ")")
@@ -236,7 +247,12 @@ Runner addStabilityCommand(CLI::App& app) {
   cmd->add_flag("--quick", args->quick,
                 "a 2 x 2 grid of each kind and 1 s per cell (for tests; overrides the grid "
                 "options)");
-  cmd->add_option("--csv", args->csv, "CSV file to write (default: standard output)");
+  cmd->add_option("--csv", args->csv,
+                  "CSV file to write (default: standard output, or DIR/stability.csv with "
+                  "--chart)");
+  cmd->add_option("--chart", args->chart,
+                  "also draw the heat maps into this folder (tools/chart.py heatmap through "
+                  "the venv, as mlcp chart does)");
   cmd->add_option("--max-speed", args->thresholds.maxSpeed, "exploded above this speed (m/s)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
