@@ -651,13 +651,13 @@ DantzigSolver& DantzigSolver::operator=(DantzigSolver&&) noexcept = default;
 
 int DantzigSolver::passes() const { return ws_->passes; }
 
-bool DantzigSolver::wantsBlockStage(const Problem& problem, bool warm) const {
+bool DantzigSolver::wantsBlockStage(const Problem& problem) const {
   const int n = problem.size();
   if (n == 0 || params_.blockStage == DantzigParams::BlockStage::Never ||
       options().frictionBounds == FrictionBounds::FixedOnce)
     return false;
   if (params_.blockStage == DantzigParams::BlockStage::Always) return true;
-  if (!warm || n < params_.autoMinRows) return false;
+  if (n < params_.autoMinRows) return false;
   const double nonZeros = problem.isSparse()
                               ? static_cast<double>(problem.sparseA().nonZeros())
                               : static_cast<double>((problem.denseA().array() != 0).count());
@@ -674,25 +674,50 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
   }
   blockSteps_ = 0;
   blockSettled_ = false;
-  if (wantsBlockStage(problem, !x.isZero(0.0))) {
+  const bool warm = !x.isZero(0.0);
+  if (!wantsBlockStage(problem)) {
+    runPivoting(problem, x, result);
+    return;
+  }
+  auto settle = [&](const detail::BlockPivoting::Report& rep) {
+    blockSettled_ = true;
+    ws.passes = 1;
+    result.status = Status::Converged;
+    result.iterations = blockSteps_;
+    result.message = rep.message;
+  };
+  std::string blockMessage;
+  // Auto first tries a few full steps from the cold guess (every row clamped): resting piles
+  // (ODE) settle in one step there, often sooner than from a warm guess whose sets are off by
+  // a few rows; when they do not settle the trial is dropped (its iterate is a worse start than
+  // none: synthetic pyramids from cold), so it costs at most autoColdSteps factorizations.
+  if (params_.blockStage == DantzigParams::BlockStage::Auto) {
+    Vector trial = Vector::Zero(problem.size());
+    const detail::BlockPivoting::Report rep =
+        block_->run(problem, trial, options(),
+                    std::max(1, std::min(params_.autoColdSteps, params_.maxBlockSteps)));
+    blockSteps_ += rep.steps;
+    if (rep.settled) {
+      x = trial;
+      settle(rep);
+      return;
+    }
+    blockMessage = "cold trial: " + rep.message + "; ";
+  }
+  if (warm || params_.blockStage == DantzigParams::BlockStage::Always) {
     const detail::BlockPivoting::Report rep =
         block_->run(problem, x, options(), std::max(1, params_.maxBlockSteps));
-    blockSteps_ = rep.steps;
+    blockSteps_ += rep.steps;
     if (rep.settled) {
-      blockSettled_ = true;
-      ws.passes = 1;
-      result.status = Status::Converged;
-      result.iterations = rep.steps;
-      result.message = rep.message;
+      settle(rep);
       return;
     }
     // x holds the best iterate: its index sets warm start the incremental pivoting.
-    runPivoting(problem, x, result);
-    result.iterations += rep.steps;
-    result.message = "block stage: " + rep.message + "; pivoting: " + result.message;
-    return;
+    blockMessage += rep.message;
   }
   runPivoting(problem, x, result);
+  result.iterations += blockSteps_;
+  result.message = "block stage: " + blockMessage + "; pivoting: " + result.message;
 }
 
 void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& result) {

@@ -1,14 +1,29 @@
 // ODE adapter benchmark: our stepper (pgs, dantzig) against stock dWorldStep and
 // dWorldQuickStep on box pyramids of about 100, 500 and 2000 constraint rows, timed side by
-// side in one run (interleaved step by step, median per step), with the residual of every
-// answer measured by the same function (mlcp::accuracy on the island's rows).
+// side in one run (median per step), with the residual of every answer measured by the same
+// function (mlcp::accuracy on the island's rows).
 //
-//     build/bench/ode_bench [steps]     (default 30 timed steps per method and size)
+//     build/bench/ode_bench [steps] [warm-up steps]     (defaults 20 and 20)
+//
+// Same world state for every method: one pile is stepped by our dantzig (the reference
+// trajectory); before each step every other method's pile is set to the reference pile's state
+// (positions, orientations, velocities), so all methods solve the very same contacts from the
+// very same state at every step (the piles are built identically; dCollide is deterministic).
+// Methods with a warm start (ours) take it from their own previous step, which started from the
+// reference state too. The other methods step only in the last 3 warm-up steps and the timed
+// steps. "max |dv| vs dantzig" is the largest difference of any body's linear or angular
+// velocity after the step from the reference's, in m/s or rad/s (g h = 0.098 m/s for scale):
+// "equal answers" means the same residual level and |dv| far below g h; the steps column
+// counts the timed steps with |dv| > 1e-6 (dWorldStep's dxSolveLCP sometimes stops with
+// "LCP internal error, s <= 0" on these piles and returns a wrong answer).
 //
 // "stock dWorldStep residual" is that of ODE's own dxSolveLCP on our assembled rows (the
-// "ode-lcp" method, equal to dWorldStep to round-off; see tests/ode/plumbing_test.cpp).
-// pgs runs QuickStep's iteration count (20) and relaxation (1.3) without convergence checks.
+// "ode-lcp" reference of our dantzig stepper, equal to dWorldStep to round-off; see
+// tests/ode/plumbing_test.cpp); its time is excluded from our dantzig's time. The island
+// count shows whether the pile is one island. pgs runs QuickStep's iteration count (20) and
+// relaxation (1.3) without convergence checks.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -29,7 +44,9 @@ struct Method {
   bool quick = false;
   std::unique_ptr<Scene> scene;
   std::vector<double> times;
-  double residual = 0;  // worst over the timed steps
+  double residual = 0;      // worst over the timed steps
+  double velocityDiff = 0;  // worst max |dv| against the reference (our dantzig)
+  int differing = 0;        // timed steps with max |dv| > 1e-6
   int rows = 0;
 };
 
@@ -38,15 +55,43 @@ double median(std::vector<double> v) {
   return v.empty() ? 0 : v[v.size() / 2];
 }
 
+// Sets every body of `to` to the state of the same body of `from` (identically built scenes).
+void copyState(const Scene& from, Scene& to) {
+  for (size_t i = 0; i < from.bodies.size(); ++i) {
+    dBodyID a = from.bodies[i], b = to.bodies[i];
+    const dReal* p = dBodyGetPosition(a);
+    const dReal* v = dBodyGetLinearVel(a);
+    const dReal* w = dBodyGetAngularVel(a);
+    dBodySetPosition(b, p[0], p[1], p[2]);
+    dBodySetQuaternion(b, dBodyGetQuaternion(a));
+    dBodySetLinearVel(b, v[0], v[1], v[2]);
+    dBodySetAngularVel(b, w[0], w[1], w[2]);
+  }
+}
+
+// The largest difference of any body's linear or angular velocity component.
+double velocityDifference(const Scene& a, const Scene& b) {
+  double d = 0;
+  for (size_t i = 0; i < a.bodies.size(); ++i)
+    for (auto get : {dBodyGetLinearVel, dBodyGetAngularVel}) {
+      const dReal *u = get(a.bodies[i]), *v = get(b.bodies[i]);
+      for (int k = 0; k < 3; ++k) d = std::max(d, std::abs(double(u[k] - v[k])));
+    }
+  return d;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  const int steps = argc > 1 ? std::max(1, std::atoi(argv[1])) : 30;
+  const int steps = argc > 1 ? std::max(1, std::atoi(argv[1])) : 20;
+  const int warmup = argc > 2 ? std::max(3, std::atoi(argv[2])) : 20;
   const dReal h = 0.01;
 
-  std::printf("| pyramid base | rows | method | ms/step | x dWorldStep | worst residual |\n");
-  std::printf("|---|---|---|---|---|---|\n");
-  for (int base : {3, 6, 12}) {
+  std::printf(
+      "| pyramid base | rows | islands | method | ms/step | x dWorldStep | worst residual | "
+      "max \\|dv\\| vs dantzig (steps) |\n");
+  std::printf("|---|---|---|---|---|---|---|---|\n");
+  for (int base : {3, 7, 12}) {
     std::vector<Method> methods;
     auto add = [&](const std::string& name, std::unique_ptr<Stepper> s, bool quick) {
       Method m;
@@ -68,10 +113,15 @@ int main(int argc, char** argv) {
     StepperOptions dz;
     dz.reference = "ode-lcp";  // stock's residual on the very same problems
     add("ours dantzig (exact)", std::make_unique<Stepper>("dantzig", dz), false);
+    Method& ref = methods[3];
+    int islands = 0;
 
-    // Settle every pile with its own method, then time steps interleaved.
-    for (int k = 0; k < 40 + steps; ++k) {
+    for (int k = 0; k < warmup + steps; ++k) {
+      const bool all = k >= warmup - 3;
+      for (Method& m : methods)
+        if (&m != &ref && all) copyState(*ref.scene, *m.scene);
       for (Method& m : methods) {
+        if (&m != &ref && !all) continue;
         const double t0 = mlcp::nowSeconds();
         m.scene->step(
             [&](dWorldID w, dReal dt) {
@@ -83,29 +133,47 @@ int main(int argc, char** argv) {
                 dWorldStep(w, dt);
             },
             h);
-        if (k < 40) continue;
-        m.times.push_back(mlcp::nowSeconds() - t0);
+        double t = mlcp::nowSeconds() - t0;
+        if (m.stepper)
+          for (const IslandStats& st : m.stepper->lastStep().islands) t -= st.referenceSeconds;
+        if (k < warmup) continue;
+        m.times.push_back(t);
         if (m.stepper) {
           m.residual = std::max(m.residual, m.stepper->lastStep().maxResidual());
           m.rows = m.stepper->lastStep().rows();
-          if (m.name.find("dantzig") != std::string::npos)
-            for (const IslandStats& st : m.stepper->lastStep().islands)
-              if (st.rows > 0)
-                methods[0].residual = std::max(methods[0].residual, st.referenceResidual);
+          if (&m == &ref) {
+            int withRows = 0;
+            for (const IslandStats& st : m.stepper->lastStep().islands) {
+              if (st.rows == 0) continue;
+              ++withRows;
+              methods[0].residual = std::max(methods[0].residual, st.referenceResidual);
+            }
+            islands = std::max(islands, withRows);
+          }
         }
       }
+      if (k >= warmup)
+        for (Method& m : methods) {
+          if (&m == &ref) continue;
+          const double d = velocityDifference(*m.scene, *ref.scene);
+          m.velocityDiff = std::max(m.velocityDiff, d);
+          m.differing += d > 1e-6;
+        }
     }
     const double stock = median(methods[0].times);
     for (const Method& m : methods) {
       const double t = median(m.times);
-      char res[32] = "n/a";
+      char res[32] = "n/a", dv[64] = "0 (reference)";
       if (m.stepper || (&m == &methods[0])) std::snprintf(res, sizeof res, "%.2e", m.residual);
-      std::printf("| %d | %d | %s | %.3f | %.2f | %s |\n", base, methods[3].rows, m.name.c_str(),
-                  1e3 * t, stock / t, res);
+      if (&m != &ref)
+        std::snprintf(dv, sizeof dv, "%.1e (%d of %d > 1e-6)", m.velocityDiff, m.differing, steps);
+      std::printf("| %d | %d | %d | %s | %.3f | %.2f | %s | %s |\n", base, ref.rows, islands,
+                  m.name.c_str(), 1e3 * t, stock / t, res, dv);
+      std::fflush(stdout);
     }
   }
   std::printf(
-      "\n(x dWorldStep = dWorldStep's time / this method's time; residual: scaled "
-      "natural-map residual, mlcp::accuracy)\n");
+      "\n(x dWorldStep = dWorldStep's time / this method's time, all on the same state per step; "
+      "residual: scaled natural-map residual, mlcp::accuracy; islands: islands with rows)\n");
   return 0;
 }

@@ -402,6 +402,36 @@ TEST(DantzigBlock, PyramidColdMatchesTheDensePath) {
   }
 }
 
+// Auto's cold trial (autoColdSteps full steps from "every row clamped"): it either settles
+// within its step budget or is dropped and the pivoting starts cold; either way the answer is
+// the dense path's.
+TEST(DantzigBlock, AutoColdTrialSettlesOrIsDropped) {
+  test::PyramidSpec spec;
+  spec.levels = 4;
+  for (double side : {0.0, 0.5}) {
+    spec.sideVelocity = side;
+    test::BoxPyramid pyramid(spec);
+    pyramid.nextStep(1e-4);
+    const Problem p = pyramid.rows().assemble(true);
+    ASSERT_GE(p.size(), DantzigParams().autoMinRows);
+    DantzigSolver autoStage = withStage(DantzigParams::BlockStage::Auto);
+    DantzigSolver dense = withStage(DantzigParams::BlockStage::Never);
+    autoStage.options().tolerance = dense.options().tolerance = 1e-13;
+    Vector xa, xd;
+    const Result ra = autoStage.solve(p, xa), rd = dense.solve(p, xd);
+    ASSERT_TRUE(ra.converged()) << ra.message;
+    ASSERT_TRUE(rd.converged()) << rd.message;
+    EXPECT_GT(autoStage.blockSteps(), 0);
+    EXPECT_LE(autoStage.blockSteps(), autoStage.params().autoColdSteps);
+    if (!autoStage.blockSettled()) {
+      EXPECT_GT(ra.iterations, autoStage.blockSteps());
+    }
+    EXPECT_LE(accuracy(p, xa).boundViolation, 1e-12);
+    EXPECT_LE((xa - xd).lpNorm<Eigen::Infinity>(), 1e-9 * (1 + xd.lpNorm<Eigen::Infinity>()))
+        << "side velocity " << side;
+  }
+}
+
 // Sliding contacts (sideways velocities) exercise the sliding rows' low-rank update.
 TEST(DantzigBlock, SlidingPyramidWarmStart) {
   test::PyramidSpec spec;

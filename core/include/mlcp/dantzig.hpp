@@ -122,7 +122,10 @@ class BlockPivoting;
 // Parameters of DantzigSolver beyond Options (see "Block stage" above).
 struct DantzigParams {
   enum class BlockStage {
-    Auto,    // warm starts with n >= autoMinRows and at most autoMaxDensity n^2 nonzeros in A
+    // n >= autoMinRows and at most autoMaxDensity n^2 nonzeros in A: first a trial of
+    // autoColdSteps from the cold guess (dropped when it does not settle), then warm starts get
+    // up to maxBlockSteps from their guess, and cold starts pivot from zero.
+    Auto,
     Always,  // whenever it applies (Exact friction, symmetric A), cold starts too
     Never,   // incremental pivoting only (the dense path)
   };
@@ -131,8 +134,10 @@ struct DantzigParams {
   int maxBlockSteps = 40;
   // Auto: the smallest problem (rows) that gets the block stage. Default 100.
   int autoMinRows = 100;
-  // Auto: the largest fraction of nonzero entries in A. Default 0.1.
-  double autoMaxDensity = 0.1;
+  // Auto: the largest fraction of nonzero entries in A. Default 0.3.
+  double autoMaxDensity = 0.3;
+  // Auto: factorizations of the trial from the cold guess. Default 3.
+  int autoColdSteps = 3;
 };
 
 class DantzigSolver : public Solver {
@@ -160,7 +165,7 @@ class DantzigSolver : public Solver {
 
  private:
   struct Workspace;
-  bool wantsBlockStage(const Problem& problem, bool warm) const;
+  bool wantsBlockStage(const Problem& problem) const;
   void runPivoting(const Problem& problem, Vector& x, Result& result);
   std::unique_ptr<Workspace> ws_;
   std::unique_ptr<detail::BlockPivoting> block_;
