@@ -281,6 +281,10 @@ def index_html(out_dir, tables, setting, notes):
 
     if has_table:
         parts.append("<h2 id='siconos'>Seed and Siconos problems</h2>")
+        parts.append("<p class='note'><code>mlcp table --markdown</code>: each solver on the "
+                     "seed's worked examples and the Siconos LCP corpus; a cell is the residual "
+                     "reached (tolerance 1e-10) or the status, with the reasons below. Also as "
+                     "<a href='table.md'>table.md</a>.</p>")
         with open(os.path.join(out_dir, "table.md")) as f:
             parts.append(markdown_to_html(f.read()))
     parts.append("</body></html>")

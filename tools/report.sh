@@ -89,7 +89,7 @@ if [ -d "$siconos/lcp" ]; then
   t0=$SECONDS
   "$mlcp" table --markdown "$repo/tests/data/seed_lemke.json" "$repo/tests/data/spd.json" \
     "$repo/tests/data/boxed.json" "$repo/tests/data/findex.json" "$siconos"/lcp/*.dat \
-    > "$out/table.md"
+    --solvers pgs,lemke,dantzig,auto > "$out/table.md"
   echo "$((SECONDS - t0)) s"
 else
   notes+=("No Siconos table: $siconos/lcp is missing (set MLCP_SICONOS_DIR).")

@@ -24,6 +24,10 @@ for s in stack_10 pendulum_chain; do
   grep -q "src='charts/$s.png'" "$out/index.html" || fail "index.html does not show charts/$s.png"
 done
 grep -q "^| engine | solver | iterations |" "$out/summary.md" || fail "summary.md lacks the table header"
+if [ -d "${MLCP_SICONOS_DIR:-$repo/../shared/data/siconos}/lcp" ]; then
+  grep -q "^| problem | n | pgs | lemke | dantzig | auto |" "$out/table.md" || fail "table.md lacks the solver table"
+  grep -q "id='siconos'" "$out/index.html" || fail "index.html lacks the Siconos table"
+fi
 if grep -qE '^ +stability' <<< "$("$mlcp" --help)"; then
   [ -s "$out/stability.csv" ] || fail "stability.csv is missing"
   ls "$out"/stability/*.png > /dev/null 2>&1 || fail "no stability heat map"
