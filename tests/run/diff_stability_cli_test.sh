@@ -60,7 +60,7 @@ check files-not-trajectory 2 'steps.csv: line 1: expected the trajectory header'
 check files-and-solvers 2 'take no --engine' -- "$mlcp" diff "$tmp/a.csv" "$tmp/b.csv" --solvers pgs,pgs
 
 # Stability: --quick grid, the chart script's columns, valid outcomes, a row per cell.
-check stability-quick 0 'stability: [0-9]+ cells' -- \
+check stability-quick 0 'stack_time_step [a-z]+/pgs  iterations 20: [SDCEF]{2} \| 3: [SDCEF]{2}  \(time_step' -- \
   "$mlcp" stability --quick --solvers pgs,dantzig,bullet-si,ode-quick --csv "$tmp/stab.csv"
 n_engines=$(grep -oE 'bullet|ode' <<< "$engines" | wc -l)
 want_rows=$((n_engines * 3 * 8))

@@ -65,6 +65,36 @@ std::string label(const Cell& c) {
   return s.str();
 }
 
+// The grid as letters on standard output, one line per engine, solver and grid: rows from the
+// largest y down, columns x ascending, e.g.
+//   stack_mass_ratio bullet/pgs  height 16: DDCC | 8: DDCC | 4: SDCC | 2: SSCC  (mass_ratio 1 10
+//   100 1000)
+void printMaps(const std::vector<Cell>& cells, const std::string& letters) {
+  std::size_t i = 0;
+  while (i < cells.size()) {
+    std::size_t end = i;
+    std::map<double, std::map<double, char>> rows;  // y -> x -> letter
+    while (end < cells.size() && cells[end].engine == cells[i].engine &&
+           cells[end].solver == cells[i].solver && cells[end].scene == cells[i].scene) {
+      rows[cells[end].y][cells[end].x] = letters[end];
+      ++end;
+    }
+    std::ostringstream line;
+    line << cells[i].scene << ' ' << cells[i].engine << '/' << cells[i].solver << "  "
+         << cells[i].yName << ' ';
+    for (auto row = rows.rbegin(); row != rows.rend(); ++row) {
+      line << (row == rows.rbegin() ? "" : " | ") << row->first << ": ";
+      for (const auto& [x, letter] : row->second) line << letter;
+    }
+    line << "  (" << cells[i].xName;
+    for (const auto& [x, letter] : rows.begin()->second) line << ' ' << x;
+    line << ')';
+    std::cout << line.str() << "\n";
+    i = end;
+  }
+  std::cout << "(S stable, D drifting, C collapsed, E exploded, F solver-failure)\n";
+}
+
 int runStability(StabilityArgs args) {
   if (args.quick) {
     args.ratios = {1, 100};
@@ -144,6 +174,7 @@ int runStability(StabilityArgs args) {
       << std::setprecision(9);
 
   std::map<Outcome, int> counts;
+  std::string letters;  // one per cell, in cell order
   Progress progress("stability", int(cells.size()));
   for (const Cell& c : cells) {
     progress.start(label(c));
@@ -155,6 +186,7 @@ int runStability(StabilityArgs args) {
     const CellMeasures& m = tracker.measures();
     const Classification k = classify(m, args.thresholds);
     ++counts[k.outcome];
+    letters.push_back("SDCEF"[static_cast<int>(k.outcome)]);
     csv << c.engine << ',' << c.solver << ',' << c.xName << ',' << c.x << ',' << c.yName << ','
         << c.y << ',' << toString(k.outcome) << ',' << c.scene << ',' << m.steps << ','
         << m.maxSpeed << ',' << m.maxDisplacementRatio << ',' << m.topDisplacement << ','
@@ -163,6 +195,7 @@ int runStability(StabilityArgs args) {
     progress.done();
   }
   progress.finish();
+  if (!args.csv.empty()) printMaps(cells, letters);
   std::cerr << "stability: " << cells.size() << " cells:";
   for (const auto& [outcome, n] : counts) std::cerr << ' ' << toString(outcome) << ' ' << n;
   std::cerr << (args.csv.empty() ? "" : "; wrote " + args.csv) << "\n";
