@@ -173,11 +173,12 @@ std::string Problem::validate() const {
   return "";
 }
 
-ProblemClass Problem::classify() const {
-  if (size() == 0) return ProblemClass::Empty;
-  if (hasFindex()) return ProblemClass::Findex;
+ProblemClass classifyBounds(const Vector& lo, const Vector& hi, const std::vector<int>& findex) {
+  if (lo.size() == 0) return ProblemClass::Empty;
+  for (int f : findex)
+    if (f >= 0) return ProblemClass::Findex;
   bool allFree = true, allStandard = true;
-  for (int i = 0; i < size(); ++i) {
+  for (Eigen::Index i = 0; i < lo.size(); ++i) {
     const bool freeRow = lo[i] == -kInf && hi[i] == kInf;
     const bool standardRow = lo[i] == 0 && hi[i] == kInf;
     allFree = allFree && freeRow;
@@ -186,6 +187,11 @@ ProblemClass Problem::classify() const {
   if (allFree) return ProblemClass::Linear;
   if (allStandard) return ProblemClass::StandardLcp;
   return ProblemClass::Boxed;
+}
+
+ProblemClass Problem::classify() const {
+  if (size() == 0) return ProblemClass::Empty;
+  return classifyBounds(lo, hi, findex);
 }
 
 }  // namespace mlcp

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 
 namespace mlcp::scene {
 
@@ -47,6 +48,12 @@ RunSettings RunSettings::fromScene(const Scene& scene) {
   s.tolerance = scene.solver.tolerance;
   s.warmStart = scene.solver.warmStart;
   return s;
+}
+
+std::string capturePrefix(const std::string& folder, const std::string& scene, const char* engine,
+                          int step) {
+  const std::string name = scene + "-" + engine + "-step" + std::to_string(step) + "-";
+  return (std::filesystem::path(folder) / name).string();
 }
 
 bool isFinite(const BodyState& b) {

@@ -429,7 +429,7 @@ TEST(SceneParse, DefaultsAreTheDocumentedOnes) {
   EXPECT_DOUBLE_EQ(s.settings.cfm, 1e-5);
   EXPECT_FALSE(s.settings.sleeping);
   EXPECT_EQ(s.settings.maxContactsPerPair, 4);
-  EXPECT_EQ(s.solver.name, "pgs");
+  EXPECT_EQ(s.solver.name, "auto");
   EXPECT_EQ(s.solver.iterations, 50);
   EXPECT_DOUBLE_EQ(s.solver.tolerance, 1e-6);
   EXPECT_TRUE(s.solver.warmStart);

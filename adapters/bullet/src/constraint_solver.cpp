@@ -1,7 +1,6 @@
 #include "mlcp/bullet/constraint_solver.hpp"
 
 #include <cmath>
-#include <optional>
 #include <stdexcept>
 
 #include "mlcp/registry.hpp"
@@ -25,16 +24,6 @@ int severity(Status s) {
   return 6;
 }
 
-// "pgs" runs on the rows (no matrix); any other name is a core solver fed an assembled A.
-std::unique_ptr<Solver> make(const std::string& name, bool& rowPgs) {
-  rowPgs = name == "pgs";
-  if (rowPgs) return nullptr;
-  std::string error;
-  std::unique_ptr<Solver> s = makeSolver(name, &error);
-  if (!s) throw std::invalid_argument("mlcp::bullet::ConstraintSolver: " + error + ", or si");
-  return s;
-}
-
 void worst(StepStats& into, const StepStats& from) {
   if (std::isnan(into.residual) || from.residual > into.residual) into.residual = from.residual;
   if (severity(from.status) > severity(into.status)) into.status = from.status;
@@ -43,17 +32,17 @@ void worst(StepStats& into, const StepStats& from) {
 
 }  // namespace
 
-bool acceptable(const Result& r, double acceptResidual) {
-  if (r.status == Status::InvalidInput || r.status == Status::Unsupported) return false;
-  return std::isfinite(r.residual) && r.residual <= acceptResidual;
-}
-
 ConstraintSolver::ConstraintSolver(const Settings& settings) : settings_(settings) {
   si_ = settings_.solver == "si";
-  if (!si_) primary_ = make(settings_.solver, primaryIsRowPgs_);
-  if (!settings_.fallback.empty()) secondary_ = make(settings_.fallback, secondaryIsRowPgs_);
-  if (!(settings_.acceptResidual >= 0))
-    throw std::invalid_argument("mlcp::bullet::ConstraintSolver: acceptResidual must be >= 0");
+  RowSolverSettings rs = settings_;
+  if (si_) rs.solver = "pgs";  // only the fallback name is checked
+  try {
+    auto rows = std::make_unique<RowSolver>(rs);
+    if (!si_) rows_ = std::move(rows);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("mlcp::bullet::ConstraintSolver: " + std::string(e.what()) +
+                                ", or si");
+  }
 }
 
 ConstraintSolver::~ConstraintSolver() = default;
@@ -84,10 +73,12 @@ void ConstraintSolver::finishStep() {
   totals_.assembleSeconds += current_.assembleSeconds;
   totals_.fallbacks += current_.fallbacks;
   totals_.failures += current_.failures;
+  totals_.choices.add(current_.choices);
   worst(totals_, current_);
 }
 
-void ConstraintSolver::record(const Result& r, int rows) {
+void ConstraintSolver::record(const Result& r, int rows, const std::string& choice) {
+  current_.choices.add(choice);
   StepStats one;
   one.residual = r.residual;
   one.status = r.status;
@@ -123,12 +114,19 @@ btScalar ConstraintSolver::solveGroupCacheFriendlyIterations(
       current_.status = Status::MaxIterations;
     }
   } else {
+    if (settings_.bulletIterations) {
+      // pgs/gs as SI runs them: a fixed sweep count, the residual checked once, at the end.
+      for (auto [name, options] : {std::pair(&settings_.solver, &rows_->options()),
+                                   std::pair(&settings_.fallback, &rows_->fallbackOptions())})
+        if (*name == "pgs" || *name == "gs")
+          options->maxIterations = options->checkEvery = info.m_numIterations;
+    }
     builder_.build(rows, info, settings_.cfm, settings_.warmStart);
     current_.inertRows += builder_.inertRows();
     for (int k = 0; k < builder_.count(); ++k) {
       Island& island = builder_.island(k);
-      solveIsland(island, info, false);
-      if (info.m_splitImpulse && island.hasSplit) solveIsland(island, info, true);
+      solveIsland(island, k, false);
+      if (info.m_splitImpulse && island.hasSplit) solveIsland(island, k, true);
     }
     current_.seconds += nowSeconds() - t0;
   }
@@ -147,79 +145,29 @@ void ConstraintSolver::measureSi(int sweeps) {
     const Accuracy a = accuracy(island.start, s.slack(island.start), s.lo, s.hi, s.findex,
                                 s.b.size() ? s.b.lpNorm<Eigen::Infinity>() : 0.0);
     applyAccuracy(r, a, settings_.options.tolerance);
-    record(r, s.size());
+    record(r, s.size(), "si");
     if (settings_.keepIslands)
       records_.push_back({s, island.start, island.start, r, "si", false, false});
   }
 }
 
-void ConstraintSolver::solveIsland(Island& island, const btContactSolverInfo& info, bool split) {
+void ConstraintSolver::solveIsland(Island& island, std::uint64_t key, bool split) {
   RowSystem& s = island.system;
   const int n = s.size();
   // The split problem shares A and the bounds; only b and the start differ.
   if (split) s.b.swap(island.splitB);
   const Vector& start = split ? island.splitStart : island.start;
-
-  std::optional<Problem> assembled;
-  auto run = [&](Solver* solver, bool rowPgs, Options o, Vector& x) {
-    o.warmStart = true;
-    if (settings_.bulletIterations && (rowPgs || std::string(solver->name()) == "gs")) {
-      // Fixed sweep count like SI: check the residual once, at the end.
-      o.maxIterations = info.m_numIterations;
-      o.checkEvery = o.maxIterations;
-    }
-    Result r;
-    if (rowPgs) {
-      RowPgs pgs;
-      pgs.options() = o;
-      x = start;
-      r = pgs.solve(s, x);
-    } else {
-      if (!assembled) {
-        const double t0 = nowSeconds();
-        assembled = s.assemble(n > settings_.denseMaxRows);
-        current_.assembleSeconds += nowSeconds() - t0;
-      }
-      solver->setOptions(o);
-      r = solver->solveWithGuess(*assembled, start, x);
-    }
-    if (r.status == Status::InvalidInput || r.status == Status::Unsupported) x = start;
-    return r;
-  };
-
-  const char* used = si_ ? "si" : settings_.solver.c_str();
-  Result result = run(primary_.get(), primaryIsRowPgs_, settings_.options, xPrimary_);
-  Vector* answer = &xPrimary_;
-  bool fellBack = false;
-  if (!acceptable(result, settings_.acceptResidual)) {
-    current_.fallbacks += 1;
-    if (current_.message.empty())
-      current_.message = settings_.solver + ": " + toString(result.status) + ", " + result.message;
-    fellBack = true;
-    if (secondary_ || secondaryIsRowPgs_) {
-      Result second =
-          run(secondary_.get(), secondaryIsRowPgs_, settings_.fallbackOptions, xSecondary_);
-      const bool better = std::isfinite(second.residual) &&
-                          !(std::isfinite(result.residual) && result.residual <= second.residual);
-      if (!acceptable(second, settings_.acceptResidual)) current_.failures += 1;
-      if (better || acceptable(second, settings_.acceptResidual)) {
-        result = second;
-        answer = &xSecondary_;
-        used = settings_.fallback.c_str();
-      }
-    } else {
-      current_.failures += 1;
-    }
-    if (!std::isfinite(result.residual)) {
-      // Nothing usable: keep the start (no impulse change).
-      xPrimary_ = start;
-      answer = &xPrimary_;
-    }
-  }
-  record(result, n);
+  const IslandSolve solved = rows_->solve(s, start, x_, key);
+  const Result& result = solved.result;
+  current_.assembleSeconds += solved.assembleSeconds;
+  current_.fallbacks += solved.fellBack;
+  current_.failures += !solved.accepted;
+  if (current_.message.empty() && (solved.fellBack || !solved.accepted))
+    current_.message = result.message;
+  record(result, n, solved.choice);
 
   // Store impulses: the change from the start goes through Bullet's own body update.
-  const Vector& x = *answer;
+  const Vector& x = x_;
   for (int i = 0; i < n; ++i) {
     btSolverConstraint& c = *island.rows[i];
     btSolverBody& a = m_tmpSolverBodyPool[c.m_solverBodyIdA];
@@ -241,7 +189,8 @@ void ConstraintSolver::solveIsland(Island& island, const btContactSolverInfo& in
       c.m_appliedImpulse = xi;
     }
   }
-  if (settings_.keepIslands) records_.push_back({s, start, x, result, used, split, fellBack});
+  if (settings_.keepIslands)
+    records_.push_back({s, start, x, result, solved.choice, split, solved.fellBack});
   if (split) s.b.swap(island.splitB);
 }
 

@@ -89,7 +89,7 @@ class BulletWorld : public scene::World {
       solver = scenes::makeBulletSolver(name.substr(7));
       stock_ = static_cast<scenes::StockMlcp*>(solver.get());
       pivoting_ = name != "bullet-mlcp-pgs";
-    } else if (!makeSolver(name)) {
+    } else if (!RowSolver::known(name)) {
       throw std::invalid_argument("unknown solver '" + name +
                                   "' for Bullet (known: " + worldSolverNames() + ")");
     } else {
@@ -148,11 +148,26 @@ class BulletWorld : public scene::World {
   }
   const char* engine() const override { return "bullet"; }
 
+  bool captureNextStep(const std::string& folder) override {
+    captured_.clear();
+    if (!ours_ || !ours_->rowSolver()) return false;
+    capturing_ = true;
+    ours_->rowSolver()->setCapture(
+        scene::capturePrefix(folder, scene().name, engine(), stepsTaken()));
+    return true;
+  }
+  std::vector<std::string> capturedFiles() const override { return captured_; }
+
  protected:
   void stepEngine(scene::StepMeasures& m) override {
     timed_->seconds = 0;
     const int fallbacksBefore = stock_ ? stock_->fallbacks() : 0;
     world_->stepSimulation(scene().settings.timeStep, 0, scene().settings.timeStep);
+    if (capturing_) {
+      captured_ = ours_->rowSolver()->capturedFiles();
+      ours_->rowSolver()->setCapture("");
+      capturing_ = false;
+    }
     m.solverMs = 1e3 * timed_->seconds;
     if (ours_) {
       const StepStats& st = ours_->lastStep();
@@ -161,6 +176,7 @@ class BulletWorld : public scene::World {
       m.iterations = st.iterations;
       m.status = toString(st.status);
       m.fallbacks = st.fallbacks;
+      m.choice = st.choices.toString();
     } else if (stock_) {
       m.solverMs -= 1e3 * stock_->stepMeasureSeconds();
       m.residual = stock_->stepResidual();
@@ -274,7 +290,8 @@ class BulletWorld : public scene::World {
   std::unique_ptr<TimedSolver> timed_;
   ConstraintSolver* ours_ = nullptr;
   scenes::StockMlcp* stock_ = nullptr;
-  bool fixedSweeps_ = false, pivoting_ = false;
+  bool fixedSweeps_ = false, pivoting_ = false, capturing_ = false;
+  std::vector<std::string> captured_;
   int iterations_ = 0;
   double tolerance_ = 0;
   std::unique_ptr<btDefaultCollisionConfiguration> config_;

@@ -247,15 +247,9 @@ Result solveWithOdeLcp(IslandWork& w, int nub, dxWorldProcessMemArena* arena,
   return r;
 }
 
-bool usable(const Result& r, const Vector& x, int n) {
-  if (x.size() != n || !x.allFinite()) return false;
-  return r.status != Status::InvalidInput && r.status != Status::Unsupported &&
-         r.status != Status::NumericalIssue;
-}
-
 }  // namespace
 
-Method makeMethod(const std::string& name) {
+Method makeMethod(const std::string& name, RowSolverSettings settings) {
   Method m;
   m.name = name;
   if (name == "ode-step") {
@@ -264,15 +258,13 @@ Method makeMethod(const std::string& name) {
     m.kind = Method::Kind::ForwardQuickStep;
   } else if (name == "ode-lcp") {
     m.kind = Method::Kind::OdeLcp;
-  } else if (name == "pgs") {
-    m.kind = Method::Kind::RowPgs;
   } else {
-    std::string error;
-    m.solver = makeSolver(name, &error);
-    if (!m.solver)
+    if (!RowSolver::known(name))
       throw std::invalid_argument("mlcp::ode::Stepper: unknown solver '" + name +
                                   "' (known: " + Stepper::knownSolvers() + ")");
-    m.kind = Method::Kind::Assembled;
+    settings.solver = name;
+    m.kind = Method::Kind::Core;
+    m.solver = std::make_unique<RowSolver>(settings);
   }
   return m;
 }
@@ -353,27 +345,31 @@ namespace mlcp::ode {
 
 namespace {
 
-Result solveWith(Method& method, IslandWork& w, int nub, dxWorldProcessMemArena* arena,
-                 const StepperOptions& so, bool warm, Vector& x) {
-  Options opt = so.solver;
-  opt.warmStart = warm;
-  x = warm ? w.x0 : Vector::Zero(w.rows.size());
-  switch (method.kind) {
-    case Method::Kind::RowPgs: method.rowPgs.options() = opt; return method.rowPgs.solve(w.rows, x);
-    case Method::Kind::OdeLcp: return solveWithOdeLcp(w, nub, arena, opt, x);
-    case Method::Kind::Assembled:
-      if (!w.haveAssembled) {
-        w.assembled = w.rows.assemble(so.sparse);
-        w.haveAssembled = true;
-      }
-      method.solver->options() = opt;
-      return method.solver->solve(w.assembled, x);
-    default: break;
+// Stage 5 with ODE's own solver or a core one (RowSolver: choice, verification, fallback).
+// Nothing usable leaves the start (the caller's warm start), as RowSolver does.
+IslandSolve solveWith(Method& method, IslandWork& w, int nub, dxWorldProcessMemArena* arena,
+                      const StepperOptions& so, std::uint64_t key, Vector& x) {
+  if (method.kind == Method::Kind::Core) {
+    method.solver->options() = so.solver;
+    return method.solver->solve(w.rows, w.x0, x, key);
   }
-  Result r;
-  r.status = Status::Unsupported;
-  r.message = method.name + " forwards whole islands and cannot solve a problem";
-  return r;
+  IslandSolve out;
+  out.problemClass = classify(w.rows);
+  out.choice = out.requested = method.name;
+  if (method.kind == Method::Kind::OdeLcp) {
+    out.result = solveWithOdeLcp(w, nub, arena, so.solver, x);
+    out.accepted = acceptable(out.result, so.acceptResidual);
+    if (!x.allFinite()) {
+      x = w.x0;
+      applyAccuracy(out.result, islandAccuracy(w.rows, x), so.solver.tolerance);
+      out.result.message += "; start kept";
+    }
+    return out;
+  }
+  out.result.status = Status::Unsupported;
+  out.result.message = method.name + " forwards whole islands and cannot solve a problem";
+  out.accepted = false;
+  return out;
 }
 
 }  // namespace
@@ -419,10 +415,9 @@ void mlcp::ode::Stepper::Impl::runIsland(const dxStepperProcessingCallContext* c
   st.joints = static_cast<int>(w.joints.size());
   st.rows = m;
   for (int i = 0; i < m; ++i) st.unbounded += w.rows.lo[i] == -kInf && w.rows.hi[i] == kInf;
-  w.haveAssembled = false;
 
   if (m > 0) {
-    // Stage 4: warm start.
+    // Stage 4: warm start (zeros where nothing matches).
     w.x0.setZero(m);
     bool warm = false;
     if (options.warmStart)
@@ -431,44 +426,26 @@ void mlcp::ode::Stepper::Impl::runIsland(const dxStepperProcessingCallContext* c
                                   options.contactMatchDistance);
     st.warmStarted = warm;
 
-    // Stage 5: solve, check, fall back.
+    // Stage 5: solve, verify, fall back (RowSolver), keyed by the island's first body.
+    const std::uint64_t key = reinterpret_cast<std::uintptr_t>(body[0]);
     const double ts = nowSeconds();
-    Result r = solveWith(primary, w, nub, ctx->m_stepperArena, options, warm, w.x);
-    bool ok = usable(r, w.x, m);
-    double res = ok ? r.residual : kInf;  // the solver's result carries the checked residual
-    if (hasFallback && (!ok || (r.status == Status::Failed && res > options.fallbackResidual))) {
-      Result rf = solveWith(fallback, w, nub, ctx->m_stepperArena, options, warm, w.xAlt);
-      const double resf = usable(rf, w.xAlt, m) ? rf.residual : kInf;
-      if (resf < res) {
-        st.fellBack = true;
-        rf.message = fallback.name + " after " + primary.name + " (" + toString(r.status) +
-                     ", residual " + std::to_string(res) + "): " + rf.message;
-        rf.iterations += r.iterations;
-        r = std::move(rf);
-        std::swap(w.x, w.xAlt);
-        res = resf;
-        ok = true;
-      }
-    }
-    if (!ok) {
-      // Nothing usable: apply no constraint forces rather than NaN.
-      w.x.setZero(m);
-      res = islandAccuracy(w.rows, w.x).residual;
-      r.message = "no usable answer (" + std::string(toString(r.status)) + ": " + r.message +
-                  "); constraint forces set to zero";
-    }
+    const IslandSolve solved = solveWith(primary, w, nub, ctx->m_stepperArena, options, key, w.x);
     st.solveSeconds = nowSeconds() - ts;
-    st.status = r.status;
-    st.iterations = r.iterations;
-    st.residual = res;
-    st.message = r.message;
+    st.status = solved.result.status;
+    st.iterations = solved.result.iterations;
+    st.residual = solved.result.residual;
+    st.message = solved.result.message;
+    st.choice = solved.choice;
+    st.fellBack = solved.fellBack;
+    st.accepted = solved.accepted;
 
     if (hasReference) {
       const double tr = nowSeconds();
-      Result rr = solveWith(reference, w, nub, ctx->m_stepperArena, options, warm, w.xAlt);
+      const IslandSolve rr =
+          solveWith(reference, w, nub, ctx->m_stepperArena, options, key, w.xAlt);
       st.referenceSeconds = nowSeconds() - tr;
-      if (usable(rr, w.xAlt, m)) {
-        st.referenceResidual = islandAccuracy(w.rows, w.xAlt).residual;
+      if (std::isfinite(rr.result.residual) && w.xAlt.size() == m) {
+        st.referenceResidual = rr.result.residual;
         st.referenceDifference =
             (w.xAlt - w.x).lpNorm<Eigen::Infinity>() / (1 + w.x.lpNorm<Eigen::Infinity>());
       } else {
@@ -480,6 +457,7 @@ void mlcp::ode::Stepper::Impl::runIsland(const dxStepperProcessingCallContext* c
     w.x.resize(0);
     st.residual = 0;
     st.message = "no constraint rows";
+    st.choice = "none";
   }
 
   // Stage 6: store impulses and integrate.

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "mlcp/ode/stepper.hpp"
+#include "mlcp/row_solver.hpp"
 #include "mlcp/rows.hpp"
 #include "mlcp/solver.hpp"
 #include "ode_internal.hpp"
@@ -22,19 +23,18 @@ struct Method {
     ForwardStep,       // ODE's dxStepIsland does the whole island
     ForwardQuickStep,  // ODE's dxQuickStepIsland does the whole island
     OdeLcp,            // ODE's dxSolveLCP on our rows
-    RowPgs,            // mlcp::RowPgs on our rows
-    Assembled,         // a core solver on RowSystem::assemble()
+    Core,              // mlcp::RowSolver on our rows (a core solver or "auto", verified)
   };
-  Kind kind = Kind::Assembled;
+  Kind kind = Kind::Core;
   std::string name;
-  std::unique_ptr<Solver> solver;  // Assembled only
-  RowPgs rowPgs;                   // RowPgs only
+  std::unique_ptr<RowSolver> solver;  // Core only
 
   bool forwards() const { return kind == Kind::ForwardStep || kind == Kind::ForwardQuickStep; }
 };
 
-// Throws std::invalid_argument for an unknown name.
-Method makeMethod(const std::string& name);
+// Throws std::invalid_argument for an unknown name. Core methods get a RowSolver with these
+// settings (its solver set to `name`).
+Method makeMethod(const std::string& name, RowSolverSettings settings);
 
 // The last step's lambda, to warm-start this step's.
 class WarmStartCache {
@@ -83,8 +83,6 @@ struct IslandWork {
   RowSystem rows;
   std::vector<Vector6> bodyTmp;  // per body: M^-1 f_ext + v/h, later J^T lambda
   Vector x, x0, xAlt;
-  Problem assembled;
-  bool haveAssembled = false;
   // ODE's dense layout for dxSolveLCP: A (m x dPAD(m)), (b, x) and (lo, hi) pairs, findex.
   std::vector<double> odeA, odeBx, odeLh;
   std::vector<int> odeFindex;
@@ -95,8 +93,8 @@ struct IslandWork {
 struct mlcp::ode::Stepper::Impl {
   std::string name;
   StepperOptions options;
-  Method primary, fallback, reference;
-  bool hasFallback = false, hasReference = false;
+  Method primary, reference;
+  bool hasReference = false;
   StepStats stats;
   WarmStartCache warm;
   IslandWork work;

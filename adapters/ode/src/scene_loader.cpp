@@ -33,7 +33,7 @@ class OdeWorld : public scene::World {
     } else if (run.solver == "ode-quick") {
       stepperName = "ode-quickstep";
       quick_ = true;
-    } else if (!makeSolver(run.solver)) {
+    } else if (!RowSolver::known(run.solver)) {
       throw std::invalid_argument("unknown solver '" + run.solver +
                                   "' for ODE (known: " + worldSolverNames() + ")");
     }
@@ -42,7 +42,7 @@ class OdeWorld : public scene::World {
     options.solver.tolerance = run.tolerance;
     options.warmStart = run.warmStart;
     options.fallback = run.fallback;  // the stepper never falls back from "ode-..."
-    options.fallbackResidual = run.fallbackResidual;
+    options.acceptResidual = run.fallbackResidual;
     stepper_ = std::make_unique<Stepper>(stepperName, options);
     iterations_ = run.iterations;
 
@@ -89,12 +89,27 @@ class OdeWorld : public scene::World {
   }
   const char* engine() const override { return "ode"; }
 
+  bool captureNextStep(const std::string& folder) override {
+    captured_.clear();
+    if (!stepper_->rowSolver()) return false;
+    capturing_ = true;
+    stepper_->rowSolver()->setCapture(
+        scene::capturePrefix(folder, scene().name, engine(), stepsTaken()));
+    return true;
+  }
+  std::vector<std::string> capturedFiles() const override { return captured_; }
+
  protected:
   void stepEngine(scene::StepMeasures& m) override {
     contactCount_ = 0;
     deepest_ = 0;
     dSpaceCollide(space_, this, &OdeWorld::nearCallback);
     stepper_->step(world_, scene().settings.timeStep);
+    if (capturing_) {
+      captured_ = stepper_->rowSolver()->capturedFiles();
+      stepper_->rowSolver()->setCapture("");
+      capturing_ = false;
+    }
     dJointGroupEmpty(contacts_);
     const StepStats& st = stepper_->lastStep();
     double seconds = 0;
@@ -107,6 +122,7 @@ class OdeWorld : public scene::World {
     }
     m.solverMs = 1e3 * seconds;
     m.fallbacks = st.fallbacks();
+    if (!quick_ && stepper_->rowSolver()) m.choice = st.choices().toString();
     m.contacts = contactCount_;
     m.maxPenetration = deepest_;
     if (quick_) {
@@ -234,8 +250,9 @@ class OdeWorld : public scene::World {
   }
 
   std::unique_ptr<Stepper> stepper_;
-  bool quick_ = false;
+  bool quick_ = false, capturing_ = false;
   int iterations_ = 0;
+  std::vector<std::string> captured_;
   dWorldID world_ = nullptr;
   dSpaceID space_ = nullptr;
   dJointGroupID contacts_ = nullptr;

@@ -63,6 +63,12 @@ int StepStats::fallbacks() const {
                                         [](const IslandStats& s) { return s.fellBack; }));
 }
 
+ChoiceCounts StepStats::choices() const {
+  ChoiceCounts counts;
+  for (const IslandStats& s : islands) counts.add(s.choice);
+  return counts;
+}
+
 double StepStats::maxResidual() const {
   double r = 0;
   for (const IslandStats& s : islands)
@@ -82,17 +88,24 @@ Stepper::Stepper(const std::string& solver, const StepperOptions& options)
     : impl_(std::make_unique<Impl>()) {
   impl_->name = solver;
   impl_->options = options;
-  impl_->primary = makeMethod(solver);
-  if (!options.fallback.empty()) {
-    impl_->fallback = makeMethod(options.fallback);
-    if (impl_->fallback.forwards())
-      throw std::invalid_argument("mlcp::ode::Stepper: fallback '" + options.fallback +
-                                  "' forwards whole islands and cannot be a fallback");
-    // ODE's own solvers are there to reproduce stock ODE, answers and all.
-    impl_->hasFallback = !impl_->primary.forwards() && impl_->primary.kind != Method::Kind::OdeLcp;
-  }
+  RowSolverSettings rs;
+  rs.options = options.solver;
+  rs.fallback = options.fallback;
+  rs.fallbackOptions = options.fallbackOptions;
+  rs.acceptResidual = options.acceptResidual;
+  rs.denseMaxRows = options.denseMaxRows;
+  if (!options.fallback.empty() && !RowSolver::known(options.fallback))
+    throw std::invalid_argument("mlcp::ode::Stepper: fallback '" + options.fallback +
+                                "' is not a core solver (known: " + solverNames() + ")");
+  // ODE's own solvers ("ode-...") are there to reproduce stock ODE, answers and all: they never
+  // fall back.
+  impl_->primary = makeMethod(solver, rs);
   if (!options.reference.empty()) {
-    impl_->reference = makeMethod(options.reference);
+    // The reference only measures: no fallback, every answer kept.
+    RowSolverSettings ref = rs;
+    ref.fallback = "";
+    ref.acceptResidual = kInf;
+    impl_->reference = makeMethod(options.reference, ref);
     if (impl_->reference.forwards())
       throw std::invalid_argument("mlcp::ode::Stepper: reference '" + options.reference +
                                   "' forwards whole islands and cannot be a reference");
@@ -107,6 +120,7 @@ const StepperOptions& Stepper::options() const { return impl_->options; }
 mlcp::Options& Stepper::solverOptions() { return impl_->options.solver; }
 const StepStats& Stepper::lastStep() const { return impl_->stats; }
 void Stepper::resetWarmStart() { impl_->warm.clear(); }
+RowSolver* Stepper::rowSolver() { return impl_->primary.solver.get(); }
 
 bool Stepper::step(dWorldID world, dReal h) {
   if (!world) throw std::invalid_argument("mlcp::ode::Stepper::step: null world");
@@ -143,7 +157,7 @@ unsigned Stepper::Impl::estimateMaxCallCount(unsigned activeThreads, unsigned al
 sizeint Stepper::Impl::memoryFor(dxBody* const* body, unsigned nb, dxJoint* const* joint,
                                  unsigned nj) const {
   sizeint need = 0;
-  for (const Method* m : {&primary, &fallback, &reference}) {
+  for (const Method* m : {&primary, &reference}) {
     switch (m->kind) {
       case Method::Kind::ForwardStep:
         if (m == &primary)
@@ -154,7 +168,7 @@ sizeint Stepper::Impl::memoryFor(dxBody* const* body, unsigned nb, dxJoint* cons
           need = std::max(need, dxEstimateQuickStepMemoryRequirements(body, nb, joint, nj));
         break;
       case Method::Kind::OdeLcp:
-        if (m == &primary || (m == &fallback && hasFallback) || (m == &reference && hasReference))
+        if (m == &primary || hasReference)
           need = std::max(need, dxEstimateSolveLCPMemoryReq(sureMaxRows(joint, nj), false));
         break;
       default: break;

@@ -45,6 +45,8 @@ enum class ProblemClass {
   Findex,       // at least one friction-coupled row
 };
 const char* toString(ProblemClass c);
+// The class from the bounds and findex alone (size n = lo.size(); findex may be empty).
+ProblemClass classifyBounds(const Vector& lo, const Vector& hi, const std::vector<int>& findex);
 
 class Problem {
  public:

@@ -164,8 +164,8 @@ struct Settings {
 
 // What `mlcp run` uses when the command line names no solver settings.
 struct SolverDefaults {
-  // A name known to mlcp::makeSolver (registry.hpp). Default "pgs".
-  std::string name = "pgs";
+  // A name known to mlcp::makeSolver (registry.hpp); "auto" chooses per island. Default "auto".
+  std::string name = "auto";
   // Options::maxIterations. Default 50.
   int iterations = 50;
   // Options::tolerance (scaled natural-map residual). Default 1e-6.

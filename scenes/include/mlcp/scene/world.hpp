@@ -26,15 +26,16 @@
 #include <string>
 #include <vector>
 
+#include "mlcp/row_solver.hpp"
 #include "mlcp/scene/scene.hpp"
 
 namespace mlcp::scene {
 
 // What a run uses: the solver and its limits. fromScene() takes the scene's `solver` defaults.
 struct RunSettings {
-  // A core registry name (through our adapters) or an engine's stock solver name ("bullet-si",
-  // "ode-world", ...; each loader lists its own). Default "pgs".
-  std::string solver = "pgs";
+  // A core registry name (through our adapters; "auto" chooses per island) or an engine's
+  // stock solver name ("bullet-si", "ode-world", ...; each loader lists its own). Default "auto".
+  std::string solver = "auto";
   // Sweeps (iterative) or outer iterations (pivoting); stock iterative solvers' iteration count.
   // Default 50.
   int iterations = 50;
@@ -45,11 +46,11 @@ struct RunSettings {
   // Core solver run when the primary's answer is rejected, "" for none (core solvers only).
   // Default "pgs" (the adapters' default, with the core's default options).
   std::string fallback = "pgs";
-  // Scaled residual above which the primary's answer goes to the fallback. Default 1e-3. The
-  // adapters differ here: Bullet's drop-in rejects any answer above it (Settings::
-  // acceptResidual), ODE's stepper only unusable or Failed ones (StepperOptions::
-  // fallbackResidual), not answers that merely ran out of iterations.
-  double fallbackResidual = 1e-3;
+  // Largest accepted scaled residual, the same rule in both engines (mlcp::acceptable in
+  // mlcp/row_solver.hpp: an answer that is not finite, is Failed, or whose recomputed residual
+  // is above this goes to the fallback; the better answer is kept). Default 1e-3, the adapters'
+  // mlcp::kDefaultAcceptResidual; +inf accepts any finite answer.
+  double fallbackResidual = kDefaultAcceptResidual;
 
   static RunSettings fromScene(const Scene& scene);
 };
@@ -104,7 +105,8 @@ class World {
   virtual const char* engine() const = 0;
 
   // Asks the engine to write, during the next step(), each island's MLCP as an mlcp-problem/1
-  // file in `folder` (named <scene>-<engine>-step<N>-island<K>.json). Returns false when this
+  // file in `folder` (named <scene>-<engine>-step<N>-island<K>.json, N = stepsTaken() before
+  // that step, K counting the step's solves from 0). Returns false when this
   // engine/solver cannot (stock solvers): nothing is written then. The files written are
   // listed by capturedFiles() after that step.
   virtual bool captureNextStep(const std::string& folder) {
@@ -130,6 +132,11 @@ class World {
 // tests. `anchors` as kept by World.
 void measureStates(const Scene& scene, const std::vector<BodyState>& states,
                    const std::vector<std::pair<Vec3, Vec3>>& anchors, StepMeasures& m);
+
+// What captureNextStep's files start with: folder/<scene>-<engine>-step<N>- (the engines' row
+// solvers append island<K>.json).
+std::string capturePrefix(const std::string& folder, const std::string& scene, const char* engine,
+                          int step);
 
 // Whether every number of the state is finite (a blown-up simulation is not).
 bool isFinite(const BodyState& b);

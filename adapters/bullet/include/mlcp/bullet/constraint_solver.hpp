@@ -29,13 +29,13 @@
 //     (Bullet's applied impulse divided by m_warmstartingFactor, 0.85: SI's setup has already
 //     applied the scaled impulse to the solver bodies, and the write-back below only applies
 //     the difference), 0 for joints (SI does not warm-start them).
-//  5. solve — "pgs" runs on the rows themselves (mlcp::RowPgs, O(nnz J) per sweep, no matrix);
-//     every other core solver gets A = J M^-1 J^T + diag(cfm) assembled from the body graph,
-//     dense for small islands and sparse above Settings::denseMaxRows.
-//  6. check — every answer is accepted only when it is finite and its scaled natural-map
-//     residual (mlcp::accuracy, recomputed here) is <= Settings::acceptResidual; otherwise the
-//     fallback solver runs from the same start, and the better of the two answers is kept. Both
-//     events are counted in StepStats.
+//  5. solve and 6. check — mlcp::RowSolver (mlcp/row_solver.hpp), shared with the ODE adapter:
+//     it classifies the island (bilateral only, frictionless contacts, boxed, friction), runs
+//     the named solver or `auto`'s choice ("pgs" on the rows, others on an assembled A, dense up
+//     to Settings::denseMaxRows rows), accepts the answer only when it is finite, not Failed
+//     and its recomputed residual is <= Settings::acceptResidual, and otherwise runs the
+//     fallback from the same start and keeps the better answer. StepStats counts the choices,
+//     the fallbacks and the answers rejected even after the fallback.
 //  7. store impulses — per row delta = x - appliedImpulse goes through btSolverBody::
 //     internalApplyImpulse (as btMLCPSolver does); SI's finish then writes contact impulses,
 //     joint feedback, breaking thresholds, velocities and transforms.
@@ -53,6 +53,7 @@
 
 #include "mlcp/bullet/islands.hpp"
 #include "mlcp/result.hpp"
+#include "mlcp/row_solver.hpp"
 #include "mlcp/rows.hpp"
 #include "mlcp/solver.hpp"
 
@@ -68,28 +69,16 @@ enum class CfmModel {
   StockMlcp,
 };
 
-struct Settings {
-  // Core solver by registry name (mlcp::solverNames()), or "si" for Bullet's own sequential
-  // impulse iterations. Default "pgs".
-  std::string solver = "pgs";
-  // Options of the primary solver (tolerance, iteration and pivot limits, ...). warmStart is
-  // governed by Settings::warmStart. Default: core defaults.
-  Options options;
-  // Solver that runs when the primary's answer is rejected, "" for none. Default "pgs".
-  std::string fallback = "pgs";
-  // Options of the fallback. Default: core defaults (tolerance 1e-10, 1000 sweeps).
-  Options fallbackOptions;
-  // Largest scaled natural-map residual (dimensionless) at which an answer is accepted. Set it to
-  // +inf for SI-like fixed-iteration PGS. Default 1e-6.
-  double acceptResidual = 1e-6;
+// The island solver's settings (mlcp::RowSolverSettings: solver "auto", options, fallback "pgs",
+// fallbackOptions, acceptResidual 1e-3, denseMaxRows 64; documented in mlcp/row_solver.hpp,
+// the same defaults as the ODE adapter's), plus Bullet's own. `solver` may also be "si":
+// Bullet's own sequential impulse iterations. options.warmStart is governed by warmStart below.
+struct Settings : RowSolverSettings {
   // pgs/gs take their sweep count from btContactSolverInfo::m_numIterations (as SI and the stock
   // MLCP solvers do) instead of options.maxIterations. Default false.
   bool bulletIterations = false;
   // Start every solve from Bullet's applied impulses. Default true.
   bool warmStart = true;
-  // Islands with at most this many rows give matrix-based solvers a dense A, larger ones a
-  // sparse A. Default 64.
-  int denseMaxRows = 64;
   // Regularisation model; see CfmModel. Default Engine.
   CfmModel cfm = CfmModel::Engine;
   // Keep every island's rows, start, answer and result of the last step (for tests and tools;
@@ -106,7 +95,7 @@ struct IslandRecord {
   Vector start;        // warm start given to the solver
   Vector x;            // the answer written back
   Result result;       // of the answer written back
-  std::string solver;  // which solver gave it ("dantzig", "pgs" after a fallback, "si")
+  std::string solver;  // which solver gave it ("dantzig", "ldlt", "pgs" after a fallback, "si")
   bool split = false;  // the split-impulse (position) problem
   bool fellBack = false;
 };
@@ -124,15 +113,11 @@ struct StepStats {
   double seconds = 0;          // wall time of stages 2-7 (SI: its iterations), summed over groups
   double measureSeconds = 0;   // time spent measuring residuals outside the solve (si only)
   double assembleSeconds = 0;  // part of `seconds` spent assembling A for matrix-based solvers
-  int fallbacks = 0;           // islands whose primary answer was rejected
-  int failures = 0;            // islands where the fallback's answer was rejected too
+  int fallbacks = 0;           // islands whose primary answer was rejected (the fallback ran)
+  int failures = 0;            // islands whose returned answer is still rejected
   std::string message;         // why the first rejected answer was rejected ("" if none)
+  ChoiceCounts choices;        // which solver answered, per island ("dantzig:3 ldlt:1")
 };
-
-// The check every answer passes (drop-in and bridge alike): the solver ran (not InvalidInput or
-// Unsupported), and the recomputed scaled residual is finite and <= acceptResidual. The status
-// itself is not trusted either way.
-bool acceptable(const Result& r, double acceptResidual);
 
 class ConstraintSolver : public btSequentialImpulseConstraintSolver {
  public:
@@ -147,6 +132,8 @@ class ConstraintSolver : public btSequentialImpulseConstraintSolver {
   const StepStats& totals() const { return totals_; }
   // With Settings::keepIslands: the problems of the last step.
   const std::vector<IslandRecord>& islands() const { return records_; }
+  // The shared island solver (null with "si"): its capture hook writes each island's problem.
+  RowSolver* rowSolver() { return rows_.get(); }
 
   void prepareSolve(int numBodies, int numManifolds) override;
   void allSolved(const btContactSolverInfo& info, btIDebugDraw* debugDrawer) override;
@@ -159,19 +146,19 @@ class ConstraintSolver : public btSequentialImpulseConstraintSolver {
                                              btIDebugDraw* debugDrawer) override;
 
  private:
-  void solveIsland(Island& island, const btContactSolverInfo& info, bool split);
+  void solveIsland(Island& island, std::uint64_t key, bool split);
   void measureSi(int sweeps);
-  void record(const Result& r, int rows);
+  void record(const Result& r, int rows, const std::string& choice);
   void finishStep();
 
   Settings settings_;
-  std::unique_ptr<Solver> primary_, secondary_;
-  bool primaryIsRowPgs_ = false, secondaryIsRowPgs_ = false, si_ = false;
+  std::unique_ptr<RowSolver> rows_;
+  bool si_ = false;
   IslandBuilder builder_;
   StepStats current_, last_, totals_;
   bool stepOpen_ = false;
   std::vector<IslandRecord> records_;
-  Vector xPrimary_, xSecondary_;
+  Vector x_;
 };
 
 }  // namespace mlcp::bullet

@@ -7,8 +7,8 @@
 //
 // The stock solver hands over a dense A (it builds one for every island), Bullet's b (minus
 // ours: converted here), lo/hi (contacts [0, 1e10]), limitDependency (= findex) and x holding
-// the applied impulses (used as the warm start). The answer is checked like the drop-in's
-// (finite, scaled residual <= acceptResidual); returning false makes btMLCPSolver count a
+// the applied impulses (used as the warm start). The answer is checked by the drop-in's rule
+// (mlcp::acceptable, mlcp/row_solver.hpp); returning false makes btMLCPSolver count a
 // fallback and run its SI iterations. For large problems prefer the drop-in
 // mlcp::bullet::ConstraintSolver: it never builds the dense matrix and splits islands.
 #pragma once
@@ -20,6 +20,7 @@
 
 #include "mlcp/problem.hpp"
 #include "mlcp/result.hpp"
+#include "mlcp/row_solver.hpp"
 #include "mlcp/solver.hpp"
 
 namespace mlcp::bullet {
@@ -30,11 +31,11 @@ class MlcpBridge : public btMLCPSolverInterface {
   explicit MlcpBridge(const std::string& solver, const Options& options = Options());
 
   Solver& solver() { return *solver_; }
-  // Largest accepted scaled residual (dimensionless). Default 1e-6.
-  double acceptResidual = 1e-6;
+  // Largest accepted scaled residual (dimensionless). Default mlcp::kDefaultAcceptResidual.
+  double acceptResidual = kDefaultAcceptResidual;
   // Problems with more rows than this are converted to sparse storage (dropping A's zeros).
-  // Default 64.
-  int denseMaxRows = 64;
+  // Default mlcp::kDefaultDenseMaxRows (64).
+  int denseMaxRows = kDefaultDenseMaxRows;
   // pgs/gs take their sweep count from the numIterations argument (as the stock PGS does).
   // Default false.
   bool bulletIterations = false;

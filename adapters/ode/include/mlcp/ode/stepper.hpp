@@ -1,6 +1,6 @@
 // mlcp/ode/stepper.hpp: any core solver as ODE's island stepper.
 //
-//     mlcp::ode::Stepper stepper("dantzig");   // or "pgs", "lemke", ... (mlcp::solverNames())
+//     mlcp::ode::Stepper stepper;               // "auto", or "dantzig", "pgs", ... by name
 //     stepper.step(world, h);                   // instead of dWorldStep(world, h)
 //
 // How it plugs in. dWorldStep is two calls into ODE's world processing:
@@ -24,9 +24,11 @@
 //      w = A x + b, so b = -rhs; lo, hi and findex (made island-global) are copied;
 //   4. warm start: lambda of the last step per joint (per contact: matched by body pair,
 //      order and position), when the solver can use it;
-//   5. solve: "pgs" runs mlcp::RowPgs on the rows (O(nnz J) per sweep, no A); every other
-//      core solver gets RowSystem::assemble (sparse by the body graph, or dense); a verified
-//      fallback runs when the primary's answer is unusable or far off;
+//   5. solve: mlcp::RowSolver (mlcp/row_solver.hpp), shared with the Bullet adapter: it
+//      classifies the island, runs the named solver or `auto`'s choice ("pgs" on the rows,
+//      others on an assembled A, dense up to denseMaxRows rows), accepts the answer only when it
+//      is finite, not Failed and its recomputed residual is <= acceptResidual, and otherwise
+//      runs the fallback from the same start and keeps the better answer;
 //   6. store impulses: constraint force J^T lambda per body and joint feedback exactly as
 //      dxStepIsland fills it, v += h M^-1 (f_ext + J^T lambda), dxStepBody, zero accumulators.
 //
@@ -48,6 +50,7 @@
 #include <vector>
 
 #include "mlcp/result.hpp"
+#include "mlcp/row_solver.hpp"
 
 namespace mlcp::ode {
 
@@ -61,17 +64,20 @@ struct StepperOptions {
   // bodies, have the same rank among that pair's contacts, and their positions are closer
   // than this distance (in ODE's length unit, m). Default 0.05.
   double contactMatchDistance = 0.05;
-  // Assemble A in sparse storage for solvers that take an assembled problem (all but "pgs");
-  // false builds it dense. Default true.
-  bool sparse = true;
-  // Solver name run when the primary's answer is unusable (not finite, invalid, unsupported)
-  // or Failed with a residual above fallbackResidual; its answer is taken only when its
-  // residual is lower. "" disables the fallback; "ode-..." primaries never fall back. Default
-  // "pgs".
+  // Islands with at most this many rows give matrix-based solvers (all but "pgs") a dense A,
+  // larger ones a sparse A. Default mlcp::kDefaultDenseMaxRows (64).
+  int denseMaxRows = kDefaultDenseMaxRows;
+  // Core solver run when the primary's answer is rejected (mlcp::acceptable: not finite,
+  // Failed, NumericalIssue, InvalidInput, Unsupported, or residual above acceptResidual); the
+  // better of the two answers is applied. "" disables the fallback; "ode-..." primaries never
+  // fall back. Default "pgs".
   std::string fallback = "pgs";
-  // Residual (scaled natural-map, see mlcp/residual.hpp) above which a Failed primary answer
-  // is handed to the fallback. Default 1e-3.
-  double fallbackResidual = 1e-3;
+  // Options of the fallback. Default: core defaults (tolerance 1e-10, 1000 sweeps).
+  mlcp::Options fallbackOptions;
+  // Largest accepted scaled natural-map residual (mlcp/residual.hpp), dimensionless; +inf
+  // accepts any finite answer. Default mlcp::kDefaultAcceptResidual (1e-3), as in the Bullet
+  // adapter.
+  double acceptResidual = kDefaultAcceptResidual;
   // Diagnostics: a second solver (any name the stepper accepts except the forwarding ones) run
   // on the same island problem after the primary; its residual and time go to IslandStats,
   // its answer is discarded. "" for none. Default "".
@@ -87,7 +93,11 @@ struct IslandStats {
   double residual = kNotComputed;  // of the answer applied to the bodies
   Status status = Status::Converged;
   std::string message;
-  bool fellBack = false;  // the fallback's answer was applied
+  // The solver whose answer was applied: a core name ("dantzig", "ldlt", "pgs", ...; "auto"'s
+  // choice), "none" for an island without rows, or "ode-lcp"/"ode-step"/"ode-quickstep".
+  std::string choice;
+  bool fellBack = false;  // the primary's answer was rejected and the fallback ran
+  bool accepted = true;   // the applied answer passes mlcp::acceptable
   bool warmStarted = false;
   double solveSeconds = 0;                  // the solver(s) only
   double islandSeconds = 0;                 // the whole island, rows to integration
@@ -102,8 +112,9 @@ struct StepStats {
   std::vector<IslandStats> islands;
   double seconds = 0;  // the whole step() call
   int rows() const;
-  int fallbacks() const;
-  double maxResidual() const;  // over islands with rows; 0 when there are none
+  int fallbacks() const;         // islands that fell back
+  ChoiceCounts choices() const;  // IslandStats::choice counted over the islands
+  double maxResidual() const;    // over islands with rows; 0 when there are none
   int maxIterations() const;
 };
 
@@ -111,7 +122,7 @@ class Stepper {
  public:
   // Throws std::invalid_argument naming the known solvers when `solver` (or options.fallback,
   // options.reference) is not a name the stepper knows.
-  explicit Stepper(const std::string& solver, const StepperOptions& options = {});
+  explicit Stepper(const std::string& solver = "auto", const StepperOptions& options = {});
   ~Stepper();
   Stepper(const Stepper&) = delete;
   Stepper& operator=(const Stepper&) = delete;
@@ -128,6 +139,9 @@ class Stepper {
   const StepStats& lastStep() const;
   // Forget the warm-start cache (e.g. after teleporting bodies).
   void resetWarmStart();
+  // The shared island solver of a core primary (null for "ode-..."): its capture hook writes
+  // each island's problem.
+  RowSolver* rowSolver();
 
   // Every name accepted as a solver: the core registry's and the adapter's ("ode-...").
   static std::string knownSolvers();

@@ -1,0 +1,177 @@
+// mlcp/row_solver.hpp: the one place that solves an engine island's rows (both adapters).
+//
+//     mlcp::RowSolver solver;                      // settings: solver "auto", fallback "pgs"
+//     mlcp::IslandSolve s = solver.solve(rows, start, x, islandKey);
+//     s.choice;    // "ldlt", "dantzig", "pgs", "none", ...: the solver whose answer x is
+//     s.fellBack;  // the primary's answer was rejected and the fallback ran
+//
+// Stages per island (the Bullet drop-in and the ODE stepper both run exactly this):
+//
+//  1. classify the rows by their bounds alone (no matrix needed; ProblemClass, problem.hpp):
+//       no rows                       -> Empty:       nothing to solve ("none");
+//       every row -inf..inf            -> Linear:      bilateral joints only;
+//       every row 0..inf               -> StandardLcp: frictionless contacts;
+//       other bounds, no findex        -> Boxed:       joints with limits/motors, mixed;
+//       friction-coupled rows (findex) -> Findex:      contacts with friction.
+//  2. choose: the requested name, or with "auto" chooseSolver() below (the rules and the
+//     measurements behind them are written there).
+//  3. solve from the caller's start: "pgs" runs RowPgs on the rows themselves (O(nnz J) per
+//     sweep, no matrix); every other name gets A = J M^-1 J^T + diag(cfm) assembled once per
+//     island, dense up to denseMaxRows rows and sparse above. Solver objects live per island
+//     key and name, so the sparse analyses of ldlt and dantzig (ordering, elimination tree) are
+//     redone only when that island's pattern changes, and RowPgs' buffers are reused.
+//  4. verify, the same rule for every solver (acceptable() below): the answer is finite, its
+//     status is not Failed, NumericalIssue, InvalidInput or Unsupported, and its residual,
+//     recomputed from the problem by residual.hpp (never the solver's claim), is <=
+//     acceptResidual. A rejected answer sends the island to the fallback solver from the same
+//     start; the better of the two answers (lower residual; the primary's on a tie) is kept.
+//     When neither is usable (NaN/Inf, or nothing solved) the start itself is returned: the
+//     engine's "no change" (Bullet: the impulses already applied; ODE: last step's forces).
+//
+// acceptResidual, default 1e-3 (kDefaultAcceptResidual): the scaled natural-map residual is
+// ||x - clamp(x - w, lo', hi')||_inf / (1 + ||b||_inf); at 1e-3 the worst row's impulse error is
+// 0.1% of the island's largest velocity error term. Warm-started pgs with the scenes' 50 sweeps
+// ends at 1e-9..3e-2 on the scenes (measured with `mlcp run`): a tighter default (the Bullet
+// adapter had 1e-6) re-solved most pyramid and stack steps with the fallback's 1000 sweeps, a
+// looser one accepted pgs answers whose stacks visibly sink. +inf accepts any finite answer
+// (SI-like fixed-sweep pgs).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "mlcp/problem.hpp"
+#include "mlcp/result.hpp"
+#include "mlcp/rows.hpp"
+#include "mlcp/solver.hpp"
+
+namespace mlcp {
+
+// The acceptance limit both adapters use by default (see above). Dimensionless.
+inline constexpr double kDefaultAcceptResidual = 1e-3;
+// Largest island assembled dense for matrix-based solvers, in rows. Default 64.
+inline constexpr int kDefaultDenseMaxRows = 64;
+
+struct RowSolverSettings {
+  // A registry name (mlcp::solverNames(), "a>b" chains included), "auto" (chooseSolver per
+  // island) or "pgs" (RowPgs on the rows). Default "auto".
+  std::string solver = "auto";
+  // Options of the primary (tolerance, iteration and pivot limits, ...). warmStart is ignored:
+  // every solve starts from the caller's start. Default: core defaults.
+  Options options;
+  // Solver run when the primary's answer is rejected (any name `solver` accepts except
+  // "auto"), "" for none. Default "pgs".
+  std::string fallback = "pgs";
+  // Options of the fallback. Default: core defaults (tolerance 1e-10, 1000 sweeps).
+  Options fallbackOptions;
+  // Largest accepted scaled natural-map residual (dimensionless); +inf accepts any finite
+  // answer. Default kDefaultAcceptResidual (1e-3).
+  double acceptResidual = kDefaultAcceptResidual;
+  // Islands with at most this many rows give matrix-based solvers a dense A, larger ones a
+  // sparse A (rows). Default kDefaultDenseMaxRows (64).
+  int denseMaxRows = kDefaultDenseMaxRows;
+};
+
+// The verification every answer passes (see stage 4 above): finite residual <= acceptResidual
+// and a status other than Failed, NumericalIssue, InvalidInput, Unsupported.
+bool acceptable(const Result& r, double acceptResidual);
+
+// ProblemClass of the rows from their bounds and findex alone (Problem::classify's rules).
+ProblemClass classify(const RowSystem& rows);
+
+// `auto`'s choice for an island of this class and size at this requested tolerance (scaled
+// residual). Rules, measured on the scenes in both engines (`mlcp run SCENE --steps 100`, mean
+// solver ms per step; see row_solver.cpp for the table):
+//   Empty                      -> "none"
+//   Linear                     -> "ldlt"    one sparse LDL^T solve, exact, analysis reused
+//   StandardLcp, Boxed, Findex
+//     rows <= kAutoPivotingRows -> "dantzig" exact pivoting answer (residual ~1e-12)
+//     larger, tolerance >= kAutoPgsTolerance -> "pgs" (rows, warm-started sweeps)
+//     larger, tighter tolerance -> "dantzig"
+const char* chooseSolver(ProblemClass c, int rows, double tolerance);
+// Largest contact island handed to dantzig whatever the tolerance (rows). See chooseSolver.
+inline constexpr int kAutoPivotingRows = 600;
+// Loosest requested tolerance at which large contact islands go to pgs. See chooseSolver.
+inline constexpr double kAutoPgsTolerance = 1e-4;
+
+// What one island's solve gives back.
+struct IslandSolve {
+  // The returned answer's result: status, iterations, residual (recomputed), seconds (the
+  // primary's and the fallback's, assembly included), message (with the rejection reason).
+  Result result;
+  ProblemClass problemClass = ProblemClass::Empty;
+  std::string choice;          // the solver whose answer was returned ("none" for no rows)
+  std::string requested;       // the primary that ran ("auto"'s choice, or the requested name)
+  bool fellBack = false;       // the primary's answer was rejected and the fallback ran
+  bool accepted = true;        // the returned answer passes acceptable()
+  double assembleSeconds = 0;  // part of result.seconds spent assembling A
+};
+
+// Counts of IslandSolve::choice over a step, e.g. "dantzig:3 ldlt:1 none:2".
+class ChoiceCounts {
+ public:
+  void add(const std::string& choice, int count = 1);
+  void add(const ChoiceCounts& other);
+  void clear() { counts_.clear(); }
+  int count(const std::string& choice) const;
+  int total() const;
+  // "name:count" pairs in name order, space separated; "" when empty.
+  std::string toString() const;
+  const std::vector<std::pair<std::string, int>>& counts() const { return counts_; }
+
+ private:
+  std::vector<std::pair<std::string, int>> counts_;  // sorted by name
+};
+
+class RowSolver {
+ public:
+  // Throws std::invalid_argument naming the known solvers for an unknown solver or fallback
+  // name, and for a negative or NaN acceptResidual.
+  explicit RowSolver(const RowSolverSettings& settings = RowSolverSettings());
+  ~RowSolver();
+  RowSolver(const RowSolver&) = delete;
+  RowSolver& operator=(const RowSolver&) = delete;
+
+  const RowSolverSettings& settings() const { return settings_; }
+  // The primary's and fallback's options may be changed between solves (names may not).
+  Options& options() { return settings_.options; }
+  Options& fallbackOptions() { return settings_.fallbackOptions; }
+
+  // Solves the island's rows from `start` (size rows.size(), used as given: pass zeros for a
+  // cold start) into x. islandKey identifies the island across steps (any stable number, e.g.
+  // its first body's address); solver workspaces are kept per key.
+  IslandSolve solve(const RowSystem& rows, const Vector& start, Vector& x,
+                    std::uint64_t islandKey = 0);
+
+  // While prefix is not "", every solve() with rows writes the island's assembled problem
+  // (mlcp-problem/1, io.hpp) to prefix + "island<K>.json", K = 0, 1, ... from this call on.
+  void setCapture(const std::string& prefix);
+  // The files written since the last setCapture.
+  const std::vector<std::string>& capturedFiles() const { return captured_; }
+
+  // Whether a name can be given as `solver` / `fallback`.
+  static bool known(const std::string& name);
+
+ private:
+  struct Slot;
+  Solver* assembledSolver(std::uint64_t key, const std::string& name);
+  Result run(const RowSystem& rows, const std::string& name, const Options& options,
+             const Vector& start, Vector& x, std::uint64_t key, IslandSolve& report);
+  void capture(const RowSystem& rows);
+
+  RowSolverSettings settings_;
+  RowPgs rowPgs_;
+  Problem assembled_;
+  bool haveAssembled_ = false;
+  Vector xFallback_;
+  std::unordered_map<std::uint64_t, std::unique_ptr<Slot>> slots_;
+  std::uint64_t calls_ = 0;
+  std::string capturePrefix_;
+  std::vector<std::string> captured_;
+};
+
+}  // namespace mlcp

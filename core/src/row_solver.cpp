@@ -1,0 +1,225 @@
+#include "mlcp/row_solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "mlcp/io.hpp"
+#include "mlcp/registry.hpp"
+#include "mlcp/residual.hpp"
+
+namespace mlcp {
+
+bool acceptable(const Result& r, double acceptResidual) {
+  switch (r.status) {
+    case Status::Failed:
+    case Status::NumericalIssue:
+    case Status::InvalidInput:
+    case Status::Unsupported: return false;
+    default: break;
+  }
+  return std::isfinite(r.residual) && r.residual <= acceptResidual;
+}
+
+ProblemClass classify(const RowSystem& rows) {
+  return classifyBounds(rows.lo, rows.hi, rows.findex);
+}
+
+const char* chooseSolver(ProblemClass c, int rows, double tolerance) {
+  switch (c) {
+    case ProblemClass::Empty: return "none";
+    case ProblemClass::Linear: return "ldlt";
+    default: break;
+  }
+  if (rows > kAutoPivotingRows && tolerance >= kAutoPgsTolerance) return "pgs";
+  return "dantzig";
+}
+
+// --- choice counts --------------------------------------------------------------------------
+
+void ChoiceCounts::add(const std::string& choice, int count) {
+  auto it =
+      std::lower_bound(counts_.begin(), counts_.end(), choice,
+                       [](const auto& entry, const std::string& c) { return entry.first < c; });
+  if (it != counts_.end() && it->first == choice)
+    it->second += count;
+  else
+    counts_.insert(it, {choice, count});
+}
+
+void ChoiceCounts::add(const ChoiceCounts& other) {
+  for (const auto& [choice, count] : other.counts_) add(choice, count);
+}
+
+int ChoiceCounts::count(const std::string& choice) const {
+  for (const auto& [name, n] : counts_)
+    if (name == choice) return n;
+  return 0;
+}
+
+int ChoiceCounts::total() const {
+  int n = 0;
+  for (const auto& entry : counts_) n += entry.second;
+  return n;
+}
+
+std::string ChoiceCounts::toString() const {
+  std::string s;
+  for (const auto& [name, n] : counts_)
+    s += (s.empty() ? "" : " ") + name + ":" + std::to_string(n);
+  return s;
+}
+
+// --- the row solver -------------------------------------------------------------------------
+
+// The assembled-problem solvers of one island, by name, and when it was last solved.
+struct RowSolver::Slot {
+  std::vector<std::pair<std::string, std::unique_ptr<Solver>>> solvers;
+  std::uint64_t lastUse = 0;
+};
+
+namespace {
+// Islands not solved for this many calls lose their workspaces (once there are this many).
+constexpr std::size_t kSlotLimit = 1024;
+}  // namespace
+
+bool RowSolver::known(const std::string& name) {
+  return name == "auto" || name == "pgs" || makeSolver(name) != nullptr;
+}
+
+RowSolver::RowSolver(const RowSolverSettings& settings) : settings_(settings) {
+  auto refuse = [](const char* what, const std::string& name, const char* extra) {
+    throw std::invalid_argument("mlcp::RowSolver: unknown " + std::string(what) + " '" + name +
+                                "' (known: " + solverNames() + extra + ")");
+  };
+  if (!known(settings_.solver)) refuse("solver", settings_.solver, "");
+  if (!settings_.fallback.empty() && (settings_.fallback == "auto" || !known(settings_.fallback)))
+    refuse("fallback", settings_.fallback, "; auto only as the primary");
+  if (!(settings_.acceptResidual >= 0))
+    throw std::invalid_argument("mlcp::RowSolver: acceptResidual must be >= 0");
+}
+
+RowSolver::~RowSolver() = default;
+
+void RowSolver::setCapture(const std::string& prefix) {
+  capturePrefix_ = prefix;
+  captured_.clear();
+}
+
+Solver* RowSolver::assembledSolver(std::uint64_t key, const std::string& name) {
+  auto it = slots_.find(key);
+  if (it == slots_.end()) {
+    if (slots_.size() >= kSlotLimit) {
+      // Forget islands that have not been solved for a while (they merged, split or slept).
+      for (auto old = slots_.begin(); old != slots_.end();)
+        old = old->second->lastUse + kSlotLimit < calls_ ? slots_.erase(old) : std::next(old);
+    }
+    it = slots_.emplace(key, std::make_unique<Slot>()).first;
+  }
+  Slot& slot = *it->second;
+  slot.lastUse = calls_;
+  for (auto& [n, solver] : slot.solvers)
+    if (n == name) return solver.get();
+  slot.solvers.emplace_back(name, makeSolver(name));
+  return slot.solvers.back().second.get();
+}
+
+Result RowSolver::run(const RowSystem& rows, const std::string& name, const Options& options,
+                      const Vector& start, Vector& x, std::uint64_t key, IslandSolve& report) {
+  Options o = options;
+  o.warmStart = true;
+  if (name == "pgs") {
+    rowPgs_.options() = o;
+    x = start;
+    return rowPgs_.solve(rows, x);
+  }
+  if (!haveAssembled_) {
+    const double t0 = nowSeconds();
+    assembled_ = rows.assemble(rows.size() > settings_.denseMaxRows);
+    haveAssembled_ = true;
+    report.assembleSeconds += nowSeconds() - t0;
+  }
+  Solver* solver = assembledSolver(key, name);
+  solver->setOptions(o);
+  return solver->solveWithGuess(assembled_, start, x);
+}
+
+void RowSolver::capture(const RowSystem& rows) {
+  if (!haveAssembled_) {
+    assembled_ = rows.assemble(rows.size() > settings_.denseMaxRows);
+    haveAssembled_ = true;
+  }
+  const std::string path = capturePrefix_ + "island" + std::to_string(captured_.size()) + ".json";
+  io::writeProblemJson(assembled_, path);
+  captured_.push_back(path);
+}
+
+IslandSolve RowSolver::solve(const RowSystem& rows, const Vector& start, Vector& x,
+                             std::uint64_t key) {
+  const double t0 = nowSeconds();
+  ++calls_;
+  haveAssembled_ = false;
+  IslandSolve out;
+  const int n = rows.size();
+  out.problemClass = classify(rows);
+  if (n == 0) {
+    x.resize(0);
+    out.choice = out.requested = "none";
+    out.result.status = Status::Converged;
+    out.result.iterations = 0;
+    out.result.residual = out.result.complementarity = out.result.boundViolation = 0;
+    out.result.solver = "none";
+    out.result.message = "no constraint rows";
+    return out;
+  }
+  if (!capturePrefix_.empty()) capture(rows);
+
+  out.requested = settings_.solver == "auto"
+                      ? chooseSolver(out.problemClass, n, settings_.options.tolerance)
+                      : settings_.solver;
+  Result r = run(rows, out.requested, settings_.options, start, x, key, out);
+  if (r.status == Status::InvalidInput || r.status == Status::Unsupported) x = start;
+  out.choice = out.requested;
+  if (!acceptable(r, settings_.acceptResidual)) {
+    std::ostringstream why;
+    why << out.requested << " rejected (" << toString(r.status) << ", residual " << r.residual
+        << (r.message.empty() ? "" : ": ") << r.message << ")";
+    if (!settings_.fallback.empty()) {
+      out.fellBack = true;
+      Result f =
+          run(rows, settings_.fallback, settings_.fallbackOptions, start, xFallback_, key, out);
+      const bool usable = f.status != Status::InvalidInput && f.status != Status::Unsupported &&
+                          std::isfinite(f.residual);
+      if (usable && !(std::isfinite(r.residual) && r.residual <= f.residual)) {
+        f.iterations += r.iterations;
+        f.message = why.str() + "; " + settings_.fallback + ": " + f.message;
+        r = std::move(f);
+        x.swap(xFallback_);
+        out.choice = settings_.fallback;
+      } else {
+        r.message = why.str() + "; " + settings_.fallback + " no better (" + toString(f.status) +
+                    ", residual " + std::to_string(f.residual) + ")";
+      }
+    } else {
+      r.message = why.str() + "; no fallback";
+    }
+    if (!std::isfinite(r.residual)) {
+      // Nothing usable: the start is the engine's "no change".
+      x = start.allFinite() ? start : Vector::Zero(n);
+      r.message += "; start kept";
+      applyAccuracy(r,
+                    accuracy(x, rows.slack(x), rows.lo, rows.hi, rows.findex,
+                             rows.b.lpNorm<Eigen::Infinity>()),
+                    settings_.options.tolerance);
+    }
+  }
+  out.accepted = acceptable(r, settings_.acceptResidual);
+  r.solver = out.choice;
+  r.fallbacks = out.fellBack ? 1 : 0;
+  r.seconds = nowSeconds() - t0;
+  out.result = std::move(r);
+  return out;
+}
+
+}  // namespace mlcp
