@@ -226,7 +226,13 @@ int runSweep(const SweepArgs& args) {
     const std::string prefix =
         args.setting + "," + fmtValue(combo.value) + "," + (combo.applies ? "1" : "0") + ",";
     bar.start(label);
-    auto world = makeWorld(combo.engine, sc, run);  // the pair was checked above
+    std::unique_ptr<scene::World> world;
+    try {
+      world = makeWorld(combo.engine, sc, run);  // the pair was checked on the smallest scene
+    } catch (const std::exception& e) {
+      std::cerr << me << label << ": " << e.what() << "\n";
+      return kInvalidInput;
+    }
     auto lastDraw = std::chrono::steady_clock::now();
     const RunSummary sum = runWorld(*world, steps, [&](const scene::World& w, int i) {
       csv << prefix;
