@@ -702,7 +702,7 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
       settle(rep);
       return;
     }
-    blockMessage = "cold trial: " + rep.message + "; ";
+    blockMessage = "cold trial: " + rep.message;
   }
   if (warm || params_.blockStage == DantzigParams::BlockStage::Always) {
     const detail::BlockPivoting::Report rep =
@@ -713,7 +713,7 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
       return;
     }
     // x holds the best iterate: its index sets warm start the incremental pivoting.
-    blockMessage += rep.message;
+    blockMessage += (blockMessage.empty() ? "" : "; ") + rep.message;
   }
   runPivoting(problem, x, result);
   result.iterations += blockSteps_;

@@ -98,11 +98,11 @@
 // Bullet adapter's 55-box pyramid (n = 1160, warm start from the cached impulses, globalCfm
 // 1e-5): full steps alone diverge (residual 0.2 -> 25 in 4 steps) and the hand-over cost 0.7-0.85
 // s of pivoting; the damped steps reach residual ~1e-3 in 40 steps (~1.6 ms each), total 80-115
-// ms. ODE 6-base pile (n = 432): full steps settle in 1-2 steps cold (~1.2 ms) and 7-8 warm
-// (~9 ms), against ~10-12 ms for the incremental pivoting (Auto leaves the stage off there: A
-// holds 14% nonzeros). Synthetic box pyramids: a warm start settles in 1-2 full steps (55 boxes,
-// n = 1200: about 8 ms per step including assembly); from a cold start Auto does not use the
-// stage.
+// ms. ODE piles (tests/bench/ode_bench.cpp; A holds ~14% nonzeros): the all-clamped cold guess
+// settles in 1 full step (n = 432: ~2.3 ms; n = 1728: ~30 ms) where the stepper's warm guess
+// needed 6-9 steps, hence Auto's cold trial first. Synthetic box pyramids: a warm start settles
+// in 1-2 full steps (55 boxes, n = 1200: about 8 ms per step including assembly); from a cold
+// start the trial does not settle and the incremental pivoting runs from zero.
 //
 // Result::iterations counts pivots (direction computations: each row added or exchanged)
 // summed over all passes; Options::maxPivots (0: 50 n + 100) limits them per pass
