@@ -145,12 +145,13 @@ Problem RowSystem::assemble(bool sparse) const {
   return p;
 }
 
-void RowPgs::slackFromVelocities(const Vector& x) {
+void RowPgs::slackFromVelocities(const RowSystem& s, const Vector& x) {
   const int n = static_cast<int>(packed_.size());
   w_.resize(n);
   for (int i = 0; i < n; ++i) {
     const PackedRow& p = packed_[i];
-    w_[i] = p.jA.dot(velocity_[p.a].v) + p.jB.dot(velocity_[p.b].v) + p.cfm * x[i] + p.rhs;
+    const ConstraintRow& r = s.rows[i];
+    w_[i] = r.jA.dot(velocity_[p.a].v) + r.jB.dot(velocity_[p.b].v) + p.cfm * x[i] + p.rhs;
   }
 }
 
@@ -176,7 +177,7 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
   Accuracy last;           // accuracy of x as it is after the last check
   bool lastValid = false;  // whether x is unchanged since
   auto check = [&]() {
-    slackFromVelocities(x);
+    slackFromVelocities(s, x);
     last = accuracy(x, w_, s.lo, s.hi, s.findex, bNorm);
     lastValid = true;
   };
@@ -190,28 +191,25 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
   packed_.resize(n);
   velocity_.resize(world + 1);
   for (BodyVelocity& v : velocity_) v.v.setZero();
-  // One side of a row: "the world" (-1) becomes the zero-velocity slot with zero blocks.
-  auto packSide = [&](int body, const Vector6& j, int& slot, Vector6& pj, Vector6& mj) {
+  // One side of a row: "the world" (-1) becomes the zero-velocity slot (its J meets v = 0).
+  auto packSide = [&](int body, const Vector6& j, int& slot, Vector6& mj) {
     slot = body >= 0 ? body : world;
-    if (body >= 0) {
-      pj = j;
+    if (body >= 0)
       mj = applyInverseMass(s.bodies[body], j);
-    } else {
-      pj.setZero();
+    else
       mj.setZero();
-    }
   };
   for (int i = 0; i < n; ++i) {
     const ConstraintRow& r = s.rows[i];
     PackedRow& p = packed_[i];
-    packSide(r.bodyA, r.jA, p.a, p.jA, p.mA);
-    packSide(r.bodyB, r.jB, p.b, p.jB, p.mB);
+    packSide(r.bodyA, r.jA, p.a, p.mA);
+    packSide(r.bodyB, r.jB, p.b, p.mB);
     p.cfm = s.cfm[i];
     p.rhs = s.b[i];
     p.lo = s.lo[i];
     p.hi = s.hi[i];
     p.findex = s.findex.empty() ? -1 : s.findex[i];
-    const double d = p.jA.dot(p.mA) + p.jB.dot(p.mB) + p.cfm;
+    const double d = r.jA.dot(p.mA) + r.jB.dot(p.mB) + p.cfm;
     if (!(d > 0)) {
       // velocity_ does not hold M^-1 J^T x yet: the final check uses the rows themselves.
       packed_.resize(i);
@@ -223,7 +221,7 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
       lastValid = true;
       return finish();
     }
-    p.invDiag = 1.0 / d;
+    p.step = opt.relaxation / d;
     // v = M^-1 J^T x of the start.
     if (const double xi = x[i]; xi != 0) {
       velocity_[p.a].v += p.mA * xi;
@@ -232,7 +230,6 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
   }
   velocity_[world].v.setZero();  // the world never moves (its blocks are zero anyway)
 
-  const double omega = opt.relaxation;
   detail::SweepMonitor monitor(opt, result);
   if (n == 0) {
     result.status = Status::Converged;
@@ -242,16 +239,19 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
   for (int sweep = 1; n > 0 && sweep <= opt.maxIterations; ++sweep) {
     for (int i = 0; i < n; ++i) {
       const PackedRow& p = packed_[i];
+      const ConstraintRow& r = s.rows[i];
       Vector6& va = velocity_[p.a].v;
       Vector6& vb = velocity_[p.b].v;
-      const double wi = p.jA.dot(va) + p.jB.dot(vb) + p.cfm * xs[i] + p.rhs;
+      // One reduction for both bodies: the row's latency chain is the sweep's critical path.
+      const double wi =
+          (r.jA.cwiseProduct(va) + r.jB.cwiseProduct(vb)).sum() + p.cfm * xs[i] + p.rhs;
       double lo = p.lo, hi = p.hi;
       if (p.findex >= 0) {
         const double normal = std::abs(xs[p.findex]);
         lo *= normal;
         hi *= normal;
       }
-      const double xi = std::clamp(xs[i] - omega * wi * p.invDiag, lo, hi);
+      const double xi = std::clamp(xs[i] - wi * p.step, lo, hi);
       const double dx = xi - xs[i];
       xs[i] = xi;
       va += p.mA * dx;

@@ -128,6 +128,12 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
   };
 
   const double stockCfm = info.m_globalCfm / info.m_timeStep;
+  // SI starts contacts and friction from the cached impulse times m_warmstartingFactor (0.85); a
+  // solver that can use a guess gets the cached impulse itself.
+  const double unscaleContacts =
+      (info.m_warmstartingFactor > 0 && (info.m_solverMode & SOLVER_USE_WARMSTARTING))
+          ? 1.0 / info.m_warmstartingFactor
+          : 1.0;
   for (int i = 0; i < n; ++i) {
     if (rowIsland_[i] < 0) continue;
     Island& isl = islands_[rowIsland_[i]];
@@ -171,12 +177,7 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
       s.lo[r] = bound(c.m_lowerLimit);
       s.hi[r] = bound(c.m_upperLimit);
     }
-    // SI starts contacts and friction from the cached impulse times m_warmstartingFactor
-    // (0.85); a solver that can use a guess gets the cached impulse itself.
-    const double unscale =
-        (i >= nj && info.m_warmstartingFactor > 0 && (info.m_solverMode & SOLVER_USE_WARMSTARTING))
-            ? 1.0 / info.m_warmstartingFactor
-            : 1.0;
+    const double unscale = i >= nj ? unscaleContacts : 1.0;
     isl.start[r] = warmStart ? unscale * static_cast<double>(c.m_appliedImpulse) : 0.0;
     isl.splitStart[r] = warmStart ? static_cast<double>(c.m_appliedPushImpulse) : 0.0;
   }

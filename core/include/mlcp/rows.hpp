@@ -79,12 +79,12 @@ class RowPgs {
   Result solve(const RowSystem& system, Vector& x);
 
  private:
-  // One row as the sweep reads it: bodies remapped so that "the world" is a zero-velocity slot
-  // (no branches in the inner loop), J and M^-1 J^T side by side, 1 / A_ii. 64-byte aligned:
-  // four cache lines per row.
-  struct alignas(64) PackedRow {
-    Vector6 jA, jB, mA, mB;
-    double invDiag, cfm, rhs, lo, hi;
+  // What the sweep reads per row besides J (which it reads from the system's rows): bodies
+  // remapped so that "the world" is a zero-velocity slot (no branches in the inner loop),
+  // M^-1 J^T, step = omega / A_ii, and the row's scalars.
+  struct PackedRow {
+    Vector6 mA, mB;
+    double step, cfm, rhs, lo, hi;
     int a, b, findex;
   };
   // A body's velocity change padded to one cache line.
@@ -93,7 +93,7 @@ class RowPgs {
     double pad[2];
   };
   // w = J v + cfm x + b for every row, from the maintained velocities (see above).
-  void slackFromVelocities(const Vector& x);
+  void slackFromVelocities(const RowSystem& system, const Vector& x);
 
   Options options_;
   std::vector<PackedRow> packed_;  // reused between solves
