@@ -30,14 +30,23 @@ Problem boundsOnly(const RowSystem& s) {
   return p;
 }
 
-// Problem::validate's rules for b, bounds and findex as one predicate without copies: the fast
-// path of RowSystem::validate, called every step by the adapters. When it says no, the shell
-// below gives the message (Problem::validate stays the one statement of the rules' wording).
-bool boundsValid(const RowSystem& s) {
+// Every per-row rule of RowSystem::validate and Problem::validate (b, bounds, findex) as one
+// predicate in one pass without copies: the fast path of RowSystem::validate, which the adapters
+// call every step. When it says no, the checks below find the row and say what is wrong
+// (Problem::validate stays the one statement of the bound rules' wording). A false alarm (a sum
+// of finite Jacobian entries overflowing) only costs the slow path.
+bool rowsValid(const RowSystem& s) {
   const int n = s.size();
+  const unsigned slots = static_cast<unsigned>(s.bodies.size()) + 1;  // -1 .. nb - 1
   const bool coupled = !s.findex.empty();
   if (coupled && static_cast<int>(s.findex.size()) != n) return false;
   for (int i = 0; i < n; ++i) {
+    const ConstraintRow& r = s.rows[i];
+    if (static_cast<unsigned>(r.bodyA + 1) >= slots || static_cast<unsigned>(r.bodyB + 1) >= slots)
+      return false;
+    // Any NaN or Inf entry makes the sum NaN or Inf.
+    if (!std::isfinite(r.jA.sum() + r.jB.sum())) return false;
+    if (!(s.cfm[i] >= 0 && s.cfm[i] < kInf)) return false;
     const double lo = s.lo[i], hi = s.hi[i];
     // !(lo <= hi) also catches NaN bounds.
     if (!std::isfinite(s.b[i]) || !(lo <= hi) || lo == kInf || hi == -kInf) return false;
@@ -56,8 +65,8 @@ bool boundsValid(const RowSystem& s) {
 }  // namespace
 
 std::string RowSystem::validate() const {
-  std::ostringstream os;
   const int n = size();
+  std::ostringstream os;
   if (b.size() != n || lo.size() != n || hi.size() != n || cfm.size() != n) {
     os << "row arrays disagree: " << n << " rows, b " << b.size() << ", lo " << lo.size() << ", hi "
        << hi.size() << ", cfm " << cfm.size();
@@ -71,6 +80,7 @@ std::string RowSystem::validate() const {
       return os.str();
     }
   }
+  if (rowsValid(*this)) return "";
   for (int i = 0; i < n; ++i) {
     const ConstraintRow& r = rows[i];
     if (r.bodyA < -1 || r.bodyA >= nb || r.bodyB < -1 || r.bodyB >= nb) {
@@ -86,7 +96,6 @@ std::string RowSystem::validate() const {
       return os.str();
     }
   }
-  if (boundsValid(*this)) return "";
   // Problem::validate checks b, bounds and findex and says what is wrong; give it a shell.
   Problem shell = boundsOnly(*this);
   shell.setA(SparseMatrix(n, n));

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "mlcp/pgs.hpp"
@@ -151,6 +152,20 @@ TEST(RowPgs, RejectsBadRows) {
   s = stackRows(2, 4);
   s.cfm[0] = -1;
   EXPECT_EQ(RowPgs().solve(s, x).status, Status::InvalidInput);
+  // Opposite infinities cancel in no sum: the one-pass check must still see them.
+  s = stackRows(2, 4);
+  s.rows[2].jA[1] = kInf;
+  s.rows[2].jB[1] = -kInf;
+  r = RowPgs().solve(s, x);
+  EXPECT_EQ(r.status, Status::InvalidInput);
+  EXPECT_NE(r.message.find("row 2 has a non-finite Jacobian"), std::string::npos) << r.message;
+  s = stackRows(2, 4);
+  s.b[4] = std::nan("");
+  EXPECT_EQ(s.validate().find("b[4]"), 0u) << s.validate();
+  // Large finite entries whose sum overflows are valid (the slow path confirms it).
+  s = stackRows(2, 4);
+  s.rows[1].jA[0] = s.rows[1].jA[1] = 1e308;
+  EXPECT_EQ(s.validate(), "");
 }
 
 TEST(RowPgs, ZeroRowIsAFailureNotAConvergence) {
