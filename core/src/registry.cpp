@@ -13,10 +13,9 @@ template <class S>
 std::unique_ptr<Solver> make() {
   return std::make_unique<S>();
 }
-}  // namespace
 
-const std::vector<SolverInfo>& solvers() {
-  static const std::vector<SolverInfo> list = {
+std::vector<SolverInfo>& registered() {
+  static std::vector<SolverInfo> list = {
       {"gs", "Gauss-Seidel for problems without bounds (linear systems)", &make<GaussSeidelSolver>},
       {"pgs", "projected Gauss-Seidel / SOR for boxed problems with findex", &make<PgsSolver>},
       {"dantzig", "Dantzig principal pivoting for boxed problems with findex (ODE-style)",
@@ -29,6 +28,18 @@ const std::vector<SolverInfo>& solvers() {
        &make<AutoSolver>},
   };
   return list;
+}
+}  // namespace
+
+const std::vector<SolverInfo>& solvers() { return registered(); }
+
+bool registerSolver(const SolverInfo& info) {
+  const std::string name = info.name ? info.name : "";
+  if (name.empty() || name.find('>') != std::string::npos || !info.make) return false;
+  for (const SolverInfo& known : registered())
+    if (name == known.name) return false;
+  registered().push_back(info);
+  return true;
 }
 
 std::string solverNames() {

@@ -73,10 +73,12 @@ std::string ChoiceCounts::toString() const {
 
 // --- the row solver -------------------------------------------------------------------------
 
-// The assembled-problem solvers of one island, by name, and when it was last solved.
+// What is kept per island: its assembled-problem solvers by name, when it was last solved, and
+// how many more `auto` solves run pgs first after a rejected pivoting answer.
 struct RowSolver::Slot {
   std::vector<std::pair<std::string, std::unique_ptr<Solver>>> solvers;
   std::uint64_t lastUse = 0;
+  int pgsFirst = 0;
 };
 
 namespace {
@@ -107,7 +109,7 @@ void RowSolver::setCapture(const std::string& prefix) {
   captured_.clear();
 }
 
-Solver* RowSolver::assembledSolver(std::uint64_t key, const std::string& name) {
+RowSolver::Slot& RowSolver::slot(std::uint64_t key) {
   auto it = slots_.find(key);
   if (it == slots_.end()) {
     if (slots_.size() >= kSlotLimit) {
@@ -117,12 +119,24 @@ Solver* RowSolver::assembledSolver(std::uint64_t key, const std::string& name) {
     }
     it = slots_.emplace(key, std::make_unique<Slot>()).first;
   }
-  Slot& slot = *it->second;
-  slot.lastUse = calls_;
-  for (auto& [n, solver] : slot.solvers)
+  it->second->lastUse = calls_;
+  return *it->second;
+}
+
+Solver* RowSolver::assembledSolver(std::uint64_t key, const std::string& name) {
+  Slot& s = slot(key);
+  for (auto& [n, solver] : s.solvers)
     if (n == name) return solver.get();
-  slot.solvers.emplace_back(name, makeSolver(name));
-  return slot.solvers.back().second.get();
+  s.solvers.emplace_back(name, makeSolver(name));
+  return s.solvers.back().second.get();
+}
+
+const Solver* RowSolver::cachedSolver(std::uint64_t key, const std::string& name) const {
+  const auto it = slots_.find(key);
+  if (it == slots_.end()) return nullptr;
+  for (const auto& [n, solver] : it->second->solvers)
+    if (n == name) return solver.get();
+  return nullptr;
 }
 
 Result RowSolver::run(const RowSystem& rows, const std::string& name, const Options& options,
@@ -175,13 +189,19 @@ IslandSolve RowSolver::solve(const RowSystem& rows, const Vector& start, Vector&
   }
   if (!capturePrefix_.empty()) capture(rows);
 
-  out.requested = settings_.solver == "auto"
-                      ? chooseSolver(out.problemClass, n, settings_.options.tolerance)
-                      : settings_.solver;
+  const bool autoChoice = settings_.solver == "auto";
+  out.requested = autoChoice ? chooseSolver(out.problemClass, n, settings_.options.tolerance)
+                             : settings_.solver;
+  Slot& island = slot(key);
+  if (autoChoice && out.requested == "dantzig" && island.pgsFirst > 0) {
+    --island.pgsFirst;
+    out.requested = "pgs";
+  }
   Result r = run(rows, out.requested, settings_.options, start, x, key, out);
   if (r.status == Status::InvalidInput || r.status == Status::Unsupported) x = start;
   out.choice = out.requested;
   if (!acceptable(r, settings_.acceptResidual)) {
+    if (autoChoice && out.requested == "dantzig") island.pgsFirst = kAutoPgsAfterRejection;
     std::ostringstream why;
     why << out.requested << " rejected (" << toString(r.status) << ", residual " << r.residual
         << (r.message.empty() ? "" : ": ") << r.message << ")";

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "common/broken_solvers.hpp"
 #include "mlcp/bullet/constraint_solver.hpp"
 #include "mlcp/bullet/mlcp_bridge.hpp"
 #include "mlcp/registry.hpp"
@@ -250,3 +251,78 @@ TEST(BulletPlumbing, SiThroughTheDropInMatchesStockSi) {
 }
 
 }  // namespace
+
+// An injected NaN and a failing primary: every island falls back, the statistics say so, and
+// the answer written back is the fallback's own answer from the same start.
+TEST(BulletPlumbing, BrokenPrimariesFallBackCountedAndTheFallbackAnswers) {
+  mlcp::test::registerBrokenSolvers();
+  for (const char* broken : {"test-nan", "test-fail"}) {
+    sc::World w;
+    Settings s;
+    s.solver = broken;
+    s.fallback = "dantzig";
+    s.keepIslands = true;
+    w.setSolver(std::make_unique<ConstraintSolver>(s));
+    auto* mine = static_cast<ConstraintSolver*>(w.solver());
+    sc::stack(w, 3);
+    for (int i = 0; i < 20; ++i) {
+      w.step();
+      const mlcp::bullet::StepStats& st = mine->lastStep();
+      ASSERT_GT(st.islands, 0);
+      EXPECT_EQ(st.fallbacks, st.islands) << broken << " step " << i;
+      EXPECT_EQ(st.choices.count("dantzig"), st.islands) << st.choices.toString();
+      EXPECT_NE(st.message.find(std::string(broken) + " rejected"), std::string::npos)
+          << st.message;
+      for (const mlcp::bullet::IslandRecord& rec : mine->islands()) {
+        EXPECT_TRUE(rec.fellBack);
+        EXPECT_EQ(rec.solver, "dantzig");
+        mlcp::RowSolverSettings alone;
+        alone.solver = "dantzig";
+        alone.fallback = "";
+        mlcp::RowSolver dantzig(alone);
+        mlcp::Vector x;
+        dantzig.solve(rec.system, rec.start, x);
+        EXPECT_EQ(rec.x, x) << broken << " step " << i;
+        EXPECT_LE(mlcp::residual(rec.system.assemble(false), rec.x), s.acceptResidual);
+      }
+    }
+    EXPECT_EQ(mine->totals().fallbacks, mine->totals().islands);
+  }
+}
+
+// A hinge chain hanging from the world has only bilateral rows: auto solves it with one sparse
+// LDL^T and says so.
+TEST(BulletPlumbing, AutoPicksLdltForABilateralOnlyIsland) {
+  sc::World w;
+  Settings s;  // auto
+  s.keepIslands = true;
+  w.setSolver(std::make_unique<ConstraintSolver>(s));
+  auto* mine = static_cast<ConstraintSolver*>(w.solver());
+  btRigidBody* prev = nullptr;
+  for (int i = 0; i < 4; ++i) {
+    btTransform pose;
+    pose.setIdentity();
+    pose.setOrigin(btVector3(0.5 + i, 5, 0));
+    btRigidBody* link = w.addBox(btVector3(0.5, 0.1, 0.1), 1.0, pose);
+    const btVector3 axis(0, 0, 1);
+    if (!prev)
+      w.addConstraint(std::make_unique<btHingeConstraint>(*link, btVector3(-0.5, 0, 0), axis));
+    else
+      w.addConstraint(std::make_unique<btHingeConstraint>(*prev, *link, btVector3(0.5, 0, 0),
+                                                          btVector3(-0.5, 0, 0), axis, axis));
+    prev = link;
+  }
+  for (int i = 0; i < 60; ++i) {
+    w.step();
+    const mlcp::bullet::StepStats& st = mine->lastStep();
+    ASSERT_EQ(st.islands, 1);
+    EXPECT_EQ(st.choices.toString(), "ldlt:1");
+    EXPECT_EQ(st.fallbacks, 0);
+    ASSERT_EQ(mine->islands().size(), 1u);
+    const mlcp::bullet::IslandRecord& rec = mine->islands()[0];
+    EXPECT_EQ(rec.solver, "ldlt");
+    EXPECT_EQ(rec.system.size(), 20);  // 4 hinges x 5 rows
+    EXPECT_LE(mlcp::residual(rec.system.assemble(false), rec.x), 1e-10);
+  }
+  EXPECT_EQ(mine->totals().choices.toString(), "ldlt:60");
+}

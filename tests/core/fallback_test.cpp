@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "common/broken_solvers.hpp"
 #include "common/generators.hpp"
 #include "mlcp/ldlt.hpp"
 #include "mlcp/pgs.hpp"
@@ -69,26 +70,7 @@ TEST(Ldlt, RefusesBoundsAndReportsSingularSystems) {
       << toString(r.status);
 }
 
-// A primary that breaks in a chosen way, to check the chain reacts.
-class BrokenSolver : public Solver {
- public:
-  explicit BrokenSolver(bool nan) : nan_(nan) {}
-  const char* name() const override { return nan_ ? "nan-maker" : "failer"; }
-
- protected:
-  void run(const Problem&, Vector& x, Result& result) override {
-    if (nan_) {
-      x.setConstant(std::nan(""));
-      result.status = Status::Converged;  // a lying solver: the base must catch it
-    } else {
-      result.status = Status::Failed;
-      result.message = "injected failure";
-    }
-  }
-
- private:
-  bool nan_;
-};
+using test::BrokenSolver;
 
 FallbackSolver chainWith(std::unique_ptr<Solver> primary) {
   std::vector<std::unique_ptr<Solver>> chain;
@@ -106,13 +88,13 @@ TEST(Fallback, NaNFromThePrimaryFallsBackAndIsCounted) {
   ASSERT_TRUE(r.converged()) << r.message;
   EXPECT_EQ(r.fallbacks, 1);
   EXPECT_EQ(r.solver, "pgs");
-  EXPECT_NE(r.message.find("nan-maker: numerical-issue"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("test-nan: numerical-issue"), std::string::npos) << r.message;
   EXPECT_LE(residual(kp.problem, x), 1e-10);
 }
 
 TEST(Fallback, AFailingPrimaryFallsBack) {
   FallbackSolver chain = chainWith(std::make_unique<BrokenSolver>(false));
-  EXPECT_EQ(chain.name(), std::string("failer>pgs"));
+  EXPECT_EQ(chain.name(), std::string("test-fail>pgs"));
   test::Generator g(5);
   const test::KnownProblem kp = g.boxed(g.spd(10));
   Vector x;

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "common/broken_solvers.hpp"
 #include "mlcp/ode/stepper.h"
 #include "mlcp/ode/stepper.hpp"
 #include "ode/ode_scenes.hpp"
@@ -84,6 +85,61 @@ TEST(OdeEdge, IslandWithOnlyBilateralJoints) {
     ASSERT_LE(st.residual, 1e-10);
   }
   EXPECT_LE(maxAbsDiff(ours->state(), stock->state()), 1e-9);
+}
+
+// auto sees a bilateral-only island (a hinge chain), solves it with one sparse LDL^T, says so,
+// and follows stock ODE as closely as dantzig does.
+TEST(OdeEdge, AutoPicksLdltForABilateralOnlyIsland) {
+  auto ours = pendulumChain(4, 0.3), stock = pendulumChain(4, 0.3);
+  Stepper stepper, reference("ode-lcp");  // the default is auto
+  EXPECT_EQ(stepper.solverName(), "auto");
+  for (int k = 0; k < 100; ++k) {
+    ours->step([&](dWorldID w, dReal h) { ASSERT_TRUE(stepper.step(w, h)); }, 0.01);
+    stock->step([&](dWorldID w, dReal h) { ASSERT_TRUE(reference.step(w, h)); }, 0.01);
+    ASSERT_EQ(stepper.lastStep().islands.size(), 1u);
+    const IslandStats& st = stepper.lastStep().islands[0];
+    ASSERT_EQ(st.choice, "ldlt") << st.message;
+    ASSERT_FALSE(st.fellBack);
+    ASSERT_LE(st.residual, 1e-10);
+    ASSERT_EQ(stepper.lastStep().choices().toString(), "ldlt:1");
+  }
+  EXPECT_LE(maxAbsDiff(ours->state(), stock->state()), 1e-8);
+}
+
+// An injected NaN and a failing primary: every island falls back, the statistics count it, and
+// the applied answer is the fallback's own (the trajectory equals the fallback alone).
+TEST(OdeEdge, BrokenPrimariesFallBackCountedAndTheFallbackAnswers) {
+  mlcp::test::registerBrokenSolvers();
+  for (const char* broken : {"test-nan", "test-fail"}) {
+    auto withFallback = boxStack(2), alone = boxStack(2);
+    StepperOptions options;
+    options.fallback = "dantzig";
+    Stepper stepper(broken, options);
+    options.fallback = "";
+    Stepper dantzig("dantzig", options);
+    int solved = 0;
+    for (int k = 0; k < 50; ++k) {
+      withFallback->step([&](dWorldID w, dReal h) { ASSERT_TRUE(stepper.step(w, h)); }, 0.01);
+      alone->step([&](dWorldID w, dReal h) { ASSERT_TRUE(dantzig.step(w, h)); }, 0.01);
+      const StepStats& st = stepper.lastStep();
+      int withRows = 0;
+      for (const IslandStats& is : st.islands) {
+        if (is.rows == 0) continue;
+        ++withRows;
+        EXPECT_TRUE(is.fellBack);
+        EXPECT_TRUE(is.accepted);
+        EXPECT_EQ(is.choice, "dantzig");
+        EXPECT_NE(is.message.find(std::string(broken) + " rejected"), std::string::npos)
+            << is.message;
+      }
+      solved += withRows;
+      EXPECT_EQ(st.fallbacks(), withRows) << broken;
+      EXPECT_EQ(st.choices().count("dantzig"), withRows) << st.choices().toString();
+      EXPECT_LE(st.maxResidual(), 1e-9);
+    }
+    EXPECT_GT(solved, 40) << "the boxes should touch";
+    EXPECT_EQ(maxAbsDiff(withFallback->state(), alone->state()), 0.0) << broken;
+  }
 }
 
 TEST(OdeEdge, UnknownSolverNameIsAClearError) {

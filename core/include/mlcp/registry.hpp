@@ -22,5 +22,9 @@ const std::vector<SolverInfo>& solvers();
 std::unique_ptr<Solver> makeSolver(const std::string& name, std::string* error = nullptr);
 // "gs, pgs, ..." for messages and help texts.
 std::string solverNames();
+// Adds a solver to the registry (a program's own, or a test's injected one); false when the
+// name is taken or holds '>'. Register before solving: lookups and registration are not
+// synchronized.
+bool registerSolver(const SolverInfo& info);
 
 }  // namespace mlcp

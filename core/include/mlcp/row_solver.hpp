@@ -84,19 +84,33 @@ bool acceptable(const Result& r, double acceptResidual);
 ProblemClass classify(const RowSystem& rows);
 
 // `auto`'s choice for an island of this class and size at this requested tolerance (scaled
-// residual). Rules, measured on the scenes in both engines (`mlcp run SCENE --steps 100`, mean
-// solver ms per step; see row_solver.cpp for the table):
-//   Empty                      -> "none"
-//   Linear                     -> "ldlt"    one sparse LDL^T solve, exact, analysis reused
-//   StandardLcp, Boxed, Findex
-//     rows <= kAutoPivotingRows -> "dantzig" exact pivoting answer (residual ~1e-12)
-//     larger, tolerance >= kAutoPgsTolerance -> "pgs" (rows, warm-started sweeps)
-//     larger, tighter tolerance -> "dantzig"
+// residual):
+//   Empty                       -> "none"
+//   Linear                      -> "ldlt"     one sparse LDL^T solve: exact, analysis reused
+//   StandardLcp, Boxed, Findex  -> "dantzig"  exact pivoting answer (residual ~1e-12)
+//     except rows > kAutoPivotingRows at tolerance >= kAutoPgsTolerance -> "pgs"
+// and RowSolver adds one rule with memory: an island whose dantzig answer was rejected runs
+// pgs first for its next kAutoPgsAfterRejection solves (then dantzig is tried again).
+// Measured with `mlcp run SCENE --engine E --solver S --steps 100` (scene defaults: 50
+// iterations, tolerance 1e-6, fallback pgs, acceptResidual 1e-3), mean solver ms per step and
+// worst residual:
+//   pendulum_chain (20 hinges, Linear)  ODE  ldlt 0.016 ms 5e-14 | dantzig 0.017 | pgs 1.35 ms 1e-1
+//                                       Bullet ldlt 0.017 ms 5e-14 | dantzig 0.059 | pgs 0.66 ms
+//   mass_ratio_stack (Findex)           ODE  dantzig 0.14 ms 1e-12 | pgs 4.5 ms 0.45
+//   pyramid_15 (Findex, ~280 rows)      ODE  dantzig 4.6 ms 5e-15 | pgs 20 ms 1e-3
+//                                       Bullet dantzig fails 29 of 30 steps (70 ms, 0.12) while
+//                                       pgs gives 1e-3 in 10 ms: hence the memory rule
+//   hinge_motor_limits (Boxed)          both dantzig 0.003-0.04 ms 1e-15 | pgs 0.004-0.008 1e-6
+// Bullet's contact islands defeat dantzig (the friction fixed point does not settle with its
+// zero-CFM friction rows); ODE's never did in these scenes. The full table is in the report
+// of issue 7 (README).
 const char* chooseSolver(ProblemClass c, int rows, double tolerance);
 // Largest contact island handed to dantzig whatever the tolerance (rows). See chooseSolver.
 inline constexpr int kAutoPivotingRows = 600;
 // Loosest requested tolerance at which large contact islands go to pgs. See chooseSolver.
 inline constexpr double kAutoPgsTolerance = 1e-4;
+// Solves of an island that run pgs first after its dantzig answer was rejected. Default 30.
+inline constexpr int kAutoPgsAfterRejection = 30;
 
 // What one island's solve gives back.
 struct IslandSolve {
@@ -153,11 +167,16 @@ class RowSolver {
   // The files written since the last setCapture.
   const std::vector<std::string>& capturedFiles() const { return captured_; }
 
+  // The assembled-problem solver kept for this island and name, or null (for tests of the
+  // workspace reuse, e.g. LdltSolver::analyses()).
+  const Solver* cachedSolver(std::uint64_t islandKey, const std::string& name) const;
+
   // Whether a name can be given as `solver` / `fallback`.
   static bool known(const std::string& name);
 
  private:
   struct Slot;
+  Slot& slot(std::uint64_t key);
   Solver* assembledSolver(std::uint64_t key, const std::string& name);
   Result run(const RowSystem& rows, const std::string& name, const Options& options,
              const Vector& start, Vector& x, std::uint64_t key, IslandSolve& report);

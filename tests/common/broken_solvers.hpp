@@ -1,0 +1,46 @@
+// Solvers that break on purpose, to check that fallbacks happen, are counted and reported.
+// registerBrokenSolvers() adds them to the registry as "test-nan" and "test-fail", so that the
+// adapters (which take solvers by name) can be handed them too.
+#pragma once
+
+#include <cmath>
+
+#include "mlcp/registry.hpp"
+#include "mlcp/solver.hpp"
+
+namespace mlcp::test {
+
+class BrokenSolver : public Solver {
+ public:
+  // nan: answers NaN and claims Converged (a lying solver: the base class must catch it);
+  // otherwise reports Failed and leaves the start.
+  explicit BrokenSolver(bool nan) : nan_(nan) {}
+  const char* name() const override { return nan_ ? "test-nan" : "test-fail"; }
+
+ protected:
+  void run(const Problem&, Vector& x, Result& result) override {
+    if (nan_) {
+      x.setConstant(std::nan(""));
+      result.status = Status::Converged;
+    } else {
+      result.status = Status::Failed;
+      result.message = "injected failure";
+    }
+  }
+
+ private:
+  bool nan_;
+};
+
+inline void registerBrokenSolvers() {
+  static const bool done = [] {
+    registerSolver({"test-nan", "answers NaN (tests only)",
+                    [] { return std::unique_ptr<Solver>(new BrokenSolver(true)); }});
+    registerSolver({"test-fail", "reports Failed (tests only)",
+                    [] { return std::unique_ptr<Solver>(new BrokenSolver(false)); }});
+    return true;
+  }();
+  (void)done;
+}
+
+}  // namespace mlcp::test

@@ -1,0 +1,292 @@
+// RowSolver: classification and auto's choice on small row systems, the verified fallback with
+// injected broken primaries, workspace reuse per island, the capture hook.
+#include "mlcp/row_solver.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "common/broken_solvers.hpp"
+#include "mlcp/dantzig.hpp"
+#include "mlcp/io.hpp"
+#include "mlcp/ldlt.hpp"
+#include "mlcp/residual.hpp"
+
+namespace mlcp {
+namespace {
+
+BodyInverseMass unitBody() {
+  BodyInverseMass b;
+  b.invMass = 1;
+  b.invInertia = Eigen::Matrix3d::Identity();
+  return b;
+}
+
+// Appends a row on body 0 (and the world) with linear part `lin` and angular part `ang`.
+void addRow(RowSystem& s, const Eigen::Vector3d& lin, const Eigen::Vector3d& ang, double b,
+            double lo, double hi, double cfm, int findex = -1) {
+  ConstraintRow r;
+  r.bodyA = 0;
+  r.jA << lin, ang;
+  s.rows.push_back(r);
+  const int n = s.size();
+  s.b.conservativeResize(n);
+  s.lo.conservativeResize(n);
+  s.hi.conservativeResize(n);
+  s.cfm.conservativeResize(n);
+  s.b[n - 1] = b;
+  s.lo[n - 1] = lo;
+  s.hi[n - 1] = hi;
+  s.cfm[n - 1] = cfm;
+  s.findex.push_back(findex);
+}
+
+// A ball joint holding one body to the world: 3 bilateral rows.
+RowSystem ballJoint() {
+  RowSystem s;
+  s.bodies = {unitBody()};
+  const Eigen::Vector3d arm(0, 0.5, 0);
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector3d e = Eigen::Vector3d::Unit(k);
+    addRow(s, e, arm.cross(e), 0.1 * (k + 1), -kInf, kInf, 0);
+  }
+  return s;
+}
+
+// A box on the ground at four corners, pressed down (b < 0): frictionless contacts; with
+// friction two tangent rows per corner coupled to the normal.
+RowSystem boxOnGround(bool friction) {
+  RowSystem s;
+  s.bodies = {unitBody()};
+  const Eigen::Vector3d n(0, 0, 1);
+  const double corner[4][2] = {{0.5, 0.5}, {-0.5, 0.5}, {-0.5, -0.5}, {0.5, -0.5}};
+  for (const auto& c : corner) {
+    const Eigen::Vector3d r(c[0], c[1], -0.5);
+    addRow(s, n, r.cross(n), -0.2 - 0.01 * c[0], 0, kInf, 1e-4);
+  }
+  if (friction)
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector3d r(corner[k][0], corner[k][1], -0.5);
+      for (const Eigen::Vector3d& t : {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0)})
+        addRow(s, t, r.cross(t), 0.05, -0.5, 0.5, 1e-4, k);
+    }
+  return s;
+}
+
+double rowResidual(const RowSystem& s, const Vector& x) { return residual(s.assemble(false), x); }
+
+TEST(RowSolver, ClassifiesRowsByTheirBounds) {
+  EXPECT_EQ(classify(RowSystem()), ProblemClass::Empty);
+  EXPECT_EQ(classify(ballJoint()), ProblemClass::Linear);
+  EXPECT_EQ(classify(boxOnGround(false)), ProblemClass::StandardLcp);
+  EXPECT_EQ(classify(boxOnGround(true)), ProblemClass::Findex);
+  RowSystem limited = ballJoint();
+  limited.lo[0] = -1;  // a joint limit: bounded rows without friction
+  EXPECT_EQ(classify(limited), ProblemClass::Boxed);
+}
+
+TEST(RowSolver, ChoosesByClassSizeAndTolerance) {
+  EXPECT_STREQ(chooseSolver(ProblemClass::Empty, 0, 1e-6), "none");
+  EXPECT_STREQ(chooseSolver(ProblemClass::Linear, 5000, 1e-6), "ldlt");
+  EXPECT_STREQ(chooseSolver(ProblemClass::Findex, 12, 1e-6), "dantzig");
+  EXPECT_STREQ(chooseSolver(ProblemClass::StandardLcp, kAutoPivotingRows, 1e-3), "dantzig");
+  EXPECT_STREQ(chooseSolver(ProblemClass::Findex, kAutoPivotingRows + 1, kAutoPgsTolerance), "pgs");
+  EXPECT_STREQ(chooseSolver(ProblemClass::Findex, kAutoPivotingRows + 1, 1e-6), "dantzig");
+}
+
+TEST(RowSolver, AutoSolvesEachClassWithItsChoiceAndReportsIt) {
+  RowSolver solver;  // auto
+  struct Case {
+    RowSystem rows;
+    const char* choice;
+  };
+  for (const Case& c : {Case{ballJoint(), "ldlt"}, Case{boxOnGround(false), "dantzig"},
+                        Case{boxOnGround(true), "dantzig"}}) {
+    Vector x;
+    const IslandSolve s = solver.solve(c.rows, Vector::Zero(c.rows.size()), x);
+    EXPECT_EQ(s.choice, c.choice);
+    EXPECT_EQ(s.result.solver, c.choice);
+    EXPECT_FALSE(s.fellBack) << s.result.message;
+    EXPECT_TRUE(s.accepted);
+    EXPECT_EQ(s.result.status, Status::Converged) << s.result.message;
+    EXPECT_LE(rowResidual(c.rows, x), 1e-10);
+    EXPECT_NEAR(s.result.residual, rowResidual(c.rows, x), 1e-12);
+  }
+  Vector x = Vector::Ones(2);
+  const IslandSolve empty = solver.solve(RowSystem(), Vector(), x);
+  EXPECT_EQ(empty.choice, "none");
+  EXPECT_EQ(x.size(), 0);
+}
+
+TEST(RowSolver, AcceptanceIsTheSameRuleForEveryStatus) {
+  Result r;
+  r.residual = 1e-5;
+  for (Status s : {Status::Converged, Status::MaxIterations, Status::TimeLimit}) {
+    r.status = s;
+    EXPECT_TRUE(acceptable(r, 1e-3)) << toString(s);
+    EXPECT_FALSE(acceptable(r, 1e-6)) << toString(s);
+  }
+  for (Status s :
+       {Status::Failed, Status::NumericalIssue, Status::InvalidInput, Status::Unsupported}) {
+    r.status = s;
+    EXPECT_FALSE(acceptable(r, 1e-3)) << toString(s);
+  }
+  r.status = Status::Converged;
+  r.residual = std::nan("");
+  EXPECT_FALSE(acceptable(r, kInf));
+}
+
+// The fallback's answer from the same start, computed alone.
+Vector fallbackAlone(const RowSystem& rows, const Vector& start, const std::string& name) {
+  RowSolverSettings settings;
+  settings.solver = name;
+  settings.fallback = "";
+  RowSolver alone(settings);
+  Vector x;
+  alone.solve(rows, start, x);
+  return x;
+}
+
+TEST(RowSolver, InjectedNaNAndFailingPrimariesFallBackAndAreCounted) {
+  test::registerBrokenSolvers();
+  const RowSystem rows = boxOnGround(true);
+  const Vector start = Vector::Constant(rows.size(), 0.01);
+  for (const char* broken : {"test-nan", "test-fail"}) {
+    for (const char* fallback : {"dantzig", "pgs"}) {
+      RowSolverSettings settings;
+      settings.solver = broken;
+      settings.fallback = fallback;
+      RowSolver solver(settings);
+      Vector x;
+      const IslandSolve s = solver.solve(rows, start, x);
+      EXPECT_TRUE(s.fellBack) << broken;
+      EXPECT_EQ(s.requested, broken);
+      EXPECT_EQ(s.choice, fallback);
+      EXPECT_EQ(s.result.fallbacks, 1);
+      EXPECT_TRUE(s.accepted) << s.result.message;
+      EXPECT_NE(s.result.message.find(std::string(broken) + " rejected"), std::string::npos)
+          << s.result.message;
+      EXPECT_LE(rowResidual(rows, x), settings.acceptResidual);
+      EXPECT_NEAR(s.result.residual, rowResidual(rows, x), 1e-12);
+      EXPECT_EQ(x, fallbackAlone(rows, start, fallback)) << broken << " > " << fallback;
+    }
+  }
+}
+
+TEST(RowSolver, NothingUsableKeepsTheStart) {
+  test::registerBrokenSolvers();
+  RowSolverSettings settings;
+  settings.solver = "test-nan";
+  settings.fallback = "";
+  RowSolver solver(settings);
+  const RowSystem rows = boxOnGround(false);
+  const Vector start = Vector::Constant(rows.size(), 0.3);
+  Vector x;
+  const IslandSolve s = solver.solve(rows, start, x);
+  EXPECT_FALSE(s.fellBack);
+  EXPECT_FALSE(s.accepted);
+  EXPECT_EQ(s.result.status, Status::NumericalIssue);
+  EXPECT_EQ(x, start);
+  EXPECT_NEAR(s.result.residual, rowResidual(rows, start), 1e-12);
+}
+
+TEST(RowSolver, AnAnswerAboveTheLimitFallsBackWhateverTheSolver) {
+  RowSolverSettings settings;
+  settings.solver = "pgs";
+  settings.options.maxIterations = 1;
+  settings.acceptResidual = 1e-9;
+  settings.fallback = "dantzig";
+  RowSolver solver(settings);
+  const RowSystem rows = boxOnGround(true);
+  Vector x;
+  const IslandSolve s = solver.solve(rows, Vector::Zero(rows.size()), x);
+  EXPECT_TRUE(s.fellBack);
+  EXPECT_EQ(s.choice, "dantzig");
+  EXPECT_LE(rowResidual(rows, x), 1e-9);
+
+  settings.acceptResidual = kInf;  // any finite answer: no fallback
+  RowSolver lenient(settings);
+  const IslandSolve l = lenient.solve(rows, Vector::Zero(rows.size()), x);
+  EXPECT_FALSE(l.fellBack);
+  EXPECT_EQ(l.choice, "pgs");
+  EXPECT_EQ(l.result.iterations, 1);
+}
+
+TEST(RowSolver, KeepsTheLdltAnalysisPerIsland) {
+  RowSolver solver;
+  RowSystem rows = ballJoint();
+  Vector x;
+  for (int step = 0; step < 4; ++step) {
+    rows.b *= 1.5;  // new values, same pattern
+    rows.bodies[0].invMass = 1.0 + step;
+    ASSERT_EQ(solver.solve(rows, Vector::Zero(3), x, 7).choice, "ldlt");
+    EXPECT_LE(rowResidual(rows, x), 1e-12);
+  }
+  const auto* ldlt = dynamic_cast<const LdltSolver*>(solver.cachedSolver(7, "ldlt"));
+  ASSERT_NE(ldlt, nullptr);
+  EXPECT_EQ(ldlt->analyses(), 1);
+  EXPECT_EQ(solver.cachedSolver(8, "ldlt"), nullptr);
+  solver.solve(rows, Vector::Zero(3), x, 8);
+  EXPECT_NE(solver.cachedSolver(8, "ldlt"), ldlt);
+}
+
+TEST(RowSolver, CaptureWritesEachIslandsProblem) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("row_solver_capture_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  RowSolver solver;
+  solver.setCapture((dir / "step3-").string());
+  const RowSystem a = boxOnGround(true), b = ballJoint();
+  Vector x;
+  solver.solve(a, Vector::Zero(a.size()), x, 1);
+  solver.solve(b, Vector::Zero(b.size()), x, 2);
+  solver.solve(RowSystem(), Vector(), x, 3);  // no rows: nothing to write
+  ASSERT_EQ(solver.capturedFiles().size(), 2u);
+  EXPECT_EQ(solver.capturedFiles()[1], (dir / "step3-island1.json").string());
+  const Problem read = io::readProblemJson(solver.capturedFiles()[0]);
+  const Problem built = a.assemble(false);
+  EXPECT_LE((read.toDense() - built.toDense()).lpNorm<Eigen::Infinity>(), 1e-12);
+  EXPECT_EQ(read.findex, built.findex);
+  solver.setCapture("");
+  solver.solve(a, Vector::Zero(a.size()), x, 1);
+  EXPECT_TRUE(solver.capturedFiles().empty());
+  std::filesystem::remove_all(dir);
+}
+
+TEST(RowSolver, UnknownNamesAreClearErrors) {
+  RowSolverSettings settings;
+  settings.solver = "nope";
+  try {
+    RowSolver solver(settings);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown solver 'nope'"), std::string::npos) << e.what();
+  }
+  settings.solver = "auto";
+  settings.fallback = "auto";
+  EXPECT_THROW(RowSolver{settings}, std::invalid_argument);
+  settings.fallback = "pgs";
+  settings.acceptResidual = -1;
+  EXPECT_THROW(RowSolver{settings}, std::invalid_argument);
+}
+
+TEST(ChoiceCounts, CountsInNameOrder) {
+  ChoiceCounts c;
+  for (const char* name : {"none", "dantzig", "ldlt", "dantzig", "none", "dantzig"}) c.add(name);
+  EXPECT_EQ(c.toString(), "dantzig:3 ldlt:1 none:2");
+  EXPECT_EQ(c.total(), 6);
+  EXPECT_EQ(c.count("ldlt"), 1);
+  EXPECT_EQ(c.count("pgs"), 0);
+  ChoiceCounts d;
+  d.add("pgs", 2);
+  d.add(c);
+  EXPECT_EQ(d.toString(), "dantzig:3 ldlt:1 none:2 pgs:2");
+  d.clear();
+  EXPECT_EQ(d.toString(), "");
+}
+
+}  // namespace
+}  // namespace mlcp
