@@ -48,7 +48,9 @@ class OdeWorld : public scene::World {
 
     ensureOdeInitialized();
     world_ = dWorldCreate();
-    space_ = dHashSpaceCreate(nullptr);
+    // Sweep and prune, not dHashSpaceCreate: ODE 0.16's hash space never reports some pairs of
+    // the sphere pit's stacked spheres (a sphere fell through the one below it, 0.5 m deep).
+    space_ = dSweepAndPruneSpaceCreate(nullptr, dSAP_AXES_XYZ);
     contacts_ = dJointGroupCreate(0);
     dWorldSetGravity(world_, s.gravity[0], s.gravity[1], s.gravity[2]);
     dWorldSetERP(world_, s.settings.erp);
