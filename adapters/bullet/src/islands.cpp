@@ -166,6 +166,7 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
       s.cfm[r] = stockCfm;
     else
       s.cfm[r] = scaled ? std::max(0.0, c.m_cfm / jd) : 0.0;
+    if (cfm == CfmModel::Regularized && findex_[i] >= 0 && s.cfm[r] == 0) s.cfm[r] = stockCfm;
     if (findex_[i] >= 0) {
       s.findex[r] = rowLocal_[findex_[i]];
       s.lo[r] = -std::abs(static_cast<double>(c.m_friction));

@@ -21,7 +21,7 @@
 //                  (diag(af) I^-1 diag(af), symmetric; SI itself uses af^2 I^-1 on one side);
 //       b_i      = -m_rhs / m_jacDiagABInv   (Bullet's rhs is a velocity error times 1/A_ii:
 //                                             its b is minus ours);
-//       cfm_i    = m_cfm / m_jacDiagABInv    (the regularisation SI's iteration converges to);
+//       cfm_i    = m_cfm / m_jacDiagABInv    (the regularisation SI converges to; see CfmModel);
 //       bounds     joints as given; contacts [0, inf); friction [-mu, mu] with findex = its
 //                  contact row; rolling friction the same with its own coefficient (SI also
 //                  caps it at mu_r in absolute terms, which is not a complementarity bound).
@@ -62,8 +62,14 @@ namespace mlcp::bullet {
 // How the diagonal regularisation (CFM) of each row is taken.
 enum class CfmModel {
   // cfm_i = m_cfm / m_jacDiagABInv: what Bullet's SI iteration converges to (contacts
-  // globalCfm / dt, friction 0, joints their own CFM times A_ii).
+  // globalCfm / dt, friction 0, joints their own CFM times A_ii). With several contacts on one
+  // face the friction rows are linearly dependent (4 contacts: 8 rows for 3 tangential degrees
+  // of freedom), so A has singular principal blocks and pivoting methods can fail on it.
   Engine,
+  // Engine, except that friction rows without a CFM of their own take their contact's,
+  // globalCfm / dt, as ODE does for every row: the redundant friction rows of a resting box
+  // become a regular problem (answers move by O(cfm) impulse). The default.
+  Regularized,
   // globalCfm / dt on every row, per-row CFM ignored: what the stock btMLCPSolver assembles. Only
   // for diffing against stock.
   StockMlcp,
@@ -79,8 +85,8 @@ struct Settings : RowSolverSettings {
   bool bulletIterations = false;
   // Start every solve from Bullet's applied impulses. Default true.
   bool warmStart = true;
-  // Regularisation model; see CfmModel. Default Engine.
-  CfmModel cfm = CfmModel::Engine;
+  // Regularisation model; see CfmModel. Default Regularized.
+  CfmModel cfm = CfmModel::Regularized;
   // Keep every island's rows, start, answer and result of the last step (for tests and tools;
   // costs copies). Default false.
   bool keepIslands = false;

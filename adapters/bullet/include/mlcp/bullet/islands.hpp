@@ -41,7 +41,7 @@ struct BulletRows {
 
 class IslandBuilder {
  public:
-  // Splits the rows into islands. globalCfm and timeStep feed CfmModel::StockMlcp only;
+  // Splits the rows into islands. globalCfm and timeStep feed CfmModel::StockMlcp and Regularized;
   // warmStart false starts every island from zero.
   void build(const BulletRows& rows, const btContactSolverInfo& info, CfmModel cfm, bool warmStart);
 
