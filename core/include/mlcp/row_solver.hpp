@@ -98,14 +98,15 @@ ProblemClass classify(const RowSystem& rows);
 //                                       Bullet ldlt 0.017 ms 5e-14 | dantzig 0.059 | pgs 0.66 ms
 //   mass_ratio_stack (Findex)           ODE  dantzig 0.14 ms 1e-12 | pgs 4.5 ms 0.45
 //   pyramid_15 (Findex, ~280 rows)      ODE  dantzig 4.6 ms 5e-15 | pgs 20 ms 1e-3
-//                                       Bullet dantzig fails 29 of 30 steps (70 ms, 0.12) while
-//                                       pgs gives 1e-3 in 10 ms: hence the memory rule; auto
-//                                       went from 47 ms to 8.6 ms with it (pyramid_55: 776 ->
-//                                       115 ms, stack_10: 3.9 -> 2.2 ms; ODE unchanged)
+//                                       Bullet (friction rows with their contact's CFM,
+//                                       bullet::CfmModel::Regularized) dantzig 3.1 ms 8e-7 |
+//                                       pgs 0.74 ms 9e-3 (100 sweeps)
 //   hinge_motor_limits (Boxed)          both dantzig 0.003-0.04 ms 1e-15 | pgs 0.004-0.008 1e-6
-// Bullet's contact islands defeat dantzig (the friction fixed point does not settle with its
-// zero-CFM friction rows); ODE's never did in these scenes. The full table is in the report
-// of issue 7 (README).
+// The memory rule dates from Bullet's zero-CFM friction rows (bullet::CfmModel::Engine), on which
+// dantzig failed 29 of 30 steps of pyramid_15 (70 ms, residual 0.12): with the rule auto went
+// from 47 ms to 8.6 ms there. With the default Regularized model dantzig's answers are accepted
+// and the rule does not fire on the scenes; it stays as the guard for islands that defeat
+// pivoting. Numbers of the main job's report: README, "Each island gets what it needs".
 const char* chooseSolver(ProblemClass c, int rows, double tolerance);
 // Largest contact island handed to dantzig whatever the tolerance (rows). See chooseSolver.
 inline constexpr int kAutoPivotingRows = 600;
