@@ -15,6 +15,11 @@ accurate value (the largest iteration count or the smallest tolerance; a stock s
 ignores the setting has its one run): mean solver time per step, worst residual, max
 penetration and joint error, fallbacks, steps by status, and which solvers answered. A run
 that blew up (non-finite state) at any value of the sweep is flagged.
+
+Above them, one table says per scene and engine whether `auto` is on the Pareto front of all
+(solver, setting value) points with a measured residual, with the charts' statistics (median
+solver ms per step, mean residual); residuals below EXACT count as equal. Each scene's section
+lists its fronts.
 """
 
 import argparse
@@ -25,7 +30,7 @@ import re
 import sys
 from collections import Counter, OrderedDict, defaultdict
 
-from chart import SWEEP_COLUMNS, InputError, read_rows, safe_name, solver_order
+from chart import SWEEP_COLUMNS, InputError, aggregate, read_rows, safe_name, solver_order
 
 STATUS_SHORT = OrderedDict([("converged", "conv"), ("max-iterations", "max-it"),
                             ("time-limit", "time"), ("failed", "FAILED"),
@@ -120,6 +125,136 @@ def fmt_value(v):
     return format(v, "g")
 
 
+# ----------------------------------------------------------------------------------------------
+# Pareto front: is `auto` as accurate as the best single solver at no more time?
+
+EXACT = 1e-12  # residuals below this are "exact": equal to each other on the front
+TIME_STAT, RESIDUAL_STAT = "median", "mean"  # as on the charts (chart.py's defaults)
+
+
+def accuracy_key(residual):
+    """The residual as the front compares it: rounding noise (1e-15 against 3e-15) is no
+    difference in accuracy."""
+    return 0.0 if residual < EXACT else residual
+
+
+def dominates(q, p):
+    """q is at least as fast and as accurate as p, and strictly better in one of the two."""
+    qa, pa = accuracy_key(q["residual"]), accuracy_key(p["residual"])
+    return (q["solver_ms"] <= p["solver_ms"] and qa <= pa
+            and (q["solver_ms"] < p["solver_ms"] or qa < pa))
+
+
+def best_by_accuracy(points):
+    """The most accurate point; among equally accurate ones the fastest."""
+    return min(points, key=lambda p: (accuracy_key(p["residual"]), p["solver_ms"]),
+               default=None)
+
+
+def fronts(path, rows):
+    """One dict per scene x engine (sweep order, engines alphabetical): the Pareto front of its
+    points with a measured residual, auto's most accurate point, the most accurate point
+    of any other solver, whether auto is on the front and, if not, the best point dominating
+    it."""
+    scenes = list(OrderedDict.fromkeys(r["scene"] for r in rows))
+    groups = defaultdict(list)
+    for p in aggregate(path, rows, RESIDUAL_STAT, TIME_STAT):
+        if math.isfinite(p["solver_ms"]) and math.isfinite(p["residual"]):
+            groups[(p["scene"], p["engine"])].append(p)
+    out = []
+    for (scene, engine), points in sorted(groups.items(),
+                                          key=lambda kv: (scenes.index(kv[0][0]), kv[0][1])):
+        values = Counter(p["solver"] for p in points)
+        for p in points:  # the setting value is part of the name only when the solver swept it
+            p["label"] = values[p["solver"]] > 1 and p["applies"]
+            p["name"] = p["solver"] + (f" ({p['setting']} {fmt_value(p['value'])})"
+                                       if p["label"] else "")
+        front = [p for p in points if not any(dominates(q, p) for q in points if q is not p)]
+        auto = best_by_accuracy([p for p in points if p["solver"] == "auto"])
+        dominating = [q for q in points if auto and dominates(q, auto)]
+        out.append({"scene": scene, "engine": engine, "front": front,
+                    "auto": auto,
+                    "best": best_by_accuracy([p for p in points if p["solver"] != "auto"]),
+                    "by": best_by_accuracy(dominating)})
+    return out
+
+
+def fmt_residual(r):
+    return f"{fmt(r)} (exact)" if r < EXACT else fmt(r)
+
+
+def fmt_ms(ms):
+    return fmt(ms, 3)
+
+
+def front_names(front):
+    """"pgs (iterations 5, 10), dantzig": the front fastest first, a solver's neighbouring
+    points in one group."""
+    groups = []
+    for p in sorted(front, key=lambda p: p["solver_ms"]):
+        if groups and groups[-1][0]["solver"] == p["solver"] and p["label"]:
+            groups[-1].append(p)
+        else:
+            groups.append([p])
+    return ", ".join(g[0]["solver"] + (f" ({g[0]['setting']} "
+                                       + ", ".join(fmt_value(p["value"]) for p in g) + ")"
+                                       if g[0]["label"] else "") for g in groups)
+
+
+def verdict(entry):
+    auto, by = entry["auto"], entry["by"]
+    if auto is None:
+        return "— (auto not run)"
+    if by is None:
+        return "yes"
+    exact = ", exact" if by["residual"] < EXACT else ""
+    return (f"no, dominated by {by['name']} ({fmt_ms(by['solver_ms'])} ms, residual "
+            f"{fmt(by['residual'])}{exact})")
+
+
+FRONT_COLUMNS = ["scene", "engine", "auto ms/step", "auto residual", "most accurate other",
+                 "its ms/step", "its residual", "auto time / its", "auto on the front"]
+
+
+def front_row(entry):
+    auto, best = entry["auto"], entry["best"]
+    row = [entry["scene"], entry["engine"]]
+    row += ([fmt_ms(auto["solver_ms"]), fmt_residual(auto["residual"])] if auto
+            else ["—", "—"])
+    row += ([best["name"], fmt_ms(best["solver_ms"]), fmt_residual(best["residual"])] if best
+            else ["—", "—", "—"])
+    row.append(f"{auto['solver_ms'] / best['solver_ms']:.2f}"
+               if auto and best and best["solver_ms"] > 0 else "—")
+    row.append(verdict(entry))
+    return row
+
+
+FRONT_INTRO = ("Is `auto` as accurate as the best single solver at no more time? Per scene and "
+               "engine, every ({setting} value, solver) point with a measured residual, with the "
+               "charts' statistics: " + TIME_STAT + " solver ms per step and " + RESIDUAL_STAT
+               + " residual over the run's steps. A point is on the Pareto front when no other "
+               "point has both lower-or-equal time and lower-or-equal residual, one of them "
+               f"strictly lower. Residuals below {EXACT:g} count as equal (\"exact\"): 1e-15 "
+               "against 3e-15 is rounding, not accuracy. Times are compared as measured, "
+               "without a margin: *most accurate other* is the point of another solver with "
+               "the lowest residual (the fastest among equals), *auto time / its* is auto's time "
+               "over its time, and *auto on the front* names the best point that dominates auto, "
+               "if one does. Where auto hands every island to that same solver, the two differ "
+               "only by auto's choice and by run-to-run noise (several per cent on a shared "
+               "machine): read the ratio, not only the yes or no.")
+
+
+def front_lines(entries):
+    """Per engine: auto against the most accurate other solver, and the front."""
+    lines = []
+    for e in entries:
+        text = f"- {e['engine']}: {front_names(e['front'])}"
+        if e["auto"]:
+            text += f"; auto on it: {verdict(e)}"
+        lines.append(text + ".")
+    return lines
+
+
 COLUMNS = [  # (key, header, formatter)
     ("engine", "engine", str),
     ("solver", "solver", str),
@@ -148,12 +283,20 @@ def columns(rows):
     return [c for c in COLUMNS if c[0] != "blew_up" or any(r["blew_up"] for r in rows)]
 
 
-def markdown_summary(tables, setting, notes):
+def markdown_summary(tables, setting, notes, pareto):
     lines = ["# mlcp comparison: summary", ""]
     lines += [f"- {n}" for n in notes] + ([""] if notes else [])
-    lines += [INTRO.format(setting=setting), ""]
+    lines += ["## auto on the Pareto front", "", FRONT_INTRO.format(setting=setting), ""]
+    lines.append("| " + " | ".join(FRONT_COLUMNS) + " |")
+    lines.append("|" + "---|" * len(FRONT_COLUMNS))
+    lines += ["| " + " | ".join(front_row(e)) + " |" for e in pareto]
+    lines += ["", INTRO.format(setting=setting), ""]
     for scene, rows in tables.items():
         lines += [f"## {scene}", ""]
+        entries = [e for e in pareto if e["scene"] == scene]
+        if entries:
+            lines += ["Pareto front, fastest first (" + TIME_STAT + " ms, " + RESIDUAL_STAT
+                      + " residual; see the top):"] + front_lines(entries) + [""]
         cols = columns(rows)
         lines.append("| " + " | ".join(h.format(setting=setting) for _, h, _ in cols) + " |")
         lines.append("|" + "---|" * len(cols))
@@ -233,7 +376,7 @@ def figures(out_dir, sub):
     return sorted(f[:-4] for f in os.listdir(folder) if f.endswith(".png"))
 
 
-def index_html(out_dir, tables, setting, notes):
+def index_html(out_dir, tables, setting, notes, pareto):
     parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>mlcp comparison</title>"
              f"<style>{CSS}</style></head><body>", "<h1>mlcp comparison report</h1>"]
     parts += [f"<p class='note'>{html.escape(n)}</p>" for n in notes]
@@ -242,9 +385,15 @@ def index_html(out_dir, tables, setting, notes):
     charts += [c for c in found if c not in charts]
     stability = figures(out_dir, "stability")
     has_table = os.path.exists(os.path.join(out_dir, "table.md"))
-    nav = [("summary", "Summary"), ("charts", "Work-precision charts")]
+    nav = [("pareto", "auto on the Pareto front"), ("summary", "Summary"),
+           ("charts", "Work-precision charts")]
     nav += [("stability", "Stability map")] + ([("siconos", "Siconos table")] if has_table else [])
     parts.append("<nav>" + "".join(f"<a href='#{a}'>{t}</a>" for a, t in nav) + "</nav>")
+
+    parts.append("<h2 id='pareto'>auto on the Pareto front</h2>")
+    parts.append(f"<p class='note'>{html.escape(FRONT_INTRO.format(setting=setting))}</p>")
+    parts.append(html_table(FRONT_COLUMNS, [front_row(e) for e in pareto],
+                            numeric=(2, 3, 5, 6, 7)))
 
     parts.append("<h2 id='summary'>Summary</h2>")
     parts.append(f"<p class='note'>{html.escape(INTRO.format(setting=setting))} "
@@ -256,6 +405,11 @@ def index_html(out_dir, tables, setting, notes):
         numeric = [i for i, (k, _, _) in enumerate(cols)
                    if k in ("steps", "ms", "residual", "penetration", "joint", "fallbacks")]
         parts.append(f"<h3>{html.escape(scene)}</h3>")
+        entries = [e for e in pareto if e["scene"] == scene]
+        if entries:
+            parts.append("<p class='note'>Pareto front, fastest first:</p><ul class='note'>"
+                         + "".join(f"<li>{html.escape(line[2:])}</li>"
+                                   for line in front_lines(entries)) + "</ul>")
         parts.append(html_table(header, [[f(r[k]) for k, _, f in cols] for r in rows],
                                 numeric))
 
@@ -297,15 +451,18 @@ def main(argv=None):
     parser.add_argument("--note", action="append", default=[],
                         help="a line for the top of the report (repeatable)")
     args = parser.parse_args(argv)
+    csv_path = os.path.join(args.dir, "sweep.csv")
     try:
-        tables, setting = summarise(read_rows(os.path.join(args.dir, "sweep.csv"),
-                                                SWEEP_COLUMNS))
+        rows = read_rows(csv_path, SWEEP_COLUMNS)
+        tables, setting = summarise(rows)
+        pareto = fronts(csv_path, rows)
     except InputError as e:
         print(f"report.py: {e}", file=sys.stderr)
         return 2
     written = []
-    for name, text in (("summary.md", markdown_summary(tables, setting, args.note)),
-                       ("index.html", index_html(args.dir, tables, setting, args.note))):
+    for name, text in (("summary.md", markdown_summary(tables, setting, args.note, pareto)),
+                       ("index.html", index_html(args.dir, tables, setting, args.note,
+                                                 pareto))):
         path = os.path.join(args.dir, name)
         with open(path, "w") as f:
             f.write(text + "\n")

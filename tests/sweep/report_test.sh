@@ -24,6 +24,16 @@ for s in stack_10 pendulum_chain; do
   grep -q "src='charts/$s.png'" "$out/index.html" || fail "index.html does not show charts/$s.png"
 done
 grep -q "^| engine | solver | iterations |" "$out/summary.md" || fail "summary.md lacks the table header"
+# The Pareto table: a row per scene x engine with auto's time and a yes/no verdict.
+grep -q "^| scene | engine | auto ms/step | auto residual | most accurate other |" \
+  "$out/summary.md" || fail "summary.md lacks the Pareto table"
+for s in stack_10 pendulum_chain; do
+  for e in bullet ode; do
+    grep -qE "^\| $s \| $e \| [0-9][^|]* \| [0-9][^|]* \|.* \| (yes|no, dominated by .*) \|\$" \
+      "$out/summary.md" || fail "the Pareto table has no row with auto's numbers for $s / $e"
+  done
+done
+grep -q "id='pareto'" "$out/index.html" || fail "index.html lacks the Pareto table"
 if [ -d "${MLCP_SICONOS_DIR:-$repo/../shared/data/siconos}/lcp" ]; then
   grep -q "^| problem | n | pgs | lemke | dantzig | auto |" "$out/table.md" || fail "table.md lacks the solver table"
   grep -q "id='siconos'" "$out/index.html" || fail "index.html lacks the Siconos table"
