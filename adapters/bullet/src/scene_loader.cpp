@@ -119,8 +119,11 @@ class BulletWorld : public scene::World {
     info.m_globalCfm = s.settings.cfm;
     info.m_numIterations = run.iterations;
     info.m_minimumSolverBatchSize = 1;
-    // Two friction rows per contact, as ODE's dContactApprox1 (a friction pyramid).
-    info.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
+    // Two friction rows per contact, as ODE's dContactApprox1 (a friction pyramid), with
+    // directions kept per contact so that friction warm starts (see scene_loader.hpp).
+    info.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS |
+                         SOLVER_ENABLE_FRICTION_DIRECTION_CACHING |
+                         SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION;
     if (!run.warmStart) info.m_solverMode &= ~SOLVER_USE_WARMSTARTING;
 
     for (const scene::Body& b : s.bodies) addBody(s, b);

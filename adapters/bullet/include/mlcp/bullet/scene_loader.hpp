@@ -23,8 +23,11 @@
 //   erp, m_globalCfm = cfm, m_numIterations = iterations, minimumSolverBatchSize 1 (islands
 //   solved one by one, as the direct solvers want), SOLVER_USE_2_FRICTION_DIRECTIONS (two
 //   friction rows per contact like ODE's, so both engines solve problems of the same shape;
-//   Bullet's default is one row along the sliding direction). max_contacts_per_pair is 4 in
-//   Bullet's manifolds whatever the scene says.
+//   Bullet's default is one row along the sliding direction), SOLVER_ENABLE_FRICTION_DIRECTION_
+//   CACHING | SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION (a contact keeps its friction
+//   directions from step to step, so last step's friction impulses are a meaningful warm start:
+//   Bullet's dantzig step on pyramid_15 went from 3.1 to 1.0 ms, on pyramid_55 from ~950 to
+//   ~520 ms). max_contacts_per_pair is 4 in Bullet's manifolds whatever the scene says.
 //
 // Solver names: any mlcp::solverNames() name runs through mlcp::bullet::ConstraintSolver (its
 // statistics fill the measures); the stock ones are
