@@ -1,8 +1,10 @@
 #include "island.hpp"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <stdexcept>
 
 #include "mlcp/registry.hpp"
@@ -102,7 +104,10 @@ int prepareRows(dxWorld* world, dxBody* const* body, unsigned nb, dxJoint* const
 
   const dReal fps = dRecip(h);
   for (const JointRows& jr : w.joints) {
-    dReal J1[6 * kRowWidth] = {0}, J2[6 * kRowWidth] = {0};
+    // getInfo2 writes only the nonzero Jacobian entries: clear the joint's m rows, not all 6.
+    dReal J1[6 * kRowWidth], J2[6 * kRowWidth];
+    std::fill_n(J1, jr.m * kRowWidth, dReal(0));
+    std::fill_n(J2, jr.m * kRowWidth, dReal(0));
     dReal rhsCfm[6 * 2], loHi[6 * 2];
     int findex[6];
     for (int k = 0; k < jr.m; ++k) {
@@ -271,15 +276,44 @@ Method makeMethod(const std::string& name, RowSolverSettings settings) {
 
 // --- warm start ----------------------------------------------------------------------------
 
-bool WarmStartCache::lookup(dxJoint* joint, int m, double* lambda, double matchDistance) const {
-  dxBody* b0 = joint->node[0].body;
-  dxBody* b1 = joint->node[1].body;
-  if (joint->type() == dJointTypeContact) {
-    const auto key = std::make_pair(b0, b1);
-    const int rank = lookupRank_[key]++;
-    const auto it = contacts_[read_].find(key);
-    if (it == contacts_[read_].end() || rank >= static_cast<int>(it->second.size())) return false;
-    const ContactEntry& e = it->second[rank];
+WarmStartCache::Key WarmStartCache::keyOf(dxJoint* joint) {
+  Key k;
+  k.contact = joint->type() == dJointTypeContact;
+  if (k.contact) {
+    k.a = reinterpret_cast<std::uintptr_t>(joint->node[0].body);
+    k.b = reinterpret_cast<std::uintptr_t>(joint->node[1].body);
+  } else {
+    k.a = reinterpret_cast<std::uintptr_t>(joint);
+  }
+  return k;
+}
+
+namespace {
+
+std::size_t slotOf(std::uintptr_t a, std::uintptr_t b, std::size_t mask) {
+  std::uint64_t h = (a >> 4) * 0x9E3779B97F4A7C15ull ^ (b >> 4) * 0xC2B2AE3D27D4EB4Full;
+  return static_cast<std::size_t>(h ^ (h >> 29)) & mask;
+}
+
+}  // namespace
+
+int WarmStartCache::find(const Key& key) const {
+  if (table_.empty()) return -1;
+  const std::size_t mask = table_.size() - 1;
+  for (std::size_t s = slotOf(key.a, key.b, mask);; s = (s + 1) & mask) {
+    const int i = table_[s];
+    if (i < 0 || entries_[i].key == key) return i;
+  }
+}
+
+bool WarmStartCache::lookup(dxJoint* joint, int m, double* lambda, double matchDistance) {
+  const Key key = keyOf(joint);
+  int i = find(key);
+  if (i < 0) return false;
+  if (key.contact) {
+    for (int rank = entries_[i].lookups++; rank > 0 && i >= 0; --rank) i = entries_[i].next;
+    if (i < 0) return false;
+    const Entry& e = entries_[i];
     const dReal* pos = static_cast<dxJointContact*>(joint)->contact.geom.pos;
     const double d2 = (pos[0] - e.pos[0]) * (pos[0] - e.pos[0]) +
                       (pos[1] - e.pos[1]) * (pos[1] - e.pos[1]) +
@@ -288,53 +322,55 @@ bool WarmStartCache::lookup(dxJoint* joint, int m, double* lambda, double matchD
     std::copy(e.lambda.begin(), e.lambda.begin() + m, lambda);
     return true;
   }
-  const auto it = joints_[read_].find(joint);
-  if (it == joints_[read_].end()) return false;
-  const Entry& e = it->second;
-  if (e.type != joint->type() || e.m != m || e.body0 != b0 || e.body1 != b1) return false;
+  const Entry& e = entries_[i];
+  if (e.type != joint->type() || e.m != m || e.body0 != joint->node[0].body ||
+      e.body1 != joint->node[1].body)
+    return false;
   std::copy(e.lambda.begin(), e.lambda.begin() + m, lambda);
   return true;
 }
 
 void WarmStartCache::store(dxJoint* joint, int m, const double* lambda) {
-  const int write = 1 - read_;
-  dxBody* b0 = joint->node[0].body;
-  dxBody* b1 = joint->node[1].body;
-  if (joint->type() == dJointTypeContact) {
-    const auto key = std::make_pair(b0, b1);
-    const int rank = storeRank_[key]++;
-    std::vector<ContactEntry>& list = contacts_[write][key];
-    if (static_cast<int>(list.size()) <= rank) list.resize(rank + 1);
-    ContactEntry& e = list[rank];
-    e.m = m;
-    const dReal* pos = static_cast<dxJointContact*>(joint)->contact.geom.pos;
-    std::copy(pos, pos + 3, e.pos.begin());
-    std::copy(lambda, lambda + m, e.lambda.begin());
-    return;
-  }
-  Entry& e = joints_[write][joint];
+  Entry& e = next_.emplace_back();
+  e.key = keyOf(joint);
   e.type = joint->type();
   e.m = m;
-  e.body0 = b0;
-  e.body1 = b1;
+  e.body0 = joint->node[0].body;
+  e.body1 = joint->node[1].body;
+  if (e.key.contact) {
+    const dReal* pos = static_cast<dxJointContact*>(joint)->contact.geom.pos;
+    std::copy(pos, pos + 3, e.pos.begin());
+  }
   std::copy(lambda, lambda + m, e.lambda.begin());
 }
 
 void WarmStartCache::endStep() {
-  read_ = 1 - read_;
-  joints_[1 - read_].clear();
-  contacts_[1 - read_].clear();
-  lookupRank_.clear();
-  storeRank_.clear();
+  entries_.swap(next_);
+  next_.clear();
+  std::size_t size = 16;
+  while (size < 2 * entries_.size()) size *= 2;
+  table_.assign(size, -1);
+  const std::size_t mask = size - 1;
+  for (int i = 0; i < static_cast<int>(entries_.size()); ++i) {
+    Entry& e = entries_[i];
+    for (std::size_t s = slotOf(e.key.a, e.key.b, mask);; s = (s + 1) & mask) {
+      const int j = table_[s];
+      if (j < 0) {
+        table_[s] = e.last = i;
+        break;
+      }
+      if (entries_[j].key == e.key) {  // a joint stored twice keeps its first entry
+        if (e.key.contact) entries_[j].last = entries_[entries_[j].last].next = i;
+        break;
+      }
+    }
+  }
 }
 
 void WarmStartCache::clear() {
-  for (int k = 0; k < 2; ++k) {
-    joints_[k].clear();
-    contacts_[k].clear();
-  }
-  lookupRank_.clear();
-  storeRank_.clear();
+  entries_.clear();
+  next_.clear();
+  table_.clear();
 }
 
 }  // namespace mlcp::ode

@@ -3,10 +3,10 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <mutex>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 #include "mlcp/ode/stepper.hpp"
@@ -36,40 +36,41 @@ struct Method {
 // settings (its solver set to `name`).
 Method makeMethod(const std::string& name, RowSolverSettings settings);
 
-// The last step's lambda, to warm-start this step's.
+// The last step's lambda, to warm-start this step's. Storage reused across steps (no allocation
+// once grown): entries in store order and an open-addressing table built once per step, at
+// endStep. Joints other than contacts are keyed by the joint; contacts, which are new joints
+// every step, by body pair, then by rank among the pair's contacts in island order (a chain
+// through the pair's entries), checked by position.
 class WarmStartCache {
  public:
   // Fills lambda (size m) for the joint and returns true when a matching entry exists.
-  bool lookup(dxJoint* joint, int m, double* lambda, double matchDistance) const;
+  bool lookup(dxJoint* joint, int m, double* lambda, double matchDistance);
   void store(dxJoint* joint, int m, const double* lambda);
   // Makes what was stored since the last call the cache that lookup reads.
   void endStep();
   void clear();
 
  private:
+  struct Key {
+    std::uintptr_t a = 0, b = 0;  // the joint and 0, or a contact's two bodies
+    bool contact = false;
+    bool operator==(const Key& o) const { return a == o.a && b == o.b && contact == o.contact; }
+  };
   struct Entry {
+    Key key;
     int type = 0, m = 0;
     dxBody *body0 = nullptr, *body1 = nullptr;
+    int next = -1;    // the pair's next contact in store order
+    int last = -1;    // on a pair's first entry: its last entry (while the table is built)
+    int lookups = 0;  // on a pair's first entry: lookups of the pair this step (the rank)
+    std::array<double, 3> pos{};  // contacts
     std::array<double, 6> lambda{};
   };
-  struct ContactEntry {
-    int m = 0;
-    std::array<double, 3> pos{};
-    std::array<double, 6> lambda{};
-  };
-  struct PairHash {
-    std::size_t operator()(const std::pair<dxBody*, dxBody*>& p) const {
-      return std::hash<dxBody*>()(p.first) * 31 + std::hash<dxBody*>()(p.second);
-    }
-  };
-  using JointMap = std::unordered_map<dxJoint*, Entry>;
-  using ContactMap =
-      std::unordered_map<std::pair<dxBody*, dxBody*>, std::vector<ContactEntry>, PairHash>;
-  JointMap joints_[2];
-  ContactMap contacts_[2];
-  int read_ = 0;  // joints_[read_] is last step's, joints_[1 - read_] this step's
-  // Rank of a contact among this step's contacts of its body pair (lookup and store agree).
-  mutable std::unordered_map<std::pair<dxBody*, dxBody*>, int, PairHash> lookupRank_, storeRank_;
+  static Key keyOf(dxJoint* joint);
+  int find(const Key& key) const;  // first entry of the key in entries_, -1 if none
+
+  std::vector<Entry> entries_, next_;  // read (last step's) / this step's stores
+  std::vector<int> table_;             // entries_ index per slot, -1 empty; size a power of 2
 };
 
 struct JointRows {
