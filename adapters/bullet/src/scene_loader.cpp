@@ -105,41 +105,15 @@ class BulletWorld : public scene::World {
     iterations_ = run.iterations;
     tolerance_ = run.tolerance;
     timed_ = std::make_unique<TimedSolver>(std::move(solver));
-
-    gCalculateCombinedRestitutionCallback = &maxRestitution;
-    config_ = std::make_unique<btDefaultCollisionConfiguration>();
-    dispatcher_ = std::make_unique<btCollisionDispatcher>(config_.get());
-    broadphase_ = std::make_unique<btDbvtBroadphase>();
-    world_ = std::make_unique<btDiscreteDynamicsWorld>(dispatcher_.get(), broadphase_.get(),
-                                                       timed_.get(), config_.get());
-    world_->setGravity(bt(s.gravity));
-    btContactSolverInfo& info = world_->getSolverInfo();
-    info.m_timeStep = s.settings.timeStep;
-    info.m_erp = info.m_erp2 = s.settings.erp;
-    info.m_globalCfm = s.settings.cfm;
-    info.m_numIterations = run.iterations;
-    info.m_minimumSolverBatchSize = 1;
-    // Two friction rows per contact, as ODE's dContactApprox1 (a friction pyramid), with
-    // directions kept per contact so that friction warm starts (see scene_loader.hpp).
-    info.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS |
-                         SOLVER_ENABLE_FRICTION_DIRECTION_CACHING |
-                         SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION;
-    if (!run.warmStart) info.m_solverMode &= ~SOLVER_USE_WARMSTARTING;
-
-    for (const scene::Body& b : s.bodies) addBody(s, b);
-    for (const scene::Joint& j : s.joints) addJoint(s, j);
-  }
-
-  ~BulletWorld() override {
-    for (auto& c : constraints_) world_->removeConstraint(c.get());
-    for (auto& b : bodies_) world_->removeRigidBody(b.get());
-    world_.reset();
+    built_ = buildWorld(s, run);
+    built_->world().setConstraintSolver(timed_.get());
   }
 
   std::vector<scene::BodyState> states() const override {
-    std::vector<scene::BodyState> out(bodies_.size());
-    for (std::size_t i = 0; i < bodies_.size(); ++i) {
-      const btRigidBody& b = *bodies_[i];
+    const std::vector<btRigidBody*>& bodies = built_->bodies();
+    std::vector<scene::BodyState> out(bodies.size());
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      const btRigidBody& b = *bodies[i];
       const btTransform& t = b.getCenterOfMassTransform();
       const btQuaternion q = t.getRotation();
       out[i].position = vec(t.getOrigin());
@@ -165,7 +139,8 @@ class BulletWorld : public scene::World {
   void stepEngine(scene::StepMeasures& m) override {
     timed_->seconds = 0;
     const int fallbacksBefore = stock_ ? stock_->fallbacks() : 0;
-    world_->stepSimulation(scene().settings.timeStep, 0, scene().settings.timeStep);
+    const double h = scene().settings.timeStep;
+    built_->world().stepSimulation(h, 0, h);
     if (capturing_) {
       captured_ = ours_->rowSolver()->capturedFiles();
       ours_->rowSolver()->setCapture("");
@@ -192,8 +167,9 @@ class BulletWorld : public scene::World {
     }
     double deepest = 0;
     int contacts = 0;
-    for (int i = 0; i < dispatcher_->getNumManifolds(); ++i) {
-      const btPersistentManifold* pm = dispatcher_->getManifoldByIndexInternal(i);
+    btDispatcher& dispatcher = *built_->world().getDispatcher();
+    for (int i = 0; i < dispatcher.getNumManifolds(); ++i) {
+      const btPersistentManifold* pm = dispatcher.getManifoldByIndexInternal(i);
       for (int k = 0; k < pm->getNumContacts(); ++k) {
         ++contacts;
         deepest = std::max(deepest, -double(pm->getContactPoint(k).getDistance()));
@@ -204,92 +180,6 @@ class BulletWorld : public scene::World {
   }
 
  private:
-  void addBody(const scene::Scene& s, const scene::Body& b) {
-    std::unique_ptr<btCollisionShape> shape;
-    switch (b.shape.type) {
-      case scene::ShapeType::Plane:
-        shape = std::make_unique<btStaticPlaneShape>(bt(b.shape.normal), b.shape.offset);
-        break;
-      case scene::ShapeType::Box:
-        shape = std::make_unique<btBoxShape>(0.5 * bt(b.shape.size));
-        break;
-      case scene::ShapeType::Sphere: shape = std::make_unique<btSphereShape>(b.shape.radius); break;
-      case scene::ShapeType::Capsule:
-        shape = std::make_unique<btCapsuleShapeZ>(b.shape.radius, b.shape.length);
-        break;
-    }
-    btTransform pose;
-    pose.setIdentity();
-    if (b.shape.type != scene::ShapeType::Plane) {
-      pose.setOrigin(bt(b.position));
-      pose.setRotation(
-          btQuaternion(b.orientation.x, b.orientation.y, b.orientation.z, b.orientation.w));
-    }
-    motion_.push_back(std::make_unique<btDefaultMotionState>(pose));
-    btRigidBody::btRigidBodyConstructionInfo ci(b.mass, motion_.back().get(), shape.get(),
-                                                bt(b.inertia));
-    const scene::Material& mat = s.materials[b.material];
-    ci.m_friction = std::sqrt(mat.friction);
-    ci.m_restitution = mat.restitution;
-    bodies_.push_back(std::make_unique<btRigidBody>(ci));
-    btRigidBody* body = bodies_.back().get();
-    if (!b.isStatic()) {
-      body->setLinearVelocity(bt(b.velocity));
-      body->setAngularVelocity(bt(b.angularVelocity));
-      if (!s.settings.sleeping) body->setActivationState(DISABLE_DEACTIVATION);
-    }
-    shapes_.push_back(std::move(shape));
-    world_->addRigidBody(body);
-  }
-
-  void addJoint(const scene::Scene& s, const scene::Joint& j) {
-    btRigidBody& a = *bodies_[j.body0];
-    btRigidBody& b = j.body1 >= 0 ? *bodies_[j.body1] : btTypedConstraint::getFixedBody();
-    (void)s;
-    const btTransform ta = a.getCenterOfMassTransform().inverse();
-    const btTransform tb = b.getCenterOfMassTransform().inverse();
-    // Bullet's slider offset is B's relative to A (its hinge angle is A's relative to B, as the
-    // scene's): the reversed axis gives the slider A's offset relative to B.
-    const Vec3 reversed{-j.axis[0], -j.axis[1], -j.axis[2]};
-    std::unique_ptr<btTypedConstraint> c;
-    const double dt = scene().settings.timeStep;
-    switch (j.type) {
-      case scene::JointType::Ball:
-        c = std::make_unique<btPoint2PointConstraint>(a, b, ta * bt(j.anchor), tb * bt(j.anchor));
-        break;
-      case scene::JointType::Hinge: {
-        const btTransform f = jointFrame(j.anchor, j.axis, 2);
-        auto h = std::make_unique<btHingeConstraint>(a, b, ta * f, tb * f);
-        if (j.limits.enabled) h->setLimit(j.limits.lower, j.limits.upper, 1.0, 0.3, 1.0);
-        if (j.motor.enabled) h->enableAngularMotor(true, j.motor.velocity, j.motor.maxForce * dt);
-        c = std::move(h);
-        break;
-      }
-      case scene::JointType::Slider: {
-        const btTransform f = jointFrame(j.anchor, reversed, 0);
-        auto sl = std::make_unique<btSliderConstraint>(a, b, ta * f, tb * f, true);
-        if (j.limits.enabled) {
-          sl->setLowerLinLimit(j.limits.lower);
-          sl->setUpperLinLimit(j.limits.upper);
-        }
-        if (j.motor.enabled) {
-          sl->setPoweredLinMotor(true);
-          sl->setTargetLinMotorVelocity(j.motor.velocity);
-          sl->setMaxLinMotorForce(j.motor.maxForce);
-        }
-        c = std::move(sl);
-        break;
-      }
-      case scene::JointType::Fixed: {
-        const btTransform f = jointFrame(j.anchor, {0, 0, 1}, 2);
-        c = std::make_unique<btFixedConstraint>(a, b, ta * f, tb * f);
-        break;
-      }
-    }
-    world_->addConstraint(c.get(), !j.collideConnected);
-    constraints_.push_back(std::move(c));
-  }
-
   std::unique_ptr<TimedSolver> timed_;
   ConstraintSolver* ours_ = nullptr;
   scenes::StockMlcp* stock_ = nullptr;
@@ -297,17 +187,135 @@ class BulletWorld : public scene::World {
   std::vector<std::string> captured_;
   int iterations_ = 0;
   double tolerance_ = 0;
-  std::unique_ptr<btDefaultCollisionConfiguration> config_;
-  std::unique_ptr<btCollisionDispatcher> dispatcher_;
-  std::unique_ptr<btBroadphaseInterface> broadphase_;
-  std::unique_ptr<btDiscreteDynamicsWorld> world_;
-  std::vector<std::unique_ptr<btCollisionShape>> shapes_;
-  std::vector<std::unique_ptr<btMotionState>> motion_;
-  std::vector<std::unique_ptr<btRigidBody>> bodies_;
-  std::vector<std::unique_ptr<btTypedConstraint>> constraints_;
+  // After timed_: the world is destroyed before the solver it points at.
+  std::unique_ptr<BulletScene> built_;
 };
 
 }  // namespace
+
+BulletScene::BulletScene(const scene::Scene& s, const scene::RunSettings& run)
+    : timeStep_(s.settings.timeStep) {
+  gCalculateCombinedRestitutionCallback = &maxRestitution;
+  config_ = std::make_unique<btDefaultCollisionConfiguration>();
+  dispatcher_ = std::make_unique<btCollisionDispatcher>(config_.get());
+  broadphase_ = std::make_unique<btDbvtBroadphase>();
+  stockSolver_ = std::make_unique<btSequentialImpulseConstraintSolver>();
+  world_ = std::make_unique<btDiscreteDynamicsWorld>(dispatcher_.get(), broadphase_.get(),
+                                                     stockSolver_.get(), config_.get());
+  world_->setGravity(bt(s.gravity));
+  btContactSolverInfo& info = world_->getSolverInfo();
+  info.m_timeStep = s.settings.timeStep;
+  info.m_erp = info.m_erp2 = s.settings.erp;
+  info.m_globalCfm = s.settings.cfm;
+  info.m_numIterations = run.iterations;
+  info.m_minimumSolverBatchSize = 1;
+  // Two friction rows per contact, as ODE's dContactApprox1 (a friction pyramid), with
+  // directions kept per contact so that friction warm starts (see scene_loader.hpp).
+  info.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS | SOLVER_ENABLE_FRICTION_DIRECTION_CACHING |
+                       SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION;
+  if (!run.warmStart) info.m_solverMode &= ~SOLVER_USE_WARMSTARTING;
+
+  for (const scene::Body& b : s.bodies) addBody(s, b);
+  for (const scene::Joint& j : s.joints) addJoint(j);
+}
+
+BulletScene::~BulletScene() {
+  for (auto& c : constraints_) world_->removeConstraint(c.get());
+  for (auto& b : bodies_) world_->removeRigidBody(b.get());
+  world_.reset();
+}
+
+void BulletScene::addBody(const scene::Scene& s, const scene::Body& b) {
+  std::unique_ptr<btCollisionShape> shape;
+  switch (b.shape.type) {
+    case scene::ShapeType::Plane:
+      shape = std::make_unique<btStaticPlaneShape>(bt(b.shape.normal), b.shape.offset);
+      break;
+    case scene::ShapeType::Box: shape = std::make_unique<btBoxShape>(0.5 * bt(b.shape.size)); break;
+    case scene::ShapeType::Sphere: shape = std::make_unique<btSphereShape>(b.shape.radius); break;
+    case scene::ShapeType::Capsule:
+      shape = std::make_unique<btCapsuleShapeZ>(b.shape.radius, b.shape.length);
+      break;
+  }
+  btTransform pose;
+  pose.setIdentity();
+  if (b.shape.type != scene::ShapeType::Plane) {
+    pose.setOrigin(bt(b.position));
+    pose.setRotation(
+        btQuaternion(b.orientation.x, b.orientation.y, b.orientation.z, b.orientation.w));
+  }
+  motion_.push_back(std::make_unique<btDefaultMotionState>(pose));
+  btRigidBody::btRigidBodyConstructionInfo ci(b.mass, motion_.back().get(), shape.get(),
+                                              bt(b.inertia));
+  const scene::Material& mat = s.materials[b.material];
+  ci.m_friction = std::sqrt(mat.friction);
+  ci.m_restitution = mat.restitution;
+  bodies_.push_back(std::make_unique<btRigidBody>(ci));
+  btRigidBody* body = bodies_.back().get();
+  bodyPointers_.push_back(body);
+  if (!b.isStatic()) {
+    body->setLinearVelocity(bt(b.velocity));
+    body->setAngularVelocity(bt(b.angularVelocity));
+    if (!s.settings.sleeping) body->setActivationState(DISABLE_DEACTIVATION);
+  }
+  shapes_.push_back(std::move(shape));
+  world_->addRigidBody(body);
+}
+
+void BulletScene::addJoint(const scene::Joint& j) {
+  btRigidBody& a = *bodies_[j.body0];
+  btRigidBody& b = j.body1 >= 0 ? *bodies_[j.body1] : btTypedConstraint::getFixedBody();
+  const btTransform ta = a.getCenterOfMassTransform().inverse();
+  const btTransform tb = b.getCenterOfMassTransform().inverse();
+  // Bullet's slider offset is B's relative to A (its hinge angle is A's relative to B, as the
+  // scene's): the reversed axis gives the slider A's offset relative to B.
+  const Vec3 reversed{-j.axis[0], -j.axis[1], -j.axis[2]};
+  std::unique_ptr<btTypedConstraint> c;
+  const double dt = timeStep_;
+  switch (j.type) {
+    case scene::JointType::Ball:
+      c = std::make_unique<btPoint2PointConstraint>(a, b, ta * bt(j.anchor), tb * bt(j.anchor));
+      break;
+    case scene::JointType::Hinge: {
+      const btTransform f = jointFrame(j.anchor, j.axis, 2);
+      auto h = std::make_unique<btHingeConstraint>(a, b, ta * f, tb * f);
+      if (j.limits.enabled) h->setLimit(j.limits.lower, j.limits.upper, 1.0, 0.3, 1.0);
+      if (j.motor.enabled) h->enableAngularMotor(true, j.motor.velocity, j.motor.maxForce * dt);
+      c = std::move(h);
+      break;
+    }
+    case scene::JointType::Slider: {
+      const btTransform f = jointFrame(j.anchor, reversed, 0);
+      auto sl = std::make_unique<btSliderConstraint>(a, b, ta * f, tb * f, true);
+      if (j.limits.enabled) {
+        sl->setLowerLinLimit(j.limits.lower);
+        sl->setUpperLinLimit(j.limits.upper);
+      }
+      if (j.motor.enabled) {
+        sl->setPoweredLinMotor(true);
+        sl->setTargetLinMotorVelocity(j.motor.velocity);
+        sl->setMaxLinMotorForce(j.motor.maxForce);
+      }
+      c = std::move(sl);
+      break;
+    }
+    case scene::JointType::Fixed: {
+      const btTransform f = jointFrame(j.anchor, {0, 0, 1}, 2);
+      c = std::make_unique<btFixedConstraint>(a, b, ta * f, tb * f);
+      break;
+    }
+  }
+  world_->addConstraint(c.get(), !j.collideConnected);
+  constraints_.push_back(std::move(c));
+}
+
+std::unique_ptr<BulletScene> buildWorld(const scene::Scene& scene, const scene::RunSettings& run) {
+  return std::make_unique<BulletScene>(scene, run);
+}
+
+std::unique_ptr<BulletScene> buildWorld(const scene::Scene& scene) {
+  return buildWorld(scene, scene::RunSettings::fromScene(scene));
+}
 
 std::string worldSolverNames() {
   return solverNames() +

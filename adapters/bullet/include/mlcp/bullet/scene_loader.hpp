@@ -2,6 +2,16 @@
 //
 //     auto world = mlcp::bullet::loadWorld(scene, mlcp::scene::RunSettings::fromScene(scene));
 //
+// or, for a program that drives Bullet itself (adapters/bullet/examples/pyramid.cpp):
+//
+//     auto built = mlcp::bullet::buildWorld(scene);   // the stock world, bodies and joints
+//     btDiscreteDynamicsWorld& world = built->world();
+//     mlcp::bullet::ConstraintSolver solver(settings);
+//     world.setConstraintSolver(&solver);             // the one-line swap
+//     world.stepSimulation(h, 0, h);
+//
+// loadWorld's worlds are built by buildWorld: one mapping, described here.
+//
 // How the scene maps onto Bullet:
 // - shapes: plane btStaticPlaneShape(normal, offset), box btBoxShape(size / 2), sphere
 //   btSphereShape, capsule btCapsuleShapeZ(radius, length) (along the body's z axis);
@@ -39,12 +49,56 @@
 // Stock SI and NNCG report no residual (NaN), `iterations` sweeps and status max-iterations.
 #pragma once
 
+#include <btBulletDynamicsCommon.h>
+
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "mlcp/scene/world.hpp"
 
 namespace mlcp::bullet {
+
+// A scene in a stock btDiscreteDynamicsWorld, owning the world and everything it points at
+// (collision configuration, dispatcher, broadphase, shapes, motion states, bodies,
+// constraints), destroyed in the right order. The world starts with a stock
+// btSequentialImpulseConstraintSolver owned here; world().setConstraintSolver(&yours) swaps it
+// (yours must outlive the steps; Bullet does not take ownership).
+class BulletScene {
+ public:
+  // Settings used: gravity, time step, erp, cfm (scene), iterations and warmStart (run).
+  BulletScene(const scene::Scene& scene, const scene::RunSettings& run);
+  ~BulletScene();
+  BulletScene(const BulletScene&) = delete;
+  BulletScene& operator=(const BulletScene&) = delete;
+
+  btDiscreteDynamicsWorld& world() { return *world_; }
+  const btDiscreteDynamicsWorld& world() const { return *world_; }
+  // Every scene body, static ones included, in scene order.
+  const std::vector<btRigidBody*>& bodies() const { return bodyPointers_; }
+  double timeStep() const { return timeStep_; }
+
+ private:
+  void addBody(const scene::Scene& s, const scene::Body& b);
+  void addJoint(const scene::Joint& j);
+
+  double timeStep_;
+  std::unique_ptr<btDefaultCollisionConfiguration> config_;
+  std::unique_ptr<btCollisionDispatcher> dispatcher_;
+  std::unique_ptr<btBroadphaseInterface> broadphase_;
+  std::unique_ptr<btConstraintSolver> stockSolver_;
+  std::unique_ptr<btDiscreteDynamicsWorld> world_;
+  std::vector<std::unique_ptr<btCollisionShape>> shapes_;
+  std::vector<std::unique_ptr<btMotionState>> motion_;
+  std::vector<std::unique_ptr<btRigidBody>> bodies_;
+  std::vector<btRigidBody*> bodyPointers_;
+  std::vector<std::unique_ptr<btTypedConstraint>> constraints_;
+};
+
+// The scene's stock world; the second form takes iterations and warmStart from the scene's
+// solver defaults (RunSettings::fromScene).
+std::unique_ptr<BulletScene> buildWorld(const scene::Scene& scene, const scene::RunSettings& run);
+std::unique_ptr<BulletScene> buildWorld(const scene::Scene& scene);
 
 // Throws std::invalid_argument for an unknown solver name (the message lists the known ones).
 std::unique_ptr<scene::World> loadWorld(const scene::Scene& scene,
