@@ -1,5 +1,6 @@
-// scenes.hpp: Bullet scenes built in code, shared by the example, the tests and the benchmark
-// (until the engine-neutral scene files land), and solvers picked by name.
+// scenes.hpp: Bullet scenes built in code for the adapter tests and the benchmark (older than
+// the scene files, which bullet_pyramid and `mlcp run` load through mlcp::bullet::buildWorld),
+// and solvers picked by name (the scene loader's stock bullet-mlcp-* solvers come from here).
 //
 // Solver names (makeBulletSolver):
 //   "si"                        Bullet's stock btSequentialImpulseConstraintSolver
