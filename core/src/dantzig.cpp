@@ -730,8 +730,8 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
   ws.pivTol *= opt.pivotTolerance;
   ws.pivots = 0;
   ws.pivotLimit = opt.maxPivots > 0 ? opt.maxPivots : 50 * n + 100;
-  ws.startTime = nowSeconds();
   ws.budget = opt.timeBudget;
+  ws.startTime = ws.budget > 0 ? nowSeconds() : 0.0;  // read only with a budget
   ws.message.clear();
   // Pass 1 guesses the equality rows and (warm) the rows inside their bounds as clamped.
   for (int p = 0; p < n; ++p) {
@@ -764,8 +764,8 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
     ws.pivots = 0;
     result.iterations = totalPivots;
     writeBack();
-    std::ostringstream os;
     if (o != Outcome::Done) {
+      std::ostringstream os;
       result.status = o == Outcome::Failed       ? Status::Failed
                       : o == Outcome::PivotLimit ? Status::MaxIterations
                                                  : Status::TimeLimit;
@@ -780,6 +780,7 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
           friction ? "pivoting finished (friction bounds fixed once)" : "pivoting finished";
       return;
     }
+    std::ostringstream os;  // only on the friction path: its set-up costs as much as a tiny solve
     const double res = residual(problem, x);
     if (res <= opt.tolerance) {
       result.status = Status::Converged;

@@ -1,6 +1,7 @@
 #include "mlcp/problem.hpp"
 
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 namespace mlcp {
@@ -107,8 +108,27 @@ std::string firstNonFiniteSparse(const SparseMatrix& m) {
 
 }  // namespace
 
+namespace {
+
+// An ostringstream made on the first write: constructing one costs a locale set-up, and
+// validate() runs before every solve while its messages are needed only when something is wrong.
+class LazyMessage {
+ public:
+  template <class T>
+  std::ostream& operator<<(const T& v) {
+    if (!os_) os_.emplace();
+    return *os_ << v;
+  }
+  std::string str() const { return os_ ? os_->str() : std::string(); }
+
+ private:
+  std::optional<std::ostringstream> os_;
+};
+
+}  // namespace
+
 std::string Problem::validate() const {
-  std::ostringstream os;
+  LazyMessage os;
   const Eigen::Index n = b.size();
   const Eigen::Index rows = sparse_ ? sparseA_.rows() : dense_.rows();
   const Eigen::Index cols = sparse_ ? sparseA_.cols() : dense_.cols();

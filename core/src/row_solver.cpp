@@ -123,12 +123,11 @@ RowSolver::Slot& RowSolver::slot(std::uint64_t key) {
   return *it->second;
 }
 
-Solver* RowSolver::assembledSolver(std::uint64_t key, const std::string& name) {
-  Slot& s = slot(key);
-  for (auto& [n, solver] : s.solvers)
+Solver* RowSolver::assembledSolver(Slot& island, const std::string& name) {
+  for (auto& [n, solver] : island.solvers)
     if (n == name) return solver.get();
-  s.solvers.emplace_back(name, makeSolver(name));
-  return s.solvers.back().second.get();
+  island.solvers.emplace_back(name, makeSolver(name));
+  return island.solvers.back().second.get();
 }
 
 const Solver* RowSolver::cachedSolver(std::uint64_t key, const std::string& name) const {
@@ -140,7 +139,7 @@ const Solver* RowSolver::cachedSolver(std::uint64_t key, const std::string& name
 }
 
 Result RowSolver::run(const RowSystem& rows, const std::string& name, const Options& options,
-                      const Vector& start, Vector& x, std::uint64_t key, IslandSolve& report) {
+                      const Vector& start, Vector& x, Slot& island, IslandSolve& report) {
   Options o = options;
   o.warmStart = true;
   if (name == "pgs") {
@@ -150,20 +149,21 @@ Result RowSolver::run(const RowSystem& rows, const std::string& name, const Opti
   }
   if (!haveAssembled_) {
     const double t0 = nowSeconds();
-    assembled_ = rows.assemble(rows.size() > settings_.denseMaxRows);
-    haveAssembled_ = true;
+    assemble(rows);
     report.assembleSeconds += nowSeconds() - t0;
   }
-  Solver* solver = assembledSolver(key, name);
+  Solver* solver = assembledSolver(island, name);
   solver->setOptions(o);
   return solver->solveWithGuess(assembled_, start, x);
 }
 
+void RowSolver::assemble(const RowSystem& rows) {
+  rows.assemble(rows.size() > settings_.denseMaxRows, assembled_, assembleScratch_);
+  haveAssembled_ = true;
+}
+
 void RowSolver::capture(const RowSystem& rows) {
-  if (!haveAssembled_) {
-    assembled_ = rows.assemble(rows.size() > settings_.denseMaxRows);
-    haveAssembled_ = true;
-  }
+  if (!haveAssembled_) assemble(rows);
   const std::string path = capturePrefix_ + "island" + std::to_string(captured_.size()) + ".json";
   io::writeProblemJson(assembled_, path);
   captured_.push_back(path);
@@ -197,7 +197,7 @@ IslandSolve RowSolver::solve(const RowSystem& rows, const Vector& start, Vector&
     --island.pgsFirst;
     out.requested = "pgs";
   }
-  Result r = run(rows, out.requested, settings_.options, start, x, key, out);
+  Result r = run(rows, out.requested, settings_.options, start, x, island, out);
   if (r.status == Status::InvalidInput || r.status == Status::Unsupported) x = start;
   out.choice = out.requested;
   if (!acceptable(r, settings_.acceptResidual)) {
@@ -208,7 +208,7 @@ IslandSolve RowSolver::solve(const RowSystem& rows, const Vector& start, Vector&
     if (!settings_.fallback.empty()) {
       out.fellBack = true;
       Result f =
-          run(rows, settings_.fallback, settings_.fallbackOptions, start, xFallback_, key, out);
+          run(rows, settings_.fallback, settings_.fallbackOptions, start, xFallback_, island, out);
       const bool usable = f.status != Status::InvalidInput && f.status != Status::Unsupported &&
                           std::isfinite(f.residual);
       if (usable && !(std::isfinite(r.residual) && r.residual <= f.residual)) {

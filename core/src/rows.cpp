@@ -126,14 +126,24 @@ Vector RowSystem::slack(const Vector& x) const {
 }
 
 Problem RowSystem::assemble(bool sparse) const {
+  Problem p;
+  AssembleScratch scratch;
+  assemble(sparse, p, scratch);
+  return p;
+}
+
+void RowSystem::assemble(bool sparse, Problem& p, AssembleScratch& scratch) const {
   const int n = size();
   // Rows touching each body: only rows sharing a body couple in J M^-1 J^T.
-  std::vector<std::vector<std::pair<int, const Vector6*>>> touching(bodies.size());
+  auto& touching = scratch.touching;
+  if (touching.size() < bodies.size()) touching.resize(bodies.size());
+  for (std::size_t k = 0; k < bodies.size(); ++k) touching[k].clear();
   for (int i = 0; i < n; ++i) {
     if (rows[i].bodyA >= 0) touching[rows[i].bodyA].push_back({i, &rows[i].jA});
     if (rows[i].bodyB >= 0) touching[rows[i].bodyB].push_back({i, &rows[i].jB});
   }
-  std::vector<Eigen::Triplet<double>> triplets;
+  auto& triplets = scratch.triplets;
+  triplets.clear();
   for (int i = 0; i < n; ++i) triplets.emplace_back(i, i, cfm[i]);
   for (std::size_t k = 0; k < bodies.size(); ++k) {
     for (const auto& [i, ji] : touching[k]) {
@@ -141,7 +151,10 @@ Problem RowSystem::assemble(bool sparse) const {
       for (const auto& [j, jj] : touching[k]) triplets.emplace_back(i, j, jj->dot(mji));
     }
   }
-  Problem p = boundsOnly(*this);
+  p.b = b;
+  p.lo = lo;
+  p.hi = hi;
+  p.findex = findex;
   if (sparse) {
     SparseMatrix A(n, n);
     A.setFromTriplets(triplets.begin(), triplets.end());
@@ -151,7 +164,6 @@ Problem RowSystem::assemble(bool sparse) const {
     for (const auto& t : triplets) A(t.row(), t.col()) += t.value();
     p.setA(std::move(A));
   }
-  return p;
 }
 
 void RowPgs::slackFromVelocities(const RowSystem& s, const Vector& x) {

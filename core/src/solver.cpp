@@ -54,7 +54,11 @@ void applyAccuracy(Result& r, const Accuracy& a, double tolerance) {
 
 Result Solver::solve(const Problem& problem, Vector& x) {
   const bool useGuess = options_.warmStart && x.size() == problem.b.size() && x.allFinite();
-  return runChecked(problem, useGuess ? x : Vector::Zero(problem.b.size()), x);
+  if (useGuess)
+    start_ = x;
+  else
+    start_.setZero(problem.b.size());
+  return runChecked(problem, x);
 }
 
 Result Solver::solveWithGuess(const Problem& problem, const Vector& guess, Vector& x) {
@@ -74,10 +78,11 @@ Result Solver::solveWithGuess(const Problem& problem, const Vector& guess, Vecto
     r.message = "guess holds NaN or Inf";
     return r;
   }
-  return runChecked(problem, guess, x);
+  start_ = guess;
+  return runChecked(problem, x);
 }
 
-Result Solver::runChecked(const Problem& problem, Vector start, Vector& x) {
+Result Solver::runChecked(const Problem& problem, Vector& x) {
   const double t0 = nowSeconds();
   Result r;
   if (std::string why = problem.validate(); !why.empty()) {
@@ -88,13 +93,18 @@ Result Solver::runChecked(const Problem& problem, Vector start, Vector& x) {
   }
   r.status = Status::Failed;
   r.solver = name();
-  run(problem, start, r);
+  run(problem, start_, r);
   if (r.status == Status::InvalidInput || r.status == Status::Unsupported) {
     r.seconds = nowSeconds() - t0;
     return r;  // x untouched: nothing was solved
   }
-  applyAccuracy(r, accuracy(problem, start), options_.tolerance);
-  x = std::move(start);
+  if (problem.isSparse())
+    slack_.noalias() = problem.sparseA() * start_;
+  else
+    slack_.noalias() = problem.denseA() * start_;
+  slack_ += problem.b;
+  applyAccuracy(r, accuracy(problem, start_, slack_), options_.tolerance);
+  x.swap(start_);
   r.seconds = nowSeconds() - t0;
   return r;
 }

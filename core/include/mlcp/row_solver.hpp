@@ -180,14 +180,16 @@ class RowSolver {
  private:
   struct Slot;
   Slot& slot(std::uint64_t key);
-  Solver* assembledSolver(std::uint64_t key, const std::string& name);
+  Solver* assembledSolver(Slot& island, const std::string& name);
   Result run(const RowSystem& rows, const std::string& name, const Options& options,
-             const Vector& start, Vector& x, std::uint64_t key, IslandSolve& report);
+             const Vector& start, Vector& x, Slot& island, IslandSolve& report);
+  void assemble(const RowSystem& rows);
   void capture(const RowSystem& rows);
 
   RowSolverSettings settings_;
   RowPgs rowPgs_;
-  Problem assembled_;
+  Problem assembled_;  // reused across solves with assembleScratch_: no per-step allocation
+  RowSystem::AssembleScratch assembleScratch_;
   bool haveAssembled_ = false;
   Vector xFallback_;
   std::unordered_map<std::uint64_t, std::unique_ptr<Slot>> slots_;

@@ -52,6 +52,13 @@ class RowSystem {
 
   // A = J M^-1 J^T + diag(cfm) with the bounds copied: the same MLCP as a Problem.
   Problem assemble(bool sparse) const;
+  // The same into `into`, reusing its bound vectors and the scratch's buffers: a per-step
+  // caller (RowSolver) allocates only A's storage once the sizes have been seen.
+  struct AssembleScratch {
+    std::vector<std::vector<std::pair<int, const Vector6*>>> touching;
+    std::vector<Eigen::Triplet<double>> triplets;
+  };
+  void assemble(bool sparse, Problem& into, AssembleScratch& scratch) const;
   // w = A x + b computed through body velocities, O(nnz J).
   Vector slack(const Vector& x) const;
   // Body velocity changes M^-1 J^T x, 6 per body ([linear; angular]).

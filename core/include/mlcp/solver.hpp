@@ -49,8 +49,12 @@ class Solver {
   bool outOfTime(double startSeconds) const;
 
  private:
-  Result runChecked(const Problem& problem, Vector start, Vector& x);
+  // Runs the algorithm on start_ (holding the start point) and swaps it into x.
+  Result runChecked(const Problem& problem, Vector& x);
   Options options_;
+  // The iterate and w = A x + b of the accuracy check, kept so repeated solves of one size do
+  // not allocate (an engine solves every island every step).
+  Vector start_, slack_;
 };
 
 struct Accuracy;
