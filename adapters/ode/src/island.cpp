@@ -66,26 +66,32 @@ void prepareBodies(dxWorld* world, dxBody* const* body, unsigned nb, dReal h, Ro
   }
 }
 
+// 0: all rows unbounded, 1: mixed, 2: no unbounded row.
+int jointClass(const JointRows& j) { return j.nub == j.m ? 0 : j.nub > 0 ? 1 : 2; }
+
 // Stage 2 and 3: getInfo1 for all joints (before any getInfo2), joints ordered unbounded |
 // mixed | LCP (stable within each class), then getInfo2 into the rows and the right-hand side
 // in the canonical form. Returns the number of purely unbounded joints (what dxStepIsland
 // passes to dxSolveLCP as nub).
 int prepareRows(dxWorld* world, dxBody* const* body, unsigned nb, dxJoint* const* joint,
                 unsigned nj, dReal h, IslandWork& w) {
-  w.joints.clear();
+  // Active joints by class (unbounded, mixed, LCP), island order kept within each class:
+  // bucketed through a reused buffer (std::stable_partition allocates on every call).
+  w.active.clear();
+  int count[3] = {0, 0, 0};
   for (unsigned k = 0; k < nj; ++k) {
     dxJoint::Info1 info;
     joint[k]->getInfo1(&info);
     joint[k]->tag = -1;  // inactive unless numbered below
-    if (info.m > 0) w.joints.push_back({joint[k], info.m, info.nub, -1});
+    if (info.m > 0) {
+      w.active.push_back({joint[k], info.m, info.nub, -1});
+      ++count[jointClass(w.active.back())];
+    }
   }
-  // w.joints holds the active joints in island order; order them by class, stably.
-  std::stable_partition(w.joints.begin(), w.joints.end(),
-                        [](const JointRows& j) { return j.nub == j.m; });
-  const auto mixedBegin = std::find_if(w.joints.begin(), w.joints.end(),
-                                       [](const JointRows& j) { return j.nub != j.m; });
-  const int unboundedJoints = static_cast<int>(mixedBegin - w.joints.begin());
-  std::stable_partition(mixedBegin, w.joints.end(), [](const JointRows& j) { return j.nub > 0; });
+  int next[3] = {0, count[0], count[0] + count[1]};
+  w.joints.resize(w.active.size());
+  for (const JointRows& j : w.active) w.joints[next[jointClass(j)]++] = j;
+  const int unboundedJoints = count[0];
 
   int m = 0;
   for (std::size_t k = 0; k < w.joints.size(); ++k) {

@@ -80,7 +80,8 @@ struct JointRows {
 
 // Per-island workspace, reused across islands and steps.
 struct IslandWork {
-  std::vector<JointRows> joints;
+  std::vector<JointRows> joints;  // active joints, ordered by class
+  std::vector<JointRows> active;  // active joints in island order
   RowSystem rows;
   std::vector<Vector6> bodyTmp;  // per body: M^-1 f_ext + v/h, later J^T lambda
   Vector x, x0, xAlt;
