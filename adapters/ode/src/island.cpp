@@ -366,7 +366,10 @@ void WarmStartCache::endStep() {
         break;
       }
       if (entries_[j].key == e.key) {  // a joint stored twice keeps its first entry
-        if (e.key.contact) entries_[j].last = entries_[entries_[j].last].next = i;
+        if (e.key.contact) {
+          entries_[entries_[j].last].next = i;
+          entries_[j].last = i;
+        }
         break;
       }
     }
