@@ -201,7 +201,12 @@ IslandSolve RowSolver::solve(const RowSystem& rows, const Vector& start, Vector&
   if (r.status == Status::InvalidInput || r.status == Status::Unsupported) x = start;
   out.choice = out.requested;
   if (!acceptable(r, settings_.acceptResidual)) {
-    if (autoChoice && out.requested == "dantzig") island.pgsFirst = kAutoPgsAfterRejection;
+    // A near miss (a finite answer within kAutoNearMiss x the limit, e.g. friction passes ran
+    // out) keeps dantzig for the next solve; a breakdown or a far miss sends the island to pgs.
+    const bool nearMiss = r.status != Status::Failed && r.status != Status::NumericalIssue &&
+                          r.residual <= kAutoNearMiss * settings_.acceptResidual;
+    if (autoChoice && out.requested == "dantzig" && !nearMiss)
+      island.pgsFirst = kAutoPgsAfterRejection;
     std::ostringstream why;
     why << out.requested << " rejected (" << toString(r.status) << ", residual " << r.residual
         << (r.message.empty() ? "" : ": ") << r.message << ")";
