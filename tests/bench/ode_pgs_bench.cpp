@@ -49,29 +49,6 @@ double median(std::vector<double> v) {
   return v.empty() ? NAN : v[v.size() / 2];
 }
 
-void copyState(const Scene& from, Scene& to) {
-  for (std::size_t i = 0; i < from.bodies.size(); ++i) {
-    dBodyID a = from.bodies[i], b = to.bodies[i];
-    const dReal* p = dBodyGetPosition(a);
-    const dReal* v = dBodyGetLinearVel(a);
-    const dReal* w = dBodyGetAngularVel(a);
-    dBodySetPosition(b, p[0], p[1], p[2]);
-    dBodySetQuaternion(b, dBodyGetQuaternion(a));
-    dBodySetLinearVel(b, v[0], v[1], v[2]);
-    dBodySetAngularVel(b, w[0], w[1], w[2]);
-  }
-}
-
-double velocityError(const Scene& a, const Scene& ref) {
-  double d = 0;
-  for (std::size_t i = 0; i < a.bodies.size(); ++i)
-    for (auto get : {dBodyGetLinearVel, dBodyGetAngularVel}) {
-      const dReal *u = get(a.bodies[i]), *v = get(ref.bodies[i]);
-      for (int k = 0; k < 3; ++k) d = std::max(d, std::abs(double(u[k] - v[k])));
-    }
-  return d;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -130,8 +107,8 @@ int main(int argc, char** argv) {
           },
           h);
       ref->step(stepRef, h);
-      dvQuick = std::max(dvQuick, velocityError(*quick, *ref));
-      dvPgs = std::max(dvPgs, velocityError(*ours, *ref));
+      dvQuick = std::max(dvQuick, velocityDifference(*quick, *ref));
+      dvPgs = std::max(dvPgs, velocityDifference(*ours, *ref));
       resPgs = std::max(resPgs, pgs.lastStep().maxResidual());
       resRef = std::max(resRef, reference.lastStep().maxResidual());
       rows = pgs.lastStep().rows();

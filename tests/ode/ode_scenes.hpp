@@ -6,6 +6,7 @@
 
 #include <ode/ode.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <memory>
@@ -237,6 +238,32 @@ inline std::unique_ptr<Scene> boxPyramid(int base, dReal mu = 0.6) {
     for (int k = 0; k < base - row; ++k)
       s->addBox((k + 0.5 * row) * (size + gap), 0, 0.5 * size + row * size, size, size, size);
   return s;
+}
+
+// Sets every body of `to` to the state of the same body of `from` (identically built scenes):
+// the benchmarks step several methods from one reference state.
+inline void copyState(const Scene& from, Scene& to) {
+  for (std::size_t i = 0; i < from.bodies.size(); ++i) {
+    dBodyID a = from.bodies[i], b = to.bodies[i];
+    const dReal* p = dBodyGetPosition(a);
+    const dReal* v = dBodyGetLinearVel(a);
+    const dReal* w = dBodyGetAngularVel(a);
+    dBodySetPosition(b, p[0], p[1], p[2]);
+    dBodySetQuaternion(b, dBodyGetQuaternion(a));
+    dBodySetLinearVel(b, v[0], v[1], v[2]);
+    dBodySetAngularVel(b, w[0], w[1], w[2]);
+  }
+}
+
+// The largest difference of any body's linear or angular velocity component (m/s, rad/s).
+inline double velocityDifference(const Scene& a, const Scene& b) {
+  double d = 0;
+  for (std::size_t i = 0; i < a.bodies.size(); ++i)
+    for (auto get : {dBodyGetLinearVel, dBodyGetAngularVel}) {
+      const dReal *u = get(a.bodies[i]), *v = get(b.bodies[i]);
+      for (int k = 0; k < 3; ++k) d = std::max(d, std::abs(double(u[k] - v[k])));
+    }
+  return d;
 }
 
 }  // namespace mlcp::ode::test
