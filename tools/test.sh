@@ -1,12 +1,16 @@
 #!/usr/bin/env bash
-# The whole test suite: set-up, a Release build with every test (ctest), then the same tests
-# under AddressSanitizer + UndefinedBehaviorSanitizer. Exit status is non-zero on any failure.
+# The whole test suite: set-up, the format check (tools/format.sh --check), a Release build with
+# every test (ctest), then the same tests under AddressSanitizer + UndefinedBehaviorSanitizer.
+# Exit status is non-zero on any failure.
 #   tools/test.sh            everything
 #   tools/test.sh --fast     the Release build only (no sanitizer build)
 set -euo pipefail
 repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 jobs=$(nproc 2>/dev/null || echo 2)
 "$repo/tools/setup.sh"
+
+echo "== Format check"
+"$repo/tools/format.sh" --check
 
 echo "== Release build and tests"
 "$repo/tools/build.sh" "$repo/build"

@@ -1,7 +1,6 @@
 // Solves a 2x2 LCP through the installed package; exit 0 only when it converges.
-#include <mlcp/registry.hpp>
-
 #include <cstdio>
+#include <mlcp/registry.hpp>
 
 int main() {
   mlcp::DenseMatrix A(2, 2);

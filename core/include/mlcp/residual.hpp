@@ -14,12 +14,12 @@
 namespace mlcp {
 
 struct Accuracy {
-  double residual = 0;         // ||x - clamp(x - w, lo', hi')||_inf / (1 + ||b||_inf)
+  double residual = 0;  // ||x - clamp(x - w, lo', hi')||_inf / (1 + ||b||_inf)
   // max_i (w_i^+ (x_i - lo'_i)^+ + w_i^- (hi'_i - x_i)^+), a gap to an infinite bound
   // counting as 1 (the violation is then |w_i| itself).
   double complementarity = 0;
-  double boundViolation = 0;   // max_i max(lo'_i - x_i, x_i - hi'_i, 0)
-  bool finite = true;          // x and w hold no NaN/Inf
+  double boundViolation = 0;  // max_i max(lo'_i - x_i, x_i - hi'_i, 0)
+  bool finite = true;         // x and w hold no NaN/Inf
 };
 
 // Accuracy of x for the problem (w computed as A x + b). A non-finite x or w gives

@@ -17,20 +17,20 @@ extern "C" {
 typedef struct mlcp_ode_stepper mlcp_ode_stepper;
 
 /* A stepper with the named solver and default options, or NULL (see mlcp_ode_last_error). */
-mlcp_ode_stepper *mlcp_ode_stepper_create(const char *solver);
-void mlcp_ode_stepper_destroy(mlcp_ode_stepper *stepper);
+mlcp_ode_stepper* mlcp_ode_stepper_create(const char* solver);
+void mlcp_ode_stepper_destroy(mlcp_ode_stepper* stepper);
 /* Core solver settings: residual tolerance (default 1e-10) and iteration limit (default 1000).
  * Return 1, or 0 for an invalid value (the setting is then unchanged). */
-int mlcp_ode_stepper_set_tolerance(mlcp_ode_stepper *stepper, double tolerance);
-int mlcp_ode_stepper_set_max_iterations(mlcp_ode_stepper *stepper, int iterations);
+int mlcp_ode_stepper_set_tolerance(mlcp_ode_stepper* stepper, double tolerance);
+int mlcp_ode_stepper_set_max_iterations(mlcp_ode_stepper* stepper, int iterations);
 /* Like dWorldStep: 1 on success, 0 when ODE could not allocate working memory. */
-int mlcp_ode_stepper_step(mlcp_ode_stepper *stepper, dWorldID world, dReal stepsize);
+int mlcp_ode_stepper_step(mlcp_ode_stepper* stepper, dWorldID world, dReal stepsize);
 /* Statistics of the last step: constraint rows, largest island residual, fallbacks used. */
-int mlcp_ode_stepper_last_rows(const mlcp_ode_stepper *stepper);
-double mlcp_ode_stepper_last_residual(const mlcp_ode_stepper *stepper);
-int mlcp_ode_stepper_last_fallbacks(const mlcp_ode_stepper *stepper);
+int mlcp_ode_stepper_last_rows(const mlcp_ode_stepper* stepper);
+double mlcp_ode_stepper_last_residual(const mlcp_ode_stepper* stepper);
+int mlcp_ode_stepper_last_fallbacks(const mlcp_ode_stepper* stepper);
 /* The message of the last failed create/set call on this thread ("" if none). */
-const char *mlcp_ode_last_error(void);
+const char* mlcp_ode_last_error(void);
 
 #ifdef __cplusplus
 }
