@@ -12,7 +12,7 @@ namespace mlcp {
 namespace {
 
 // M^-1 j for one body: [invMass * linear; invInertia * angular].
-Vector6 applyInverseMass(const BodyInverseMass& body, const Vector6& j) {
+inline Vector6 applyInverseMass(const BodyInverseMass& body, const Vector6& j) {
   Vector6 out;
   out.head<3>() = body.invMass * j.head<3>();
   out.tail<3>() = body.invInertia * j.tail<3>();
@@ -30,35 +30,45 @@ Problem boundsOnly(const RowSystem& s) {
   return p;
 }
 
-// Every per-row rule of RowSystem::validate and Problem::validate (b, bounds, findex) as one
-// predicate in one pass without copies: the fast path of RowSystem::validate, which the adapters
-// call every step. When it says no, the checks below find the row and say what is wrong
-// (Problem::validate stays the one statement of the bound rules' wording). A false alarm (a sum
-// of finite Jacobian entries overflowing) only costs the slow path.
-bool rowsValid(const RowSystem& s) {
+// Every per-row rule of RowSystem::validate and Problem::validate (b, bounds, findex) for row i as
+// one predicate without copies: the fast path of RowSystem::validate, which the adapters call
+// every step, and the check RowPgs folds into its packing pass. When it says no, the checks in
+// RowSystem::validate find the row and say what is wrong (Problem::validate stays the one
+// statement of the bound rules' wording). A false alarm (a sum of finite Jacobian entries
+// overflowing) only costs the slow path. slots = bodies + 1; the array sizes are checked.
+inline bool rowValid(const RowSystem& s, int i, unsigned slots) {
+  const ConstraintRow& r = s.rows[i];
+  if (static_cast<unsigned>(r.bodyA + 1) >= slots || static_cast<unsigned>(r.bodyB + 1) >= slots)
+    return false;
+  // Any NaN or Inf entry makes the sum NaN or Inf.
+  if (!std::isfinite(r.jA.sum() + r.jB.sum())) return false;
+  if (!(s.cfm[i] >= 0 && s.cfm[i] < kInf)) return false;
+  const double lo = s.lo[i], hi = s.hi[i];
+  // !(lo <= hi) also catches NaN bounds.
+  if (!std::isfinite(s.b[i]) || !(lo <= hi) || lo == kInf || hi == -kInf) return false;
+  if (s.findex.empty()) return true;
+  const int f = s.findex[i];
+  if (f < 0) return f == -1;
+  if (f >= s.size() || f == i || s.findex[f] >= 0) return false;
+  return hi >= 0 && std::isfinite(hi) && lo == -hi;
+}
+
+// The rules rowValid assumes: the per-row arrays' sizes and finite, non-negative body masses.
+bool arraysAndBodiesValid(const RowSystem& s) {
   const int n = s.size();
-  const unsigned slots = static_cast<unsigned>(s.bodies.size()) + 1;  // -1 .. nb - 1
-  const bool coupled = !s.findex.empty();
-  if (coupled && static_cast<int>(s.findex.size()) != n) return false;
-  for (int i = 0; i < n; ++i) {
-    const ConstraintRow& r = s.rows[i];
-    if (static_cast<unsigned>(r.bodyA + 1) >= slots || static_cast<unsigned>(r.bodyB + 1) >= slots)
+  if (s.b.size() != n || s.lo.size() != n || s.hi.size() != n || s.cfm.size() != n) return false;
+  if (!s.findex.empty() && static_cast<int>(s.findex.size()) != n) return false;
+  for (const BodyInverseMass& body : s.bodies)
+    if (!std::isfinite(body.invMass) || body.invMass < 0 || !body.invInertia.allFinite())
       return false;
-    // Any NaN or Inf entry makes the sum NaN or Inf.
-    if (!std::isfinite(r.jA.sum() + r.jB.sum())) return false;
-    if (!(s.cfm[i] >= 0 && s.cfm[i] < kInf)) return false;
-    const double lo = s.lo[i], hi = s.hi[i];
-    // !(lo <= hi) also catches NaN bounds.
-    if (!std::isfinite(s.b[i]) || !(lo <= hi) || lo == kInf || hi == -kInf) return false;
-    if (!coupled) continue;
-    const int f = s.findex[i];
-    if (f < 0) {
-      if (f != -1) return false;
-      continue;
-    }
-    if (f >= n || f == i || s.findex[f] >= 0) return false;
-    if (!(hi >= 0) || !std::isfinite(hi) || lo != -hi) return false;
-  }
+  return true;
+}
+
+bool rowsValid(const RowSystem& s) {
+  const unsigned slots = static_cast<unsigned>(s.bodies.size()) + 1;  // -1 .. nb - 1
+  if (!s.findex.empty() && static_cast<int>(s.findex.size()) != s.size()) return false;
+  for (int i = 0; i < s.size(); ++i)
+    if (!rowValid(s, i, slots)) return false;
   return true;
 }
 
@@ -180,20 +190,56 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
   const double t0 = nowSeconds();
   const Options& opt = options_;
   Result result;
-  if (std::string why = s.validate(); !why.empty()) {
+  auto invalid = [&](std::string why) {
     result.status = Status::InvalidInput;
-    result.message = why;
+    result.message = std::move(why);
     return result;
-  }
-  if (!(opt.relaxation > 0 && opt.relaxation < 2)) {
-    result.status = Status::InvalidInput;
-    result.message = "relaxation outside (0, 2)";
-    return result;
-  }
+  };
+  if (!(opt.relaxation > 0 && opt.relaxation < 2)) return invalid("relaxation outside (0, 2)");
+  // Validation is folded into the packing pass below (rowValid per row); RowSystem::validate
+  // runs only to name what is wrong.
+  if (!arraysAndBodiesValid(s)) return invalid(s.validate());
   const int n = s.size();
   const int world = static_cast<int>(s.bodies.size());  // the zero-velocity slot
-  // The input is valid: x is the iterate from here on (no copy).
-  if (!(opt.warmStart && x.size() == n && x.allFinite())) x.setZero(n);
+  const unsigned slots = static_cast<unsigned>(world) + 1;
+  // x is the caller's until the input is known to be valid: a cold start reads zeros.
+  const bool warm = opt.warmStart && x.size() == n && x.allFinite();
+
+  packed_.resize(n);
+  velocity_.resize(world + 1);
+  for (BodyVelocity& v : velocity_) v.v.setZero();
+  double d = 0;  // A_ii of the row that stopped the packing
+  int bad = -1;  // that row
+  for (int i = 0; i < n; ++i) {
+    if (!rowValid(s, i, slots)) return invalid(s.validate());
+    const ConstraintRow& r = s.rows[i];
+    PackedRow& p = packed_[i];
+    // "The world" (-1) becomes the zero-velocity slot (its J meets v = 0, its M^-1 J^T is 0).
+    p.a = r.bodyA >= 0 ? r.bodyA : world;
+    p.b = r.bodyB >= 0 ? r.bodyB : world;
+    p.mA = r.bodyA >= 0 ? applyInverseMass(s.bodies[r.bodyA], r.jA) : Vector6::Zero();
+    p.mB = r.bodyB >= 0 ? applyInverseMass(s.bodies[r.bodyB], r.jB) : Vector6::Zero();
+    p.cfm = s.cfm[i];
+    p.rhs = s.b[i];
+    p.lo = s.lo[i];
+    p.hi = s.hi[i];
+    p.findex = s.findex.empty() ? -1 : s.findex[i];
+    d = r.jA.dot(p.mA) + r.jB.dot(p.mB) + p.cfm;
+    if (!(d > 0)) {
+      bad = i;
+      break;
+    }
+    p.step = opt.relaxation / d;
+    // v = M^-1 J^T x of the start.
+    if (const double xi = warm ? x[i] : 0.0; xi != 0) {
+      velocity_[p.a].v += p.mA * xi;
+      velocity_[p.b].v += p.mB * xi;
+    }
+  }
+  velocity_[world].v.setZero();  // the world never moves (its blocks are zero anyway)
+  // The input is valid from here on (a non-positive A_ii is a failure, not invalid input):
+  // x is the iterate (no copy).
+  if (!warm) x.setZero(n);
   const double bNorm = n ? s.b.lpNorm<Eigen::Infinity>() : 0.0;
   Accuracy last;           // accuracy of x as it is after the last check
   bool lastValid = false;  // whether x is unchanged since
@@ -208,48 +254,19 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
     result.seconds = nowSeconds() - t0;
     return result;
   };
-
-  packed_.resize(n);
-  velocity_.resize(world + 1);
-  for (BodyVelocity& v : velocity_) v.v.setZero();
-  // One side of a row: "the world" (-1) becomes the zero-velocity slot (its J meets v = 0).
-  auto packSide = [&](int body, const Vector6& j, int& slot, Vector6& mj) {
-    slot = body >= 0 ? body : world;
-    if (body >= 0)
-      mj = applyInverseMass(s.bodies[body], j);
-    else
-      mj.setZero();
-  };
-  for (int i = 0; i < n; ++i) {
-    const ConstraintRow& r = s.rows[i];
-    PackedRow& p = packed_[i];
-    packSide(r.bodyA, r.jA, p.a, p.mA);
-    packSide(r.bodyB, r.jB, p.b, p.mB);
-    p.cfm = s.cfm[i];
-    p.rhs = s.b[i];
-    p.lo = s.lo[i];
-    p.hi = s.hi[i];
-    p.findex = s.findex.empty() ? -1 : s.findex[i];
-    const double d = r.jA.dot(p.mA) + r.jB.dot(p.mB) + p.cfm;
-    if (!(d > 0)) {
-      // velocity_ does not hold M^-1 J^T x yet: the final check uses the rows themselves.
-      packed_.resize(i);
-      std::ostringstream os;
-      os << "row " << i << " has A_ii = " << d << ": pgs needs a positive diagonal";
-      result.status = Status::Failed;
-      result.message = os.str();
-      last = accuracy(x, s.slack(x), s.lo, s.hi, s.findex, bNorm);
-      lastValid = true;
-      return finish();
-    }
-    p.step = opt.relaxation / d;
-    // v = M^-1 J^T x of the start.
-    if (const double xi = x[i]; xi != 0) {
-      velocity_[p.a].v += p.mA * xi;
-      velocity_[p.b].v += p.mB * xi;
-    }
+  if (bad >= 0) {
+    // Rows after it are not checked yet; validate them all before reporting the failure.
+    if (std::string why = s.validate(); !why.empty()) return invalid(why);
+    // velocity_ does not hold M^-1 J^T x: the final check uses the rows themselves.
+    packed_.resize(bad);
+    std::ostringstream os;
+    os << "row " << bad << " has A_ii = " << d << ": pgs needs a positive diagonal";
+    result.status = Status::Failed;
+    result.message = os.str();
+    last = accuracy(x, s.slack(x), s.lo, s.hi, s.findex, bNorm);
+    lastValid = true;
+    return finish();
   }
-  velocity_[world].v.setZero();  // the world never moves (its blocks are zero anyway)
 
   detail::SweepMonitor monitor(opt, result);
   if (n == 0) {

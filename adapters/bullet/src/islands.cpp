@@ -38,20 +38,6 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
             nr = in.rolling->size();
   const int n = nj + nc + nf + nr;
 
-  // Rows in the stock order; friction rows point at their contact row.
-  all_.resize(n);
-  findex_.assign(n, -1);
-  for (int i = 0; i < nj; ++i) all_[i] = &(*in.joints)[i];
-  for (int i = 0; i < nc; ++i) all_[nj + i] = &(*in.contacts)[i];
-  for (int i = 0; i < nf; ++i) {
-    all_[nj + nc + i] = &(*in.friction)[i];
-    findex_[nj + nc + i] = nj + (*in.friction)[i].m_frictionIndex;
-  }
-  for (int i = 0; i < nr; ++i) {
-    all_[nj + nc + nf + i] = &(*in.rolling)[i];
-    findex_[nj + nc + nf + i] = nj + (*in.rolling)[i].m_frictionIndex;
-  }
-
   dynamic_.resize(nb);
   parent_.resize(nb);
   for (int k = 0; k < nb; ++k) {
@@ -59,10 +45,29 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     dynamic_[k] = (rb && rb->getInvMass() != 0) ? k : -1;
     parent_[k] = k;
   }
-  auto dyn = [&](int solverBody) { return solverBody >= 0 ? dynamic_[solverBody] : -1; };
-  for (int i = 0; i < n; ++i) {
-    const int a = dyn(all_[i]->m_solverBodyIdA), b = dyn(all_[i]->m_solverBodyIdB);
+
+  // One pass over Bullet's rows for the graph: rows in the stock order, friction rows pointing at
+  // their contact row, each row's dynamic bodies kept compact for the passes below.
+  all_.resize(n);
+  findex_.resize(n);
+  rowBodies_.resize(n);
+  auto add = [&](int i, btSolverConstraint& c, int f) {
+    all_[i] = &c;
+    findex_[i] = f;
+    const int a = c.m_solverBodyIdA >= 0 ? dynamic_[c.m_solverBodyIdA] : -1;
+    const int b = c.m_solverBodyIdB >= 0 ? dynamic_[c.m_solverBodyIdB] : -1;
+    rowBodies_[i] = {a, b};
     if (a >= 0 && b >= 0) parent_[find(a)] = find(b);
+  };
+  for (int i = 0; i < nj; ++i) add(i, (*in.joints)[i], -1);
+  for (int i = 0; i < nc; ++i) add(nj + i, (*in.contacts)[i], -1);
+  for (int i = 0; i < nf; ++i) {
+    btSolverConstraint& c = (*in.friction)[i];
+    add(nj + nc + i, c, nj + c.m_frictionIndex);
+  }
+  for (int i = 0; i < nr; ++i) {
+    btSolverConstraint& c = (*in.rolling)[i];
+    add(nj + nc + nf + i, c, nj + c.m_frictionIndex);
   }
 
   // Islands numbered by first appearance in row order; rows keep their relative order.
@@ -72,10 +77,10 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
   rowLocal_.resize(n);
   count_ = 0;
   inert_ = 0;
-  std::vector<int>& rowsPer = bodyCount_;  // reused: rows per island, then bodies per island
+  std::vector<int>& rowsPer = bodyCount_;  // reused: rows per island
   rowsPer.clear();
   for (int i = 0; i < n; ++i) {
-    const int a = dyn(all_[i]->m_solverBodyIdA), b = dyn(all_[i]->m_solverBodyIdB);
+    const auto [a, b] = rowBodies_[i];
     if (a < 0 && b < 0) {
       rowIsland_[i] = -1;
       ++inert_;
@@ -100,7 +105,7 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     s.lo.resize(m);
     s.hi.resize(m);
     s.cfm.resize(m);
-    s.findex.assign(m, -1);
+    s.findex.resize(m);
     isl.rows.resize(m);
     isl.start.resize(m);
     isl.splitB.resize(m);
@@ -109,8 +114,7 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
   }
 
   // A dynamic body's local index in its island, created on first use.
-  auto localBody = [&](Island& isl, int solverBody) -> int {
-    const int d = dyn(solverBody);
+  auto localBody = [&](Island& isl, int d) -> int {
     if (d < 0) return -1;
     if (bodyLocal_[d] < 0) {
       const btSolverBody& sb = bodies[d];
@@ -125,6 +129,14 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
       isl.system.bodies.push_back(m);
     }
     return bodyLocal_[d];
+  };
+  // One side's Jacobian block: [n * linearFactor; r x n].
+  auto jacobian = [](Vector6& j, const btVector3& normal, const btVector3& linearFactor,
+                     const btVector3& torqueAxis) {
+    for (int k = 0; k < 3; ++k) {
+      j[k] = normal[k] * linearFactor[k];
+      j[3 + k] = torqueAxis[k];
+    }
   };
 
   const double stockCfm = info.m_globalCfm / info.m_timeStep;
@@ -142,20 +154,18 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     btSolverConstraint& c = *all_[i];
     isl.rows[r] = &c;
     ConstraintRow& row = s.rows[r];
-    row.bodyA = localBody(isl, c.m_solverBodyIdA);
-    row.bodyB = localBody(isl, c.m_solverBodyIdB);
-    if (row.bodyA >= 0) {
-      const btVector3 lin = c.m_contactNormal1 * bodies[c.m_solverBodyIdA].m_linearFactor;
-      row.jA << toEigen(lin), toEigen(c.m_relpos1CrossNormal);
-    } else {
+    row.bodyA = localBody(isl, rowBodies_[i].first);
+    row.bodyB = localBody(isl, rowBodies_[i].second);
+    if (row.bodyA >= 0)
+      jacobian(row.jA, c.m_contactNormal1, bodies[c.m_solverBodyIdA].m_linearFactor,
+               c.m_relpos1CrossNormal);
+    else
       row.jA.setZero();
-    }
-    if (row.bodyB >= 0) {
-      const btVector3 lin = c.m_contactNormal2 * bodies[c.m_solverBodyIdB].m_linearFactor;
-      row.jB << toEigen(lin), toEigen(c.m_relpos2CrossNormal);
-    } else {
+    if (row.bodyB >= 0)
+      jacobian(row.jB, c.m_contactNormal2, bodies[c.m_solverBodyIdB].m_linearFactor,
+               c.m_relpos2CrossNormal);
+    else
       row.jB.setZero();
-    }
     // rhs and cfm are stored pre-multiplied by 1 / A_ii; undo it (as btMLCPSolver does).
     const double jd = c.m_jacDiagABInv;
     const bool scaled = !btFuzzyZero(c.m_jacDiagABInv);
@@ -167,8 +177,8 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     else
       s.cfm[r] = scaled ? std::max(0.0, c.m_cfm / jd) : 0.0;
     if (cfm == CfmModel::Regularized && findex_[i] >= 0 && s.cfm[r] == 0) s.cfm[r] = stockCfm;
+    s.findex[r] = findex_[i] >= 0 ? rowLocal_[findex_[i]] : -1;
     if (findex_[i] >= 0) {
-      s.findex[r] = rowLocal_[findex_[i]];
       s.lo[r] = -std::abs(static_cast<double>(c.m_friction));
       s.hi[r] = std::abs(static_cast<double>(c.m_friction));
     } else if (i >= nj) {  // contact

@@ -13,6 +13,7 @@
 
 #include <BulletDynamics/ConstraintSolver/btSequentialImpulseConstraintSolver.h>
 
+#include <utility>
 #include <vector>
 
 #include "mlcp/rows.hpp"
@@ -58,6 +59,7 @@ class IslandBuilder {
   std::vector<btSolverConstraint*> all_;
   std::vector<int> findex_, dynamic_, parent_, islandOfRoot_, rowIsland_, rowLocal_, bodyLocal_;
   std::vector<int> bodyCount_;
+  std::vector<std::pair<int, int>> rowBodies_;  // each row's dynamic bodies (-1: none)
 };
 
 }  // namespace mlcp::bullet
