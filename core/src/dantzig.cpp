@@ -687,6 +687,7 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
     result.message = rep.message;
   };
   std::string blockMessage;
+  bool symmetric = false;  // known after a first run of the block stage
   // Auto first tries a few full steps from the cold guess (every row clamped): resting piles
   // (ODE) settle in one step there, often sooner than from a warm guess whose sets are off by
   // a few rows; when they do not settle the trial is dropped (its iterate is a worse start than
@@ -695,7 +696,8 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
     Vector trial = Vector::Zero(problem.size());
     const detail::BlockPivoting::Report rep =
         block_->run(problem, trial, options(),
-                    std::max(1, std::min(params_.autoColdSteps, params_.maxBlockSteps)));
+                    std::max(1, std::min(params_.autoColdSteps, params_.maxBlockSteps)), true);
+    symmetric = rep.symmetric;
     blockSteps_ += rep.steps;
     if (rep.settled) {
       x = trial;
@@ -704,9 +706,10 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
     }
     blockMessage = "cold trial: " + rep.message;
   }
-  if (warm || params_.blockStage == DantzigParams::BlockStage::Always) {
+  const bool warmStage = warm && problem.size() >= params_.autoWarmMinRows;
+  if (warmStage || params_.blockStage == DantzigParams::BlockStage::Always) {
     const detail::BlockPivoting::Report rep =
-        block_->run(problem, x, options(), std::max(1, params_.maxBlockSteps));
+        block_->run(problem, x, options(), std::max(1, params_.maxBlockSteps), false, symmetric);
     blockSteps_ += rep.steps;
     if (rep.settled) {
       settle(rep);

@@ -22,6 +22,70 @@ double signOf(double v) { return v < 0 ? -1.0 : 1.0; }
 double heldValue(double lo, double hi, bool atHi) { return atHi ? hi : lo; }
 }  // namespace
 
+bool SymmetricPatternLu::factor(int m, const std::vector<int>& outer, const std::vector<int>& inner,
+                                const std::vector<double>& k, const std::vector<double>& kt,
+                                double pivotTolerance) {
+  if (static_cast<int>(cols_.size()) < m) cols_.resize(m);
+  for (int c = 0; c < m; ++c) cols_[c].clear();
+  d_.assign(m, 0.0);
+  y_.assign(m, 0.0);
+  z_.assign(m, 0.0);
+  parent_.assign(m, -1);
+  tag_.assign(m, -1);
+  stack_.resize(m);
+  for (int col = 0; col < m; ++col) {
+    // Scatter column col of K above the diagonal into y, row col left of it into z; the rows
+    // of L's row col (the reach of column col's pattern in the elimination tree) go on the stack in
+    // topological order.
+    tag_[col] = col;
+    int top = m;
+    double dk = 0;
+    for (int e = outer[col]; e < outer[col + 1]; ++e) {
+      int i = inner[e];
+      if (i == col) dk = k[e];
+      if (i >= col) continue;
+      y_[i] = k[e];
+      z_[i] = kt[e];
+      int len = 0;
+      for (; tag_[i] != col; i = parent_[i]) {
+        stack_[len++] = i;
+        tag_[i] = col;
+        if (parent_[i] < 0) {
+          parent_[i] = col;
+          break;
+        }
+      }
+      while (len > 0) stack_[--top] = stack_[--len];
+    }
+    for (; top < m; ++top) {
+      const int i = stack_[top];
+      const double yi = y_[i], zi = z_[i];
+      y_[i] = z_[i] = 0;
+      for (const Entry& e : cols_[i]) {
+        y_[e.row] -= e.l * yi;
+        z_[e.row] -= e.u * zi;
+      }
+      dk -= zi * yi / d_[i];
+      cols_[i].push_back({col, zi / d_[i], yi / d_[i]});
+    }
+    if (!(std::abs(dk) > pivotTolerance)) return false;
+    d_[col] = dk;
+  }
+  return true;
+}
+
+void SymmetricPatternLu::solve(Vector& y) const {
+  const int m = static_cast<int>(y.size());
+  for (int i = 0; i < m; ++i)
+    for (const Entry& e : cols_[i]) y[e.row] -= e.l * y[i];
+  for (int i = 0; i < m; ++i) y[i] /= d_[i];
+  for (int i = m - 1; i >= 0; --i) {
+    double s = y[i];
+    for (const Entry& e : cols_[i]) s -= e.u * y[e.row];
+    y[i] = s;
+  }
+}
+
 // ||H(x)||^2 with H_i = x_i - clamp(x_i - w_i, lo'_i, hi'_i): zero exactly at a solution.
 double BlockPivoting::meritAt(const Problem& pb, const Vector& x, const Vector& w) const {
   double sum = 0;
@@ -38,13 +102,11 @@ double BlockPivoting::frictionBound(const Problem& pb, int t, Set s, const Vecto
 }
 
 // The first index sets. Cold: every row clamped (the Newton step of the linear system A x = -b).
-// Warm: from the natural map at the guess, z = x0 - w0 against the bounds at x0 (lo' when
-// z <= lo', hi' when z >= hi', clamped between), which is right for a guess that solves a
+// Warm: from the natural map at the guess (w0 = A x0 + b), z = x0 - w0 against the bounds at x0
+// (lo' when z <= lo', hi' when z >= hi', clamped between), which is right for a guess that solves a
 // nearby problem even where it holds rows only close to their bounds.
-void BlockPivoting::guess(const Problem& pb, const Vector& x0, bool cold) {
+void BlockPivoting::guess(const Problem& pb, const Vector& x0, const Vector& w0, bool cold) {
   const int n = pb.size();
-  Vector w0;
-  if (!cold) w0 = *a_ * x0 + pb.b;
   set_.assign(n, Set::Clamped);
   auto place = [&](int i, double lo, double hi) {
     if (cold) return;
@@ -141,7 +203,9 @@ bool BlockPivoting::solveClamped(const Problem& pb, Vector& x, const Vector& pre
 }
 
 void BlockPivoting::applySolve(Vector& y) const {
-  if (useLu_)
+  if (useLu_ && useSymLu_)
+    symLu_.solve(y);
+  else if (useLu_)
     y = lu_.solve(y);
   else
     y = ldlt_.solve(y);
@@ -195,7 +259,71 @@ bool BlockPivoting::factorClamped(double rho, std::string& why) {
 // fill-reducing order stays cheap.
 bool BlockPivoting::factorCoupled(double rho, std::string& why) {
   const SparseMatrix& A = *a_;
+  const int n = static_cast<int>(pos_.size());
   const int m = static_cast<int>(order_.size());
+  slidingHead_.assign(n, -1);
+  slidingNext_.resize(sliding_.size());
+  for (size_t k = 0; k < sliding_.size(); ++k) {
+    const int j = problemFindex_[sliding_[k]];
+    slidingNext_[k] = slidingHead_[j];
+    slidingHead_[j] = static_cast<int>(k);
+  }
+  mark_.assign(n, -1);
+  coupled_.assign(n, 0.0);
+  column_.assign(n, 0.0);
+  kOuter_.assign(m + 1, 0);
+  kInner_.clear();
+  kVal_.clear();
+  ktVal_.clear();
+  for (int c = 0; c < m; ++c) {
+    const int i = order_[c];
+    // Column c of K: A(C, i) plus, when i is a normal, c_t A(C, t) for its sliding rows t;
+    // row c: A(i, C) plus c_t' A(i, t') at the columns of normals with sliding rows t'.
+    bool diagonal = false;
+    for (SparseMatrix::InnerIterator it(A, i); it; ++it) {
+      column_[it.index()] = it.value();
+      mark_[it.index()] = c;
+    }
+    for (int k = slidingHead_[i]; k >= 0; k = slidingNext_[k])
+      for (SparseMatrix::InnerIterator it(A, sliding_[k]); it; ++it) {
+        if (pos_[it.index()] < 0) continue;
+        if (mark_[it.index()] != c) return factorGeneral(rho, why);  // outside A_CC's pattern
+        coupled_[it.index()] += coeff_[k] * it.value();
+      }
+    for (SparseMatrix::InnerIterator it(A, i); it; ++it) {
+      const int r = it.index();
+      if (pos_[r] < 0) continue;
+      double kt = it.value();
+      for (int k = slidingHead_[r]; k >= 0; k = slidingNext_[k])
+        kt += coeff_[k] * column_[sliding_[k]];
+      const double extra = r == i ? rho : 0.0;
+      diagonal |= r == i;
+      kInner_.push_back(pos_[r]);
+      kVal_.push_back(it.value() + coupled_[r] + extra);
+      ktVal_.push_back(kt + extra);
+    }
+    if (!diagonal) {
+      kInner_.push_back(c);
+      kVal_.push_back(rho);
+      ktVal_.push_back(rho);
+    }
+    for (SparseMatrix::InnerIterator it(A, i); it; ++it) column_[it.index()] = 0;
+    for (int k = slidingHead_[i]; k >= 0; k = slidingNext_[k])
+      for (SparseMatrix::InnerIterator it(A, sliding_[k]); it; ++it) coupled_[it.index()] = 0;
+    kOuter_[c + 1] = static_cast<int>(kInner_.size());
+  }
+  useSymLu_ = true;
+  if (symLu_.factor(m, kOuter_, kInner_, kVal_, ktVal_, pivTol_)) return true;
+  why = "the clamped system with its sliding rows is singular";
+  return false;
+}
+
+// factorCoupled for a K whose pattern is not symmetric: a general sparse LU with pivoting.
+bool BlockPivoting::factorGeneral(double rho, std::string& why) {
+  const SparseMatrix& A = *a_;
+  const int m = static_cast<int>(order_.size());
+  std::fill(coupled_.begin(), coupled_.end(), 0.0);
+  std::fill(column_.begin(), column_.end(), 0.0);
   triplets_.clear();
   for (int c = 0; c < m; ++c) {
     for (SparseMatrix::InnerIterator it(A, order_[c]); it; ++it)
@@ -210,6 +338,7 @@ bool BlockPivoting::factorCoupled(double rho, std::string& why) {
   }
   Kfull_.resize(m, m);
   Kfull_.setFromTriplets(triplets_.begin(), triplets_.end());
+  useSymLu_ = false;
   lu_.analyzePattern(Kfull_);
   lu_.factorize(Kfull_);
   if (lu_.info() != Eigen::Success) {
@@ -260,7 +389,7 @@ int BlockPivoting::setsAt(const Problem& pb, const Vector& x, const Vector& w) {
 }
 
 BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Options& opt,
-                                         int maxSteps) {
+                                         int maxSteps, bool trial, bool symmetryKnown) {
   Report rep;
   const int n = pb.size();
   if (pb.isSparse()) {
@@ -269,10 +398,11 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
     A_ = pb.toSparse();
     a_ = &A_;
   }
-  if (!isSymmetric(*a_)) {
+  if (!symmetryKnown && !isSymmetric(*a_)) {
     rep.message = "A is not symmetric";
     return rep;
   }
+  rep.symmetric = true;
   problemFindex_ = pb.findex.empty() ? std::vector<int>(n, -1) : pb.findex;
   // A fill-reducing order of all of A; every clamped block is factored in the induced order,
   // whose fill is at most A's, so the ordering is computed once per pattern of A.
@@ -289,7 +419,8 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
   eps_ = 0.01 * opt.tolerance * (1 + pb.b.lpNorm<Eigen::Infinity>());
   pos_.assign(n, -1);
   const bool cold = x.isZero(0.0);
-  guess(pb, x, cold);
+  Vector w = *a_ * x + pb.b, xOld(n), wOld(n), wNew(n);
+  guess(pb, x, w, cold);
 
   // Full steps (block principal pivoting) while they keep finding new lowest merits
   // ||H(x)||^2 (H_i = x_i - clamp(x_i - w_i, lo', hi')); then damped Newton steps on the natural
@@ -297,7 +428,6 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
   // which keeps degenerate scenes (coplanar contacts: nearly singular clamped blocks whose
   // equations throw the null-space part far away) from jumping between set guesses. When no
   // step length descends the stage hands over the best iterate.
-  Vector w = *a_ * x + pb.b, xOld(n), wOld(n), wNew(n);
   const double regularization = kProximal * (dMax > 0 ? dMax : 1.0);
   double merit = meritAt(pb, x, w), bestRes = kInf;
   int uphill = 0;
@@ -343,7 +473,7 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
     }
     if (rep.steps > 0) {
       if (damped)
-        guess(pb, x, false);
+        guess(pb, x, w, false);
       else
         setsAt(pb, x, w);
     }
@@ -353,7 +483,7 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
     std::string why;
     const double rho = damped ? regularization * std::min(1.0, std::sqrt(merit)) : 0.0;
     if (!solveClamped(pb, x, xOld, rho, why)) {
-      if (!damped) {  // a singular block: the proximal term regularizes it
+      if (!damped && !trial) {  // a singular block: the proximal term regularizes it
         x = fullBestX;
         w = *a_ * x + pb.b;
         merit = fullBest;
@@ -374,6 +504,10 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
         fullBest = merit;
         fullBestX = x;
         uphill = 0;
+      } else if (trial) {
+        x = bestX;
+        os << "residual " << bestRes << " after " << rep.steps << " full steps";
+        break;
       } else if (++uphill > kUphill) {  // no new best: damped steps from the best point
         x = fullBestX;
         w = *a_ * x + pb.b;

@@ -13,17 +13,44 @@
 
 namespace mlcp::detail {
 
+// K = L D U without pivoting (L unit lower, U unit upper) for a sparse square K whose pattern
+// is symmetric, in the given order: up-looking, row k of L and column k of U from two sparse
+// triangular solves over the elimination tree (built as it goes), so L and U^T share one
+// pattern, that of the Cholesky factor of the pattern. Twice an LDL^T's work, no symbolic phase.
+class SymmetricPatternLu {
+ public:
+  // K (m x m) in compressed columns, rows in any order within a column; kt holds the values of
+  // K^T on the same pattern (kt at the entry (i, j) is K(j, i)). False when a pivot's magnitude
+  // is at most pivotTolerance (or not finite).
+  bool factor(int m, const std::vector<int>& outer, const std::vector<int>& inner,
+              const std::vector<double>& k, const std::vector<double>& kt, double pivotTolerance);
+  void solve(Vector& y) const;  // y <- K^-1 y
+
+ private:
+  struct Entry {
+    int row;
+    double l, u;  // L(row, col) and U(col, row)
+  };
+  std::vector<std::vector<Entry>> cols_;
+  std::vector<double> d_, y_, z_;
+  std::vector<int> parent_, tag_, stack_;
+};
+
 class BlockPivoting {
  public:
   struct Report {
-    bool settled = false;  // x solves the problem to Options::tolerance (checked by residual())
-    int steps = 0;         // factorizations (block or single-switch steps)
+    bool settled = false;    // x solves the problem to Options::tolerance (checked by residual())
+    int steps = 0;           // factorizations (block or single-switch steps)
+    bool symmetric = false;  // A passed the symmetry check (else the stage did not run)
     std::string message;
   };
 
   // Runs from x (all zero: the cold guess "every row clamped"); leaves in x the solution when
-  // settled, else the iterate with the fewest violated rows. A must be symmetric.
-  Report run(const Problem& problem, Vector& x, const Options& options, int maxSteps);
+  // settled, else the iterate with the fewest violated rows. A must be symmetric (checked unless
+  // symmetryKnown: a previous run() on the same problem found it so). A trial takes full steps
+  // only and ends at the first one that brings no new lowest merit.
+  Report run(const Problem& problem, Vector& x, const Options& options, int maxSteps,
+             bool trial = false, bool symmetryKnown = false);
 
   int orderings() const { return aPattern_.analyses(); }
 
@@ -32,7 +59,7 @@ class BlockPivoting {
   using ColMajor = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
   using Ldlt = Eigen::SimplicialLDLT<ColMajor, Eigen::Upper, Eigen::NaturalOrdering<int>>;
 
-  void guess(const Problem& pb, const Vector& x0, bool cold);
+  void guess(const Problem& pb, const Vector& x0, const Vector& w0, bool cold);
   bool solveClamped(const Problem& pb, Vector& x, const Vector& prev, double rho, std::string& why);
   bool factorClamped(double rho, std::string& why);
   bool factorCoupled(double rho, std::string& why);
@@ -53,8 +80,16 @@ class BlockPivoting {
   Ldlt ldlt_;
   bool useLu_ = false;  // sliding rows present: K is nonsymmetric and factored by lu_
   std::vector<Eigen::Triplet<double>> triplets_;
-  ColMajor Kfull_;  // all of K (sliding rows substituted), for lu_
+  // K with its sliding rows substituted: A_CC's pattern (compressed columns) with the values of
+  // K and of K^T, factored by symLu_; when a sliding row touches an entry outside that pattern,
+  // Kfull_ from triplets_ and the general sparse LU.
+  std::vector<int> kOuter_, kInner_, mark_, slidingHead_, slidingNext_;
+  std::vector<double> kVal_, ktVal_, coupled_, column_;
+  SymmetricPatternLu symLu_;
+  bool useSymLu_ = false;
+  ColMajor Kfull_;
   Eigen::SparseLU<ColMajor, Eigen::NaturalOrdering<int>> lu_;
+  bool factorGeneral(double rho, std::string& why);
   double eps_ = 0, pivTol_ = 0;
 };
 
