@@ -106,7 +106,7 @@ btScalar ConstraintSolver::solveGroupCacheFriendlyIterations(
     current_.seconds += nowSeconds() - t0;
     if (settings_.measureSi || settings_.keepIslands) {
       const double t1 = nowSeconds();
-      builder_.build(rows, info, settings_.cfm, true);  // start = SI's final impulses
+      builder_.build(rows, info, settings_.cfm, Start::AppliedImpulse);  // SI's answer
       measureSi(info.m_numIterations);
       current_.measureSeconds += nowSeconds() - t1;
     } else {
@@ -121,7 +121,8 @@ btScalar ConstraintSolver::solveGroupCacheFriendlyIterations(
         if (*name == "pgs" || *name == "gs")
           options->maxIterations = options->checkEvery = info.m_numIterations;
     }
-    builder_.build(rows, info, settings_.cfm, settings_.warmStart);
+    builder_.build(rows, info, settings_.cfm,
+                   settings_.warmStart ? Start::CachedImpulse : Start::Zero);
     current_.inertRows += builder_.inertRows();
     for (int k = 0; k < builder_.count(); ++k) {
       Island& island = builder_.island(k);

@@ -31,7 +31,7 @@ int IslandBuilder::find(int k) {
 }
 
 void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info, CfmModel cfm,
-                          bool warmStart) {
+                          Start start) {
   const btAlignedObjectArray<btSolverBody>& bodies = *in.bodies;
   const int nb = bodies.size();
   const int nj = in.joints->size(), nc = in.contacts->size(), nf = in.friction->size(),
@@ -142,10 +142,11 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
   const double stockCfm = info.m_globalCfm / info.m_timeStep;
   // SI starts contacts and friction from the cached impulse times m_warmstartingFactor (0.85); a
   // solver that can use a guess gets the cached impulse itself.
-  const double unscaleContacts =
-      (info.m_warmstartingFactor > 0 && (info.m_solverMode & SOLVER_USE_WARMSTARTING))
-          ? 1.0 / info.m_warmstartingFactor
-          : 1.0;
+  const double unscaleContacts = (start == Start::CachedImpulse && info.m_warmstartingFactor > 0 &&
+                                  (info.m_solverMode & SOLVER_USE_WARMSTARTING))
+                                     ? 1.0 / info.m_warmstartingFactor
+                                     : 1.0;
+  const bool warm = start != Start::Zero;
   for (int i = 0; i < n; ++i) {
     if (rowIsland_[i] < 0) continue;
     Island& isl = islands_[rowIsland_[i]];
@@ -189,8 +190,8 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
       s.hi[r] = bound(c.m_upperLimit);
     }
     const double unscale = i >= nj ? unscaleContacts : 1.0;
-    isl.start[r] = warmStart ? unscale * static_cast<double>(c.m_appliedImpulse) : 0.0;
-    isl.splitStart[r] = warmStart ? static_cast<double>(c.m_appliedPushImpulse) : 0.0;
+    isl.start[r] = warm ? unscale * static_cast<double>(c.m_appliedImpulse) : 0.0;
+    isl.splitStart[r] = warm ? static_cast<double>(c.m_appliedPushImpulse) : 0.0;
   }
 }
 

@@ -22,6 +22,15 @@ namespace mlcp::bullet {
 
 enum class CfmModel;
 
+// What each island's start (and splitStart) holds.
+enum class Start {
+  Zero,            // a cold start
+  CachedImpulse,   // last step's impulses, the warm start: contacts' and friction's applied
+                   // impulse divided by m_warmstartingFactor (SI's setup applied the scaled
+                   // impulse), joints' as applied
+  AppliedImpulse,  // the applied impulses as they are (after SI's iterations: SI's answer)
+};
+
 struct Island {
   RowSystem system;                       // w = A x + b with b from m_rhs
   std::vector<btSolverConstraint*> rows;  // Bullet's row for each system row
@@ -42,9 +51,8 @@ struct BulletRows {
 
 class IslandBuilder {
  public:
-  // Splits the rows into islands. globalCfm and timeStep feed CfmModel::StockMlcp and Regularized;
-  // warmStart false starts every island from zero.
-  void build(const BulletRows& rows, const btContactSolverInfo& info, CfmModel cfm, bool warmStart);
+  // Splits the rows into islands. globalCfm and timeStep feed CfmModel::StockMlcp and Regularized.
+  void build(const BulletRows& rows, const btContactSolverInfo& info, CfmModel cfm, Start start);
 
   int count() const { return count_; }
   Island& island(int k) { return islands_[k]; }
