@@ -42,6 +42,19 @@ void Problem::setA(SparseMatrix A) {
   sparse_ = true;
 }
 
+void Problem::swapA(DenseMatrix& A) {
+  dense_.swap(A);
+  sparseA_ = SparseMatrix();
+  sparse_ = false;
+}
+
+void Problem::swapA(SparseMatrix& A) {
+  sparseA_.swap(A);
+  sparseA_.makeCompressed();
+  dense_ = DenseMatrix();
+  sparse_ = true;
+}
+
 DenseMatrix Problem::toDense() const { return sparse_ ? DenseMatrix(sparseA_) : dense_; }
 
 SparseMatrix Problem::toSparse() const {

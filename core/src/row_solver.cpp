@@ -147,9 +147,11 @@ Result RowSolver::run(const RowSystem& rows, const std::string& name, const Opti
     x = start;
     return rowPgs_.solve(rows, x);
   }
-  if (!haveAssembled_) {
+  // ldlt factors sparse storage whatever the size (a dense A would be converted every solve).
+  const bool sparse = name == "ldlt" || rows.size() > settings_.denseMaxRows;
+  if (!haveAssembled_ || assembled_.isSparse() != sparse) {
     const double t0 = nowSeconds();
-    assemble(rows);
+    assemble(rows, sparse);
     report.assembleSeconds += nowSeconds() - t0;
   }
   Solver* solver = assembledSolver(island, name);
@@ -157,13 +159,13 @@ Result RowSolver::run(const RowSystem& rows, const std::string& name, const Opti
   return solver->solveWithGuess(assembled_, start, x);
 }
 
-void RowSolver::assemble(const RowSystem& rows) {
-  rows.assemble(rows.size() > settings_.denseMaxRows, assembled_, assembleScratch_);
+void RowSolver::assemble(const RowSystem& rows, bool sparse) {
+  rows.assemble(sparse, assembled_, assembleScratch_);
   haveAssembled_ = true;
 }
 
 void RowSolver::capture(const RowSystem& rows) {
-  if (!haveAssembled_) assemble(rows);
+  if (!haveAssembled_) assemble(rows, rows.size() > settings_.denseMaxRows);
   const std::string path = capturePrefix_ + "island" + std::to_string(captured_.size()) + ".json";
   io::writeProblemJson(assembled_, path);
   captured_.push_back(path);

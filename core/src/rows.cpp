@@ -152,28 +152,79 @@ void RowSystem::assemble(bool sparse, Problem& p, AssembleScratch& scratch) cons
     if (rows[i].bodyA >= 0) touching[rows[i].bodyA].push_back({i, &rows[i].jA});
     if (rows[i].bodyB >= 0) touching[rows[i].bodyB].push_back({i, &rows[i].jB});
   }
-  auto& triplets = scratch.triplets;
-  triplets.clear();
-  for (int i = 0; i < n; ++i) triplets.emplace_back(i, i, cfm[i]);
-  for (std::size_t k = 0; k < bodies.size(); ++k) {
-    for (const auto& [i, ji] : touching[k]) {
-      const Vector6 mji = applyInverseMass(bodies[k], *ji);
-      for (const auto& [j, jj] : touching[k]) triplets.emplace_back(i, j, jj->dot(mji));
+  // Every entry of A as (row, column, value) in one fixed order: diag(cfm), then per body the
+  // products of the rows touching it. Dense and sparse storage sum them in this order.
+  auto forEachProduct = [&](auto&& add) {
+    for (int i = 0; i < n; ++i) add(i, i, cfm[i]);
+    for (std::size_t k = 0; k < bodies.size(); ++k) {
+      for (const auto& [i, ji] : touching[k]) {
+        const Vector6 mji = applyInverseMass(bodies[k], *ji);
+        for (const auto& [j, jj] : touching[k]) add(i, j, jj->dot(mji));
+      }
     }
-  }
+  };
   p.b = b;
   p.lo = lo;
   p.hi = hi;
   p.findex = findex;
-  if (sparse) {
-    SparseMatrix A(n, n);
-    A.setFromTriplets(triplets.begin(), triplets.end());
-    p.setA(std::move(A));
-  } else {
-    DenseMatrix A = DenseMatrix::Zero(n, n);
-    for (const auto& t : triplets) A(t.row(), t.col()) += t.value();
-    p.setA(std::move(A));
+  if (!sparse) {
+    DenseMatrix& A = scratch.dense;
+    p.swapA(A);  // A now holds the problem's previous dense storage
+    A.setZero(n, n);
+    forEachProduct([&](int i, int j, double v) { A(i, j) += v; });
+    p.swapA(A);
+    return;
   }
+  // The pattern depends only on which bodies each row joins; `into` must still hold it (its
+  // index arrays are compared, so a matrix set by anyone else is never refilled by mistake).
+  auto& key = scratch.patternBodies;
+  const bool samePattern = [&] {
+    const SparseMatrix& held = p.sparseA();
+    if (!p.isSparse() || held.rows() != n || held.cols() != n || !held.isCompressed() ||
+        key.size() != 1 + 2 * static_cast<std::size_t>(n) ||
+        key[0] != static_cast<int>(bodies.size()) ||
+        held.nonZeros() != static_cast<Eigen::Index>(scratch.patternInner.size()))
+      return false;
+    for (int i = 0; i < n; ++i)
+      if (key[1 + 2 * i] != rows[i].bodyA || key[2 + 2 * i] != rows[i].bodyB) return false;
+    return std::equal(scratch.patternOuter.begin(), scratch.patternOuter.end(),
+                      held.outerIndexPtr()) &&
+           std::equal(scratch.patternInner.begin(), scratch.patternInner.end(),
+                      held.innerIndexPtr());
+  }();
+  SparseMatrix& A = scratch.sparse;
+  p.swapA(A);  // A now holds the problem's previous sparse matrix
+  if (samePattern) {
+    double* values = A.valuePtr();
+    std::fill_n(values, A.nonZeros(), 0.0);
+    const int* slot = scratch.valueSlot.data();
+    forEachProduct([&](int, int, double v) { values[*slot++] += v; });
+  } else {
+    auto& triplets = scratch.triplets;
+    triplets.clear();
+    forEachProduct([&](int i, int j, double v) { triplets.emplace_back(i, j, v); });
+    A.resize(n, n);
+    A.setFromTriplets(triplets.begin(), triplets.end());
+    A.makeCompressed();
+    // Where each product landed (row-major: search the row's sorted column indices).
+    scratch.valueSlot.resize(triplets.size());
+    for (std::size_t t = 0; t < triplets.size(); ++t) {
+      const int row = triplets[t].row();
+      const int* first = A.innerIndexPtr() + A.outerIndexPtr()[row];
+      const int* last = A.innerIndexPtr() + A.outerIndexPtr()[row + 1];
+      scratch.valueSlot[t] =
+          static_cast<int>(std::lower_bound(first, last, triplets[t].col()) - A.innerIndexPtr());
+    }
+    scratch.patternOuter.assign(A.outerIndexPtr(), A.outerIndexPtr() + n + 1);
+    scratch.patternInner.assign(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros());
+    key.resize(1 + 2 * static_cast<std::size_t>(n));
+    key[0] = static_cast<int>(bodies.size());
+    for (int i = 0; i < n; ++i) {
+      key[1 + 2 * i] = rows[i].bodyA;
+      key[2 + 2 * i] = rows[i].bodyB;
+    }
+  }
+  p.swapA(A);
 }
 
 void RowPgs::slackFromVelocities(const RowSystem& s, const Vector& x) {

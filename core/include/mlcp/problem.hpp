@@ -68,6 +68,12 @@ class Problem {
   SparseMatrix toSparse() const;
   void setA(DenseMatrix A);
   void setA(SparseMatrix A);
+  // Exchanges A's storage with `A` in O(1), copying nothing: a caller that refills A every step
+  // (RowSystem::assemble) takes the buffer out, writes it and swaps it back, allocating nothing
+  // once the size has been seen. Afterwards the problem holds the given matrix (compressed, for
+  // sparse storage; the other kind is emptied) and `A` what the problem held of that kind.
+  void swapA(DenseMatrix& A);
+  void swapA(SparseMatrix& A);
 
   // A_ii, read from whichever storage holds A.
   double diagonal(int i) const;

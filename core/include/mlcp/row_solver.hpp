@@ -72,7 +72,8 @@ struct RowSolverSettings {
   // answer. Default kDefaultAcceptResidual (1e-3).
   double acceptResidual = kDefaultAcceptResidual;
   // Islands with at most this many rows give matrix-based solvers a dense A, larger ones a
-  // sparse A (rows). Default kDefaultDenseMaxRows (64).
+  // sparse A (rows); ldlt, which factors sparse storage, always gets a sparse A. Default
+  // kDefaultDenseMaxRows (64).
   int denseMaxRows = kDefaultDenseMaxRows;
 };
 
@@ -189,7 +190,7 @@ class RowSolver {
   Solver* assembledSolver(Slot& island, const std::string& name);
   Result run(const RowSystem& rows, const std::string& name, const Options& options,
              const Vector& start, Vector& x, Slot& island, IslandSolve& report);
-  void assemble(const RowSystem& rows);
+  void assemble(const RowSystem& rows, bool sparse);
   void capture(const RowSystem& rows);
 
   RowSolverSettings settings_;

@@ -52,11 +52,20 @@ class RowSystem {
 
   // A = J M^-1 J^T + diag(cfm) with the bounds copied: the same MLCP as a Problem.
   Problem assemble(bool sparse) const;
-  // The same into `into`, reusing its bound vectors and the scratch's buffers: a per-step
-  // caller (RowSolver) allocates only A's storage once the sizes have been seen.
+  // The same into `into`, reusing its vectors, A's storage (Problem::swapA) and the scratch's
+  // buffers: a per-step caller (RowSolver) allocates nothing once the sizes have been seen.
+  // Sparse A: when the rows join the same bodies as in the last sparse assembly with this
+  // scratch and `into` still holds that pattern (index arrays compared), only the values are
+  // written, in the order setFromTriplets sums them (bitwise the same A); otherwise the pattern
+  // is built from triplets and remembered.
   struct AssembleScratch {
     std::vector<std::vector<std::pair<int, const Vector6*>>> touching;
     std::vector<Eigen::Triplet<double>> triplets;
+    std::vector<int> patternBodies;               // bodies.size(), then bodyA, bodyB per row
+    std::vector<int> patternOuter, patternInner;  // the pattern's compressed index arrays
+    std::vector<int> valueSlot;  // per product, in assembly order: its index in A's values
+    DenseMatrix dense;           // empty between calls: A's storage is taken from `into`
+    SparseMatrix sparse;
   };
   void assemble(bool sparse, Problem& into, AssembleScratch& scratch) const;
   // w = A x + b computed through body velocities, O(nnz J).
@@ -89,14 +98,16 @@ class RowPgs {
   // Everything the sweep reads per row, in one stream: bodies remapped so that "the world" is
   // a zero-velocity slot (no branches in the inner loop), M^-1 J^T, and the update
   //     x_i <- clamp(x_i - step (J_i v + cfm_i x_i + b_i), lo', hi'),   step = omega / A_ii,
-  // regrouped as clamp(keep x_i - shift - (step J_i) v) with keep = 1 - step cfm_i and
-  // shift = step b_i: only the product with v depends on the rows just visited, so the row's
-  // latency chain (load v, dot, clamp, update v) holds one subtraction instead of a
-  // multiplication and three additions (sweeps ~20% faster; the same iterates up to round-off).
+  // regrouped as the change
+  //     dx_i = clamp(decay x_i - shift - (step J_i) v, lo' - x_i, hi' - x_i)
+  // with decay = -step cfm_i and shift = step b_i, then x_i += dx_i, v += M^-1 J_i^T dx_i. Only
+  // the product with v depends on the rows just visited, so the row's latency chain (load v,
+  // dot, clamp, update v) holds one subtraction instead of a multiplication and four additions
+  // or subtractions (sweeps ~20% faster; the same iterates up to round-off).
   struct PackedRow {
     Vector6 sA, sB;  // step * J
     Vector6 mA, mB;  // M^-1 J^T
-    double keep, shift, lo, hi;
+    double decay, shift, lo, hi;
     int a, b, findex;
   };
   // A body's velocity change padded to one cache line.
