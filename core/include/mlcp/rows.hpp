@@ -98,16 +98,14 @@ class RowPgs {
   // Everything the sweep reads per row, in one stream: bodies remapped so that "the world" is
   // a zero-velocity slot (no branches in the inner loop), M^-1 J^T, and the update
   //     x_i <- clamp(x_i - step (J_i v + cfm_i x_i + b_i), lo', hi'),   step = omega / A_ii,
-  // regrouped as the change
-  //     dx_i = clamp(decay x_i - shift - (step J_i) v, lo' - x_i, hi' - x_i)
-  // with decay = -step cfm_i and shift = step b_i, then x_i += dx_i, v += M^-1 J_i^T dx_i. Only
-  // the product with v depends on the rows just visited, so the row's latency chain (load v,
-  // dot, clamp, update v) holds one subtraction instead of a multiplication and four additions
-  // or subtractions (sweeps ~20% faster; the same iterates up to round-off).
+  // regrouped as clamp(keep x_i - shift - (step J_i) v) with keep = 1 - step cfm_i and
+  // shift = step b_i: only the product with v depends on the rows just visited, so the row's
+  // latency chain (load v, dot, clamp, update v) holds one subtraction instead of a
+  // multiplication and three additions (sweeps ~20% faster; the same iterates up to round-off).
   struct PackedRow {
     Vector6 sA, sB;  // step * J
     Vector6 mA, mB;  // M^-1 J^T
-    double decay, shift, lo, hi;
+    double keep, shift, lo, hi;
     int a, b, findex;
   };
   // A body's velocity change padded to one cache line.
