@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
+#include <cstdio>
 #include <stdexcept>
 
 #include "mlcp/io.hpp"
@@ -84,6 +84,15 @@ struct RowSolver::Slot {
 namespace {
 // Islands not solved for this many calls lose their workspaces (once there are this many).
 constexpr std::size_t kSlotLimit = 1024;
+}  // namespace
+
+namespace {
+// x as `std::ostream << x` writes it (%g, 6 digits).
+std::string shortNumber(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", x);
+  return text;
+}
 }  // namespace
 
 bool RowSolver::known(const std::string& name) {
@@ -209,9 +218,11 @@ IslandSolve RowSolver::solve(const RowSystem& rows, const Vector& start, Vector&
                           r.residual <= kAutoNearMiss * settings_.acceptResidual;
     if (autoChoice && out.requested == "dantzig" && !nearMiss)
       island.pgsFirst = kAutoPgsAfterRejection;
-    std::ostringstream why;
-    why << out.requested << " rejected (" << toString(r.status) << ", residual " << r.residual
-        << (r.message.empty() ? "" : ": ") << r.message << ")";
+    // Built on every rejection (a fixed-sweep pgs near the limit: every step), so without an
+    // ostringstream, whose locale set-up cost more than a small island's sweep.
+    const std::string why = out.requested + " rejected (" + toString(r.status) + ", residual " +
+                            shortNumber(r.residual) + (r.message.empty() ? "" : ": ") + r.message +
+                            ")";
     if (!settings_.fallback.empty()) {
       out.fellBack = true;
       Result f =
@@ -220,16 +231,16 @@ IslandSolve RowSolver::solve(const RowSystem& rows, const Vector& start, Vector&
                           std::isfinite(f.residual);
       if (usable && !(std::isfinite(r.residual) && r.residual <= f.residual)) {
         f.iterations += r.iterations;
-        f.message = why.str() + "; " + settings_.fallback + ": " + f.message;
+        f.message = why + "; " + settings_.fallback + ": " + f.message;
         r = std::move(f);
         x.swap(xFallback_);
         out.choice = settings_.fallback;
       } else {
-        r.message = why.str() + "; " + settings_.fallback + " no better (" + toString(f.status) +
+        r.message = why + "; " + settings_.fallback + " no better (" + toString(f.status) +
                     ", residual " + std::to_string(f.residual) + ")";
       }
     } else {
-      r.message = why.str() + "; no fallback";
+      r.message = why + "; no fallback";
     }
     if (!std::isfinite(r.residual)) {
       // Nothing usable: the start is the engine's "no change".
