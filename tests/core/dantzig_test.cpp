@@ -5,6 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <random>
+
+#include "../core/src/dantzig_block.hpp"  // SymmetricPatternLu (internal)
 #include "common/contact_scenes.hpp"
 #include "common/generators.hpp"
 #include "mlcp/registry.hpp"
@@ -509,6 +512,46 @@ TEST(DantzigBlock, GeneratedFamiliesThroughTheBlockStage) {
     ASSERT_TRUE(s.solveWithGuess(kp.problem, kp.solution, x).converged());
     EXPECT_TRUE(s.blockSettled());
   }
+}
+
+// The block stage's LU for sliding rows: nonsymmetric values on a symmetric pattern, no
+// pivoting; checked against Eigen's dense LU, and a zero pivot is reported.
+TEST(DantzigBlock, SymmetricPatternLuSolves) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int m : {1, 5, 40, 120}) {
+    DenseMatrix K = DenseMatrix::Zero(m, m);
+    for (int i = 0; i < m; ++i) {
+      K(i, i) = 4 + u(rng);
+      for (int j = 0; j < i; ++j)
+        if (rng() % 8 == 0) {  // symmetric pattern, unrelated values
+          K(i, j) = u(rng);
+          K(j, i) = u(rng);
+        }
+    }
+    // Columns in a scrambled row order: the factorization must not rely on sorted rows.
+    std::vector<int> outer(m + 1, 0), inner;
+    std::vector<double> k, kt;
+    for (int c = 0; c < m; ++c) {
+      for (int r = m - 1; r >= 0; --r)
+        if (K(r, c) != 0 || K(c, r) != 0) {
+          inner.push_back(r);
+          k.push_back(K(r, c));
+          kt.push_back(K(c, r));
+        }
+      outer[c + 1] = static_cast<int>(inner.size());
+    }
+    detail::SymmetricPatternLu lu;
+    ASSERT_TRUE(lu.factor(m, outer, inner, k, kt, 1e-12));
+    Vector b = Vector::NullaryExpr(m, [&](Eigen::Index) { return u(rng); });
+    Vector x = b;
+    lu.solve(x);
+    const Vector expected = K.partialPivLu().solve(b);
+    EXPECT_LE((x - expected).lpNorm<Eigen::Infinity>(), 1e-12 * (1 + expected.norm())) << m;
+  }
+  // [[1, 1], [1, 1]]: the second pivot is 0.
+  detail::SymmetricPatternLu lu;
+  EXPECT_FALSE(lu.factor(2, {0, 2, 4}, {0, 1, 0, 1}, {1, 1, 1, 1}, {1, 1, 1, 1}, 1e-12));
 }
 
 }  // namespace

@@ -79,10 +79,14 @@
 // One step solves those equations. Without sliding rows A_CC is factored by a sparse LDL^T
 // (SimplicialLDLT in a fill-reducing AMD order of the whole A, computed once per pattern of A and
 // inherited by every clamped block); sliding rows (at a bound, normal clamped) are substituted,
-// which makes the matrix nonsymmetric with A_CC's pattern, factored by a sparse LU in the same
-// order. One step of iterative refinement follows. First the steps are full (block principal
-// pivoting; the next sets change only rows violated beyond 0.01 tolerance (1 + |b|), so that
-// degenerate rows do not flip on rounding). When 3 full steps in a row bring no new lowest merit
+// which makes the matrix K nonsymmetric but keeps A_CC's pattern (a contact's friction and normal
+// rows touch the same bodies), so K = L D U is factored without pivoting by an up-looking sparse
+// LU whose L and U^T share the Cholesky pattern (twice an LDL^T's work, no symbolic phase; a K
+// outside A_CC's pattern falls back to Eigen's SparseLU, which cost 3-4x more per step on the
+// Bullet pyramids). One step of iterative refinement follows. First the steps are full (block
+// principal pivoting; the next sets change only rows violated beyond 0.01 tolerance (1 + |b|), so
+// that degenerate rows do not flip on rounding). When 3 full steps in a row bring no new lowest
+// merit
 // ||H||^2 (or a block is singular), the stage goes back to the best point and continues damped:
 // sets from the natural map at x, a proximal term rho (x_C - x_C,prev) on the clamped rows
 // (rho = 1e-2 max|A_ii| min(1, ||H||): coplanar contacts make clamped blocks nearly singular, and
@@ -94,15 +98,25 @@
 // when that keeps it within tolerance: Result::iterations counts its steps), or after
 // DantzigParams::maxBlockSteps, no descent, a singular damped block or the time budget: then the
 // best iterate is handed to the incremental pivoting below as its warm start.
-// Measured (CPU time, captured islands, tests/bench/core_bench.cpp with MLCP_BENCH_ISLANDS):
-// Bullet adapter's 55-box pyramid (n = 1160, warm start from the cached impulses, globalCfm
-// 1e-5): full steps alone diverge (residual 0.2 -> 25 in 4 steps) and the hand-over cost 0.7-0.85
-// s of pivoting; the damped steps reach residual ~1e-3 in 40 steps (~1.6 ms each), total 80-115
-// ms. ODE piles (tests/bench/ode_bench.cpp; A holds ~14% nonzeros): the all-clamped cold guess
+// Measured (CPU time on a loaded 2-core machine, islands captured from tests/bench/bullet_bench's
+// worlds, tests/bench/ode_bench.cpp). Bullet adapter's pyramids (warm start from the cached
+// impulses, globalCfm 1e-5, one friction row per contact): the guesses are poor (residual
+// 0.1-0.7; 5-40 normals in the wrong set: the stack is still moving) and A is nearly singular
+// (four coplanar contacts per face, half the normals 0 at the answer), so full steps diverge
+// (residual 0.7 -> 16 -> 53), the damped steps converge linearly (step lengths mostly 1/4-1/2) and
+// settle after 55-80 steps; neither the friction-direction caching flags (the scene loader's) nor
+// non-monotone line searches, other proximal weights (1e-3, 5e-2) or BPP-style set updates in
+// the damped phase changed that. n = 1160 (55 boxes): 40 steps (~1 ms each) then the pivoting
+// from the best iterate (~60-150 pivots, ~10 friction passes, ~20 ms): 55-105 ms per island,
+// against 165-220 ms for the pivoting alone from the guess (Never: ~2000 pivots, half of them in
+// the second friction pass because the first took its bounds from the guess). n = 280 (15
+// boxes): Never takes ~3-4 ms (~250 pivots) where the 40 damped steps plus the pivoting took ~9
+// ms, hence autoWarmMinRows. ODE piles (A holds ~14% nonzeros): the all-clamped cold guess
 // settles in 1 full step (n = 432: ~2.3 ms; n = 1728: ~30 ms) where the stepper's warm guess
-// needed 6-9 steps, hence Auto's cold trial first. Synthetic box pyramids: a warm start settles
-// in 1-2 full steps (55 boxes, n = 1200: about 8 ms per step including assembly); from a cold
-// start the trial does not settle and the incremental pivoting runs from zero.
+// needed 6-9 steps, hence Auto's cold trial first (it stops at its first non-improving step, so
+// it costs one factorization where it does not settle). Synthetic box pyramids: a warm start
+// settles in 1-2 full steps (55 boxes, n = 1200: about 8 ms per step including assembly); from a
+// cold start the trial does not settle and the incremental pivoting runs from zero.
 //
 // Result::iterations counts pivots (direction computations: each row added or exchanged)
 // summed over all passes; Options::maxPivots (0: 50 n + 100) limits them per pass
@@ -137,7 +151,8 @@ struct DantzigParams {
   int autoMinRows = 100;
   // Auto: the largest fraction of nonzero entries in A. Default 0.3.
   double autoMaxDensity = 0.3;
-  // Auto: factorizations of the trial from the cold guess. Default 3.
+  // Auto: most factorizations of the trial from the cold guess (it ends at its first full step
+  // that brings no new lowest merit). Default 3.
   int autoColdSteps = 3;
   // Auto: the smallest problem (rows) whose warm start gets the block stage after an unsettled
   // cold trial; smaller ones go to the incremental pivoting from their guess, which is cheaper
