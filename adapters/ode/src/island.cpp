@@ -473,14 +473,15 @@ void mlcp::ode::Stepper::Impl::runIsland(const dxStepperProcessingCallContext* c
 
     // Stage 5: solve, verify, fall back (RowSolver), keyed by the island's first body.
     const std::uint64_t key = reinterpret_cast<std::uintptr_t>(body[0]);
-    const double ts = nowSeconds();
-    const IslandSolve solved = solveWith(primary, w, nub, ctx->m_stepperArena, options, key, w.x);
-    st.solveSeconds = nowSeconds() - ts;
+    // The solve's own clock (RowSolver::solve's span, or solveWithOdeLcp's): no second pair of
+    // clock reads around it.
+    IslandSolve solved = solveWith(primary, w, nub, ctx->m_stepperArena, options, key, w.x);
+    st.solveSeconds = solved.result.seconds;
     st.status = solved.result.status;
     st.iterations = solved.result.iterations;
     st.residual = solved.result.residual;
-    st.message = solved.result.message;
-    st.choice = solved.choice;
+    st.message = std::move(solved.result.message);
+    st.choice = std::move(solved.choice);
     st.fellBack = solved.fellBack;
     st.accepted = solved.accepted;
 

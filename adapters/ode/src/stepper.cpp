@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <stdexcept>
-#include <unordered_map>
+#include <utility>
+#include <vector>
 
 #include "island.hpp"
 #include "mlcp/registry.hpp"
@@ -10,16 +11,22 @@ namespace mlcp::ode {
 namespace {
 
 // ODE's stepper and estimator callbacks carry no user pointer: they find the stepper through
-// the world being stepped (the estimator through its bodies' world).
+// the world being stepped (the estimator through its bodies' world). Worlds being stepped at
+// once are few: a flat list, searched linearly, that allocates nothing once it has grown.
 std::mutex registryMutex;
-std::unordered_map<const dxWorld*, Stepper::Impl*>& activeSteppers() {
-  static std::unordered_map<const dxWorld*, Stepper::Impl*> map;
-  return map;
+std::vector<std::pair<const dxWorld*, Stepper::Impl*>>& activeSteppers() {
+  static std::vector<std::pair<const dxWorld*, Stepper::Impl*>> list;
+  return list;
+}
+
+auto findActive(const dxWorld* world) {
+  auto& list = activeSteppers();
+  return std::find_if(list.begin(), list.end(), [&](const auto& e) { return e.first == world; });
 }
 
 Stepper::Impl* activeStepper(const dxWorld* world) {
   std::lock_guard<std::mutex> lock(registryMutex);
-  const auto it = activeSteppers().find(world);
+  const auto it = findActive(world);
   return it == activeSteppers().end() ? nullptr : it->second;
 }
 
@@ -28,12 +35,13 @@ class ActiveScope {
  public:
   ActiveScope(const dxWorld* world, Stepper::Impl* impl) : world_(world) {
     std::lock_guard<std::mutex> lock(registryMutex);
-    if (!activeSteppers().emplace(world, impl).second)
+    if (findActive(world) != activeSteppers().end())
       throw std::logic_error("mlcp::ode::Stepper::step: the world is being stepped already");
+    activeSteppers().emplace_back(world, impl);
   }
   ~ActiveScope() {
     std::lock_guard<std::mutex> lock(registryMutex);
-    activeSteppers().erase(world_);
+    activeSteppers().erase(findActive(world_));
   }
 
  private:
