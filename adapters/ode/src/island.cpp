@@ -109,11 +109,17 @@ int prepareRows(dxWorld* world, dxBody* const* body, unsigned nb, dxJoint* const
   rows.findex.assign(m, -1);
 
   const dReal fps = dRecip(h);
+  // getInfo2 writes each joint's Jacobian straight into its rows (J1 = jA, J2 = jB of the first
+  // row, the next row kRowSkip dReals on): no staging arrays, no copy.
+  static_assert(sizeof(ConstraintRow) % sizeof(dReal) == 0, "rows must be whole dReals apart");
+  constexpr int kRowSkip = static_cast<int>(sizeof(ConstraintRow) / sizeof(dReal));
   for (const JointRows& jr : w.joints) {
-    // getInfo2 writes only the nonzero Jacobian entries: clear the joint's m rows, not all 6.
-    dReal J1[6 * kRowWidth], J2[6 * kRowWidth];
-    std::fill_n(J1, jr.m * kRowWidth, dReal(0));
-    std::fill_n(J2, jr.m * kRowWidth, dReal(0));
+    ConstraintRow* first = rows.rows.data() + jr.offset;
+    // getInfo2 writes only the nonzero Jacobian entries.
+    for (int k = 0; k < jr.m; ++k) {
+      first[k].jA.setZero();
+      first[k].jB.setZero();
+    }
     dReal rhsCfm[6 * 2], loHi[6 * 2];
     int findex[6];
     for (int k = 0; k < jr.m; ++k) {
@@ -123,18 +129,16 @@ int prepareRows(dxWorld* world, dxBody* const* body, unsigned nb, dxJoint* const
       loHi[2 * k + dxJoint::GI2_HI] = dInfinity;
       findex[k] = -1;
     }
-    jr.joint->getInfo2(fps, world->global_erp, kRowWidth, J1, J2, 2, rhsCfm, loHi, findex);
+    jr.joint->getInfo2(fps, world->global_erp, kRowSkip, first->jA.data(), first->jB.data(), 2,
+                       rhsCfm, loHi, findex);
     const dxBody* b0 = jr.joint->node[0].body;
     const dxBody* b1 = jr.joint->node[1].body;
     for (int k = 0; k < jr.m; ++k) {
       const int i = jr.offset + k;
-      ConstraintRow& row = rows.rows[i];
+      ConstraintRow& row = first[k];
       row.bodyA = b0->tag;
       row.bodyB = b1 ? b1->tag : -1;
-      for (int c = 0; c < kRowWidth; ++c) {
-        row.jA[c] = J1[k * kRowWidth + c];
-        row.jB[c] = b1 ? J2[k * kRowWidth + c] : 0.0;
-      }
+      if (!b1) row.jB.setZero();
       rows.b[i] = rhsCfm[2 * k + dxJoint::GI2_RHS] * fps;  // ODE's rhs for now
       rows.cfm[i] = rhsCfm[2 * k + dxJoint::GI2_CFM] * fps;
       rows.lo[i] = loHi[2 * k + dxJoint::GI2_LO];
