@@ -42,16 +42,18 @@ void Problem::setA(SparseMatrix A) {
   sparse_ = true;
 }
 
+// The other kind's storage is empty already unless the kind changes (setA and swapA empty it);
+// resetting it anyway would allocate (an empty SparseMatrix holds an outer index).
 void Problem::swapA(DenseMatrix& A) {
   dense_.swap(A);
-  sparseA_ = SparseMatrix();
+  if (sparse_) sparseA_ = SparseMatrix();
   sparse_ = false;
 }
 
 void Problem::swapA(SparseMatrix& A) {
   sparseA_.swap(A);
   sparseA_.makeCompressed();
-  dense_ = DenseMatrix();
+  if (!sparse_) dense_ = DenseMatrix();
   sparse_ = true;
 }
 
