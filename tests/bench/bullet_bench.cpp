@@ -137,9 +137,13 @@ Row run(const Config& cfg, int boxes, int warmup, int steps) {
 // alike. Time is the CPU time of whole solveGroup calls (Bullet's row setup, the solve, the
 // write-back; pgs includes its own residual check), median over the steps: on a shared machine
 // wall time mostly measures the other processes. The stock SI solver is timed; SI's residual
-// comes from a third copy running SI inside our drop-in ("si-stats"), untimed.
+// comes from a third copy running SI inside our drop-in ("si-stats"), untimed. Ours starts
+// where SI starts (Settings::siStart: same sweeps, same start); a fourth copy, untimed, gives
+// the residual of ours started from the cached impulses (the adapter's default).
 struct Pair {
-  double siMs = NAN, pgsMs = NAN, siResidual = 0, pgsResidual = 0;
+  // Residuals: worst over the steps, and the median of the steps' residuals.
+  double siMs = NAN, pgsMs = NAN, siResidual = 0, pgsResidual = 0, cachedResidual = 0;
+  double siMedian = NAN, pgsMedian = NAN, cachedMedian = NAN;
   // Medians of the solver stages alone (wall time): SI's iterations (in the "si-stats" copy) and
   // our stages 2-7 (islands, solve, check, store impulses); the rest of solveGroup is Bullet's
   // row setup and finish, the same code in both.
@@ -153,8 +157,8 @@ double median(std::vector<double> v) {
 }
 
 Pair pgsVersusSi(int boxes, int warmup, int steps, int sweeps) {
-  sc::World si, siStats, ours;
-  for (sc::World* w : {&si, &siStats, &ours}) {
+  sc::World si, siStats, ours, cached;
+  for (sc::World* w : {&si, &siStats, &ours, &cached}) {
     w->info().m_globalCfm = 1e-5;
     w->info().m_numIterations = sweeps;
     sc::pyramid(*w, boxes);
@@ -167,13 +171,16 @@ Pair pgsVersusSi(int boxes, int warmup, int steps, int sweeps) {
   s.fallback = "";
   si.setSolver(std::make_unique<Timed>(sc::makeBulletSolver("si")));
   siStats.setSolver(sc::makeBulletSolver("si-stats", s));
+  cached.setSolver(sc::makeBulletSolver("pgs", s));
+  s.siStart = true;
   ours.setSolver(std::make_unique<Timed>(sc::makeBulletSolver("pgs", s)));
+  auto* fromCached = static_cast<mlcp::bullet::ConstraintSolver*>(cached.solver());
   auto* stats = static_cast<mlcp::bullet::ConstraintSolver*>(siStats.solver());
   auto* timedSi = static_cast<Timed*>(si.solver());
   auto* timedPgs = static_cast<Timed*>(ours.solver());
   auto* pgs = static_cast<mlcp::bullet::ConstraintSolver*>(timedPgs->inner());
   Pair out;
-  std::vector<double> tSi, tPgs, tSiIter, tStages;
+  std::vector<double> tSi, tPgs, tSiIter, tStages, rSi, rPgs, rCached;
   for (int k = 0; k < steps; ++k) {
     double before = timedSi->cpuSeconds;
     si.step();
@@ -184,13 +191,21 @@ Pair pgsVersusSi(int boxes, int warmup, int steps, int sweeps) {
     tStages.push_back(pgs->lastStep().seconds * 1e3);
     siStats.step();
     tSiIter.push_back(stats->lastStep().seconds * 1e3);
-    out.siResidual = std::max(out.siResidual, stats->lastStep().residual);
-    out.pgsResidual = std::max(out.pgsResidual, pgs->lastStep().residual);
+    rSi.push_back(stats->lastStep().residual);
+    rPgs.push_back(pgs->lastStep().residual);
+    out.siResidual = std::max(out.siResidual, rSi.back());
+    out.pgsResidual = std::max(out.pgsResidual, rPgs.back());
+    cached.step();
+    rCached.push_back(fromCached->lastStep().residual);
+    out.cachedResidual = std::max(out.cachedResidual, rCached.back());
     out.rows = pgs->lastStep().rows;
   }
   out.siMs = median(tSi);
   out.pgsMs = median(tPgs);
   out.siIterMs = median(tSiIter);
+  out.siMedian = median(rSi);
+  out.pgsMedian = median(rPgs);
+  out.cachedMedian = median(rCached);
   out.pgsStagesMs = median(tStages);
   return out;
 }
@@ -226,15 +241,19 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   if (pair) {
     std::printf(
-        "| boxes | rows | sweeps | SI ms/step | ours pgs ms/step | pgs / SI | SI residual | "
-        "pgs residual | SI iterations ms | ours stages ms |\n"
-        "|---|---|---|---|---|---|---|---|---|---|\n");
+        "| boxes | rows | sweeps | SI ms/step | ours pgs ms/step | pgs / SI | SI residual "
+        "worst (median) | pgs residual worst (median) | pgs from the cached impulses | "
+        "SI iterations ms | ours stages ms |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|\n");
     for (int boxes : parseSizes(sizes))
       for (int n : parseSizes(sweeps)) {
         const Pair p = pgsVersusSi(boxes, warmup, steps, n);
-        std::printf("| %d | %d | %d | %.3f | %.3f | %.2fx | %.2e | %.2e | %.3f | %.3f |\n", boxes,
-                    p.rows, n, p.siMs, p.pgsMs, p.pgsMs / p.siMs, p.siResidual, p.pgsResidual,
-                    p.siIterMs, p.pgsStagesMs);
+        std::printf(
+            "| %d | %d | %d | %.3f | %.3f | %.2fx | %.2e (%.1e) | %.2e (%.1e) | %.2e (%.1e) | "
+            "%.3f | %.3f |\n",
+            boxes, p.rows, n, p.siMs, p.pgsMs, p.pgsMs / p.siMs, p.siResidual, p.siMedian,
+            p.pgsResidual, p.pgsMedian, p.cachedResidual, p.cachedMedian, p.siIterMs,
+            p.pgsStagesMs);
         std::fflush(stdout);
       }
     return 0;

@@ -279,6 +279,38 @@ TEST(BulletPlumbing, SiResidualIsMeasuredOnSisAppliedImpulses) {
   }
 }
 
+// Settings::siStart starts contacts and friction where SI starts them: the cached impulse times
+// m_warmstartingFactor, instead of the cached impulse.
+TEST(BulletPlumbing, SiStartIsTheCachedImpulseTimesTheWarmStartingFactor) {
+  sc::World plain, si;
+  std::vector<const ConstraintSolver*> solvers;
+  for (sc::World* w : {&plain, &si}) {
+    sc::stack(*w, 3);
+    w->step(20);  // stock SI: both worlds in the same state with cached impulses
+    mlcp::bullet::Settings s;
+    s.solver = "pgs";
+    s.keepIslands = true;
+    s.siStart = w == &si;
+    w->setSolver(std::make_unique<ConstraintSolver>(s));
+    solvers.push_back(static_cast<const ConstraintSolver*>(w->solver()));
+    w->step();
+  }
+  const double factor = si.info().m_warmstartingFactor;
+  ASSERT_LT(factor, 1.0);
+  ASSERT_EQ(solvers[0]->islands().size(), solvers[1]->islands().size());
+  int contacts = 0;
+  for (std::size_t k = 0; k < solvers[0]->islands().size(); ++k) {
+    const mlcp::bullet::IslandRecord& a = solvers[0]->islands()[k];
+    const mlcp::bullet::IslandRecord& b = solvers[1]->islands()[k];
+    ASSERT_EQ(a.start.size(), b.start.size());
+    for (Eigen::Index i = 0; i < a.start.size(); ++i) {
+      EXPECT_NEAR(b.start[i], factor * a.start[i], 1e-12 * (1 + std::abs(a.start[i])));
+      contacts += a.start[i] > 0;
+    }
+  }
+  EXPECT_GT(contacts, 0);
+}
+
 }  // namespace
 
 // An injected NaN and a failing primary: every island falls back, the statistics say so, and

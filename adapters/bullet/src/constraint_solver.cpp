@@ -121,8 +121,10 @@ btScalar ConstraintSolver::solveGroupCacheFriendlyIterations(
         if (*name == "pgs" || *name == "gs")
           options->maxIterations = options->checkEvery = info.m_numIterations;
     }
-    builder_.build(rows, info, settings_.cfm,
-                   settings_.warmStart ? Start::CachedImpulse : Start::Zero);
+    const Start start = !settings_.warmStart ? Start::Zero
+                        : settings_.siStart  ? Start::AppliedImpulse
+                                             : Start::CachedImpulse;
+    builder_.build(rows, info, settings_.cfm, start);
     current_.inertRows += builder_.inertRows();
     for (int k = 0; k < builder_.count(); ++k) {
       Island& island = builder_.island(k);

@@ -28,7 +28,8 @@
 //  4. warm start — x0 = last step's impulses: for contacts and friction the cached impulse
 //     (Bullet's applied impulse divided by m_warmstartingFactor, 0.85: SI's setup has already
 //     applied the scaled impulse to the solver bodies, and the write-back below only applies
-//     the difference), 0 for joints (SI does not warm-start them).
+//     the difference), or with Settings::siStart SI's own start (the applied impulse as it is),
+//     0 for joints (SI does not warm-start them).
 //  5. solve and 6. check — mlcp::RowSolver (mlcp/row_solver.hpp), shared with the ODE adapter:
 //     it classifies the island (bilateral only, frictionless contacts, boxed, friction), runs
 //     the named solver or `auto`'s choice ("pgs" on the rows, others on an assembled A, dense up
@@ -41,6 +42,17 @@
 //     joint feedback, breaking thresholds, velocities and transforms.
 //  With split impulse on (Bullet's default) and a non-zero penetration rhs in an island, a second
 //  problem with the same A and b = -m_rhsPenetration / m_jacDiagABInv gives push impulses.
+//
+// Cost against SI, "pgs" at SI's sweep count (bulletIterations, bullet_bench --pgs-vs-si; CPU
+// time per step, 210-box pyramid, ~4250 rows, 10 sweeps): Bullet's row setup and finish are the
+// same code in both (~0.33 ms). SI's iterations take ~0.68 ms; our stages 2-7 ~1.0 ms: the
+// sweeps 0.53 (RowPgs' sweep is ~20% cheaper than SI's), and ~100 ns a row of work SI does not
+// have, because SI sweeps Bullet's rows in place: packing RowPgs' rows 0.20 ms (rows.hpp), stage
+// 2-3 (IslandBuilder: union-find and the conversion into a RowSystem) 0.165 ms, storing impulses
+// 0.065 ms, the residual check 0.055 ms. At 50 sweeps the sweeps' edge pays for it (1.0x); at 10
+// it does not (1.3-1.4x). What would remove most of it: one representation written once per
+// step that both the verification (RowSystem) and the sweep read, i.e. RowSystem holding the
+// packed rows, instead of a RowSystem copy of Bullet's rows followed by RowPgs' packed copy.
 //
 // "si" runs Bullet's own SI iterations instead (for side-by-side runs with the same statistics).
 #pragma once
@@ -83,8 +95,15 @@ struct Settings : RowSolverSettings {
   // pgs/gs take their sweep count from btContactSolverInfo::m_numIterations (as SI and the stock
   // MLCP solvers do) instead of options.maxIterations. Default false.
   bool bulletIterations = false;
-  // Start every solve from Bullet's applied impulses. Default true.
+  // Start every solve from last step's impulses (stage 4 below). Default true.
   bool warmStart = true;
+  // With warmStart: start contacts and friction where SI starts them, from the cached impulse
+  // times m_warmstartingFactor (0.85) — the impulse SI's setup has applied — instead of the
+  // cached impulse itself. SI's damping of the start lowers the residual fixed-sweep pgs reaches
+  // on stacks: bullet_bench --pgs-vs-si, 210-box pyramid, worst residual over 300 steps at 10
+  // sweeps 0.15 from the cached impulse, 0.052 from SI's start (SI itself 0.052). Exact solvers
+  // do not depend on the start. Default false.
+  bool siStart = false;
   // Regularisation model; see CfmModel. Default Regularized.
   CfmModel cfm = CfmModel::Regularized;
   // Keep every island's rows, start, answer and result of the last step (for tests and tools;

@@ -8,7 +8,12 @@
 //
 // Static bodies (Bullet maps them all to one fixed solver body) and kinematic bodies (inverse
 // mass 0) are "the world": they couple nothing, so two boxes resting on the same ground are two
-// islands. Buffers are kept between calls so a steady scene allocates little per step.
+// islands. Buffers are kept between calls so a steady scene allocates nothing per step.
+//
+// Two passes over Bullet's rows (288 bytes each, in double precision): the first reads only the
+// body indices (union-find; each row's dynamic bodies kept in a compact array for the island
+// numbering), the second converts each row into its island. ~40 ns a row (210-box pyramid),
+// mostly first touches of Bullet's rows and the scattered writes of the RowSystem's arrays.
 #pragma once
 
 #include <BulletDynamics/ConstraintSolver/btSequentialImpulseConstraintSolver.h>
