@@ -1,8 +1,9 @@
 // ode_pgs_bench: our stepper with "pgs" against dWorldQuickStep at the same sweep count, on box
 // pyramids of about 100, 500 and 2000 constraint rows, ratios measured in one run.
 //
-//     build/bench/ode_pgs_bench [steps] [warm-up steps] [sweeps] [reference sweeps]
-//                               (defaults 30, 40, 20, 5000)
+//     build/bench/ode_pgs_bench [steps] [warm-up steps] [sweeps] [reference sweeps] [base]
+//                               (defaults 30, 40, 20, 5000, all three piles; a base 3, 6 or
+//                               12 runs that pile only, e.g. under a profiler)
 //
 // Same problems: a reference pile is stepped by a converged solve (our pgs, up to 5000 sweeps,
 // tolerance 1e-9: its residual is printed); before every step the QuickStep pile and the pgs
@@ -14,7 +15,11 @@
 //
 // Time: CPU time of this thread in dWorldQuickStep / Stepper::step (islands, rows, solve,
 // integration; not collision), median over the timed steps. On a shared machine wall time
-// mostly measures the other processes.
+// mostly measures the other processes. Ours is also split (wall-clock medians from
+// IslandStats): "solve" is RowSolver::solve (RowPgs: validation, packing, sweeps, the residual
+// check), "rest" the island's other stages (getInfo1/getInfo2 into rows, right-hand side, warm
+// start, impulses and integration) plus the step's own (ODE's island search and arena).
+// QuickStep cannot be split from outside.
 //
 // Accuracy. Ours: the scaled natural-map residual (mlcp::accuracy) of every island's answer,
 // worst over the steps. QuickStep's residual cannot be measured from outside: its lambda lives in
@@ -56,14 +61,15 @@ int main(int argc, char** argv) {
   const int warmup = argc > 2 ? std::max(0, std::atoi(argv[2])) : 40;
   const int sweeps = argc > 3 ? std::max(1, std::atoi(argv[3])) : 20;
   const int referenceSweeps = argc > 4 ? std::max(1, std::atoi(argv[4])) : 5000;
+  const int only = argc > 5 ? std::atoi(argv[5]) : 0;
   const dReal h = 0.01;
 
   std::printf(
       "| base | rows | sweeps | QuickStep ms | ours pgs ms | pgs / QuickStep | QuickStep max |dv| "
-      "| "
-      "pgs max |dv| | pgs residual | reference residual "
-      "|\n|---|---|---|---|---|---|---|---|---|---|\n");
+      "| pgs max |dv| | pgs residual | reference residual | ours: solve ms | ours: rest ms "
+      "|\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (int base : {3, 6, 12}) {
+    if (only > 0 && base != only) continue;
     auto ref = boxPyramid(base), quick = boxPyramid(base), ours = boxPyramid(base);
     dWorldSetQuickStepNumIterations(quick->world, sweeps);
     dWorldSetQuickStepW(quick->world, 1.3);
@@ -86,7 +92,7 @@ int main(int argc, char** argv) {
     auto stepRef = [&](dWorldID w, dReal dt) { reference.step(w, dt); };
     for (int k = 0; k < warmup; ++k) ref->step(stepRef, h);
 
-    std::vector<double> tQuick, tPgs;
+    std::vector<double> tQuick, tPgs, tSolve, tRest;
     double dvQuick = 0, dvPgs = 0, resPgs = 0, resRef = 0;
     int rows = 0;
     for (int k = 0; k < steps; ++k) {
@@ -104,6 +110,10 @@ int main(int argc, char** argv) {
             const double t0 = cpuNow();
             pgs.step(w, dt);
             tPgs.push_back(1e3 * (cpuNow() - t0));
+            double solve = 0;
+            for (const IslandStats& is : pgs.lastStep().islands) solve += is.solveSeconds;
+            tSolve.push_back(1e3 * solve);
+            tRest.push_back(1e3 * (pgs.lastStep().seconds - solve));
           },
           h);
       ref->step(stepRef, h);
@@ -114,8 +124,9 @@ int main(int argc, char** argv) {
       rows = pgs.lastStep().rows();
     }
     const double q = median(tQuick), p = median(tPgs);
-    std::printf("| %d | %d | %d | %.3f | %.3f | %.2fx | %.2e | %.2e | %.2e | %.1e |\n", base, rows,
-                sweeps, q, p, p / q, dvQuick, dvPgs, resPgs, resRef);
+    std::printf(
+        "| %d | %d | %d | %.3f | %.3f | %.2fx | %.2e | %.2e | %.2e | %.1e | %.3f | %.3f |\n", base,
+        rows, sweeps, q, p, p / q, dvQuick, dvPgs, resPgs, resRef, median(tSolve), median(tRest));
     std::fflush(stdout);
   }
   return 0;
