@@ -7,9 +7,11 @@
 // Method: every configuration gets a fresh pyramid, settles it with SI for `warmup` steps (the
 // same states for all), then switches to its solver and times `steps` steps. Time is the wall
 // time of btConstraintSolver::solveGroup (Bullet's row setup, the solve and the write-back),
-// minus the time spent measuring residuals for this table. Residuals are the scaled natural-map
-// residual (mlcp::accuracy) of each step's answer, worst over the timed steps, on the problem
-// the stock btMLCPSolver assembles: our solvers use CfmModel::StockMlcp for that reason.
+// minus the time spent measuring residuals for this table; "cpu ms" is the same in this thread's
+// CPU time (on a shared machine wall time also counts the other processes). Residuals are the
+// scaled natural-map residual (mlcp::accuracy) of each step's answer, worst over the timed
+// steps, on the problem the stock btMLCPSolver assembles: our solvers use CfmModel::StockMlcp
+// for that reason.
 // globalCfm is 1e-5 (what Bullet's demos use with direct solvers; with 0 a box face's four
 // contact points make A singular). A configuration whose step is predicted (n^3 from the
 // previous size for pivoting methods) or measured to take more than 1 s is skipped.
@@ -73,6 +75,7 @@ struct Row {
   double ms = NAN, residual = NAN;
   int rows = 0, fallbacks = 0, iterations = 0;
   double assembleMs = NAN, solveMs = NAN;  // solveMs: our stages 2-7 (SI: its iterations)
+  double cpuMs = NAN;  // as ms, in this thread's CPU time (robust to other processes' load)
   std::string note;
 };
 
@@ -120,6 +123,7 @@ Row run(const Config& cfg, int boxes, int warmup, int steps) {
     }
   }
   row.ms = (timed->seconds - measure) * 1e3 / done;
+  row.cpuMs = (timed->cpuSeconds - measure) * 1e3 / done;
   row.residual = worst;
   row.iterations /= done;
   if (ours) {
@@ -282,8 +286,8 @@ int main(int argc, char** argv) {
         "\npyramid of %d boxes (%d warm-up SI steps, %d timed steps, dt 1/60, "
         "10 iterations, globalCfm 1e-5)\n",
         boxes, warmup, steps);
-    std::printf("%-22s %10s %10s %12s %10s %10s %12s  %s\n", "solver", "ms/step", "solve ms",
-                "residual", "fallbacks", "iter/step", "assemble ms", "note");
+    std::printf("%-22s %10s %10s %12s %10s %10s %12s %10s  %s\n", "solver", "ms/step", "solve ms",
+                "residual", "fallbacks", "iter/step", "assemble ms", "cpu ms", "note");
     for (const Config& c : configs) {
       if (c.label.find(only) == std::string::npos) continue;
       Row r;
@@ -305,8 +309,9 @@ int main(int argc, char** argv) {
       previous[c.label] = {std::max(n, 1),
                            r.note.rfind("skipped", 0) == 0 || r.ms > 1e3 ? -1.0 : r.ms};
       rows[c.label] = r;
-      std::printf("%-22s %10.3f %10.3f %12.2e %10d %10d %12.3f  %s\n", c.label.c_str(), r.ms,
-                  r.solveMs, r.residual, r.fallbacks, r.iterations, r.assembleMs, r.note.c_str());
+      std::printf("%-22s %10.3f %10.3f %12.2e %10d %10d %12.3f %10.3f  %s\n", c.label.c_str(), r.ms,
+                  r.solveMs, r.residual, r.fallbacks, r.iterations, r.assembleMs, r.cpuMs,
+                  r.note.c_str());
       std::fflush(stdout);
       if (csv)
         csv << boxes << ',' << n << ',' << c.label << ',' << r.ms << ',' << r.solveMs << ','
@@ -323,6 +328,8 @@ int main(int argc, char** argv) {
     if (std::isfinite(sdz.ms) && std::isfinite(dz.ms))
       std::printf("speed-up ours dantzig vs stock MLCP-Dantzig: %.1fx (target >= 20x at 55)\n",
                   sdz.ms / dz.ms);
+    if (std::isfinite(sdz.cpuMs) && std::isfinite(dz.cpuMs))
+      std::printf("same in CPU time (cpu ms): %.1fx\n", sdz.cpuMs / dz.cpuMs);
   }
   return 0;
 }
