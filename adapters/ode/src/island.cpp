@@ -231,7 +231,10 @@ Result solveWithOdeLcp(IslandWork& w, int nub, dxWorldProcessMemArena* arena,
   const double t0 = nowSeconds();
   const unsigned m = static_cast<unsigned>(w.rows.size());
   const unsigned skip = dPAD(m);
-  const Problem dense = w.rows.assemble(false);
+  // The kept problem and scratch, as RowSolver assembles for our solvers: "ode-world" and
+  // "auto" then time the same assembly code (see scene_loader.cpp).
+  w.rows.assemble(false, w.odeProblem, w.odeScratch);
+  const Problem& dense = w.odeProblem;
   // 64-byte aligned A, as dxStepIsland allocates it.
   w.odeA.assign(static_cast<std::size_t>(m) * skip + 8, 0.0);
   double* A = w.odeA.data();
@@ -257,7 +260,11 @@ Result solveWithOdeLcp(IslandWork& w, int nub, dxWorldProcessMemArena* arena,
   Result r;
   r.status = Status::Converged;  // dxSolveLCP reports nothing; the residual decides
   r.message = "ODE dxSolveLCP";
-  applyAccuracy(r, islandAccuracy(w.rows, x), options.tolerance);
+  // w = A x + b from the assembled A (dxSolveLCP destroyed only ODE's copy), as Solver's check
+  // does for ours.
+  w.odeSlack.noalias() = dense.denseA() * x;
+  w.odeSlack += dense.b;
+  applyAccuracy(r, accuracy(dense, x, w.odeSlack), options.tolerance);
   r.seconds = nowSeconds() - t0;
   return r;
 }

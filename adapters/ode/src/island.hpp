@@ -88,6 +88,9 @@ struct IslandWork {
   // ODE's dense layout for dxSolveLCP: A (m x dPAD(m)), (b, x) and (lo, hi) pairs, findex.
   std::vector<double> odeA, odeBx, odeLh;
   std::vector<int> odeFindex;
+  Problem odeProblem;  // A assembled for dxSolveLCP, reused like RowSolver's
+  RowSystem::AssembleScratch odeScratch;
+  Vector odeSlack;
 };
 
 }  // namespace mlcp::ode

@@ -108,6 +108,14 @@ class OdeWorld : public scene::World {
     }
     built_->clearContacts();
     const StepStats& st = stepper_->lastStep();
+    // solver_ms, per island summed. Core solvers ("auto", "dantzig", ...): RowSolver::solve,
+    // i.e. choosing, assembling A (matrix-based solvers), the solve, the recomputed residual
+    // and any fallback. "ode-world" (our stages around ODE's dxSolveLCP, equal to dWorldStep
+    // to round-off): the same span, i.e. assembling A (the same RowSystem::assemble), ODE's
+    // layout, dxSolveLCP and the recomputed residual; so auto and ode-world compare like for
+    // like, rows and integration excluded from both. "ode-quick" forwards whole islands to
+    // dxQuickStepIsland, whose solve cannot be timed apart: its solver_ms is the whole island
+    // (rows, solve, integration) and overstates its solve.
     double seconds = 0;
     Status worst = Status::Converged;
     m.iterations = 0;
