@@ -25,18 +25,34 @@ double heldValue(double lo, double hi, bool atHi) { return atHi ? hi : lo; }
 bool SymmetricPatternLu::factor(int m, const std::vector<int>& outer, const std::vector<int>& inner,
                                 const std::vector<double>& k, const std::vector<double>& kt,
                                 double pivotTolerance) {
-  if (static_cast<int>(cols_.size()) < m) cols_.resize(m);
-  for (int c = 0; c < m; ++c) cols_[c].clear();
+  // Symbolic: the elimination tree and the column counts of L (as SimplicialLDLT's analysis).
+  parent_.assign(m, -1);
+  tag_.assign(m, -1);
+  fill_.assign(m, 0);
+  for (int col = 0; col < m; ++col) {
+    tag_[col] = col;
+    for (int e = outer[col]; e < outer[col + 1]; ++e)
+      for (int i = inner[e]; i < col && tag_[i] != col; i = parent_[i]) {
+        if (parent_[i] < 0) parent_[i] = col;
+        ++fill_[i];
+        tag_[i] = col;
+      }
+  }
+  start_.assign(m + 1, 0);
+  for (int c = 0; c < m; ++c) start_[c + 1] = start_[c] + fill_[c];
+  rows_.resize(start_[m]);
+  l_.resize(start_[m]);
+  u_.resize(start_[m]);
+  std::copy(start_.begin(), start_.end() - 1, fill_.begin());
   d_.assign(m, 0.0);
   y_.assign(m, 0.0);
   z_.assign(m, 0.0);
-  parent_.assign(m, -1);
   tag_.assign(m, -1);
   stack_.resize(m);
   for (int col = 0; col < m; ++col) {
     // Scatter column col of K above the diagonal into y, row col left of it into z; the rows
-    // of L's row col (the reach of column col's pattern in the elimination tree) go on the stack in
-    // topological order.
+    // of L's row col (the reach of column col's pattern in the elimination tree) go on the
+    // stack in topological order.
     tag_[col] = col;
     int top = m;
     double dk = 0;
@@ -50,10 +66,6 @@ bool SymmetricPatternLu::factor(int m, const std::vector<int>& outer, const std:
       for (; tag_[i] != col; i = parent_[i]) {
         stack_[len++] = i;
         tag_[i] = col;
-        if (parent_[i] < 0) {
-          parent_[i] = col;
-          break;
-        }
       }
       while (len > 0) stack_[--top] = stack_[--len];
     }
@@ -61,12 +73,15 @@ bool SymmetricPatternLu::factor(int m, const std::vector<int>& outer, const std:
       const int i = stack_[top];
       const double yi = y_[i], zi = z_[i];
       y_[i] = z_[i] = 0;
-      for (const Entry& e : cols_[i]) {
-        y_[e.row] -= e.l * yi;
-        z_[e.row] -= e.u * zi;
+      for (int p = start_[i]; p < fill_[i]; ++p) {
+        y_[rows_[p]] -= l_[p] * yi;
+        z_[rows_[p]] -= u_[p] * zi;
       }
       dk -= zi * yi / d_[i];
-      cols_[i].push_back({col, zi / d_[i], yi / d_[i]});
+      const int p = fill_[i]++;
+      rows_[p] = col;
+      l_[p] = zi / d_[i];
+      u_[p] = yi / d_[i];
     }
     if (!(std::abs(dk) > pivotTolerance)) return false;
     d_[col] = dk;
@@ -77,11 +92,11 @@ bool SymmetricPatternLu::factor(int m, const std::vector<int>& outer, const std:
 void SymmetricPatternLu::solve(Vector& y) const {
   const int m = static_cast<int>(y.size());
   for (int i = 0; i < m; ++i)
-    for (const Entry& e : cols_[i]) y[e.row] -= e.l * y[i];
+    for (int p = start_[i]; p < start_[i + 1]; ++p) y[rows_[p]] -= l_[p] * y[i];
   for (int i = 0; i < m; ++i) y[i] /= d_[i];
   for (int i = m - 1; i >= 0; --i) {
     double s = y[i];
-    for (const Entry& e : cols_[i]) s -= e.u * y[e.row];
+    for (int p = start_[i]; p < start_[i + 1]; ++p) s -= u_[p] * y[rows_[p]];
     y[i] = s;
   }
 }

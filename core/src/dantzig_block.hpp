@@ -27,12 +27,10 @@ class SymmetricPatternLu {
   void solve(Vector& y) const;  // y <- K^-1 y
 
  private:
-  struct Entry {
-    int row;
-    double l, u;  // L(row, col) and U(col, row)
-  };
-  std::vector<std::vector<Entry>> cols_;
-  std::vector<double> d_, y_, z_;
+  // Column c of L (and row c of U) at [start_[c], start_[c + 1]): rows_, l_ = L(row, c),
+  // u_ = U(c, row), sized by a symbolic pass over the elimination tree.
+  std::vector<int> start_, fill_, rows_;
+  std::vector<double> l_, u_, d_, y_, z_;
   std::vector<int> parent_, tag_, stack_;
 };
 
