@@ -132,7 +132,7 @@ struct IslandSolve {
   std::string requested;       // the primary that ran ("auto"'s choice, or the requested name)
   bool fellBack = false;       // the primary's answer was rejected and the fallback ran
   bool accepted = true;        // the returned answer passes acceptable()
-  double assembleSeconds = 0;  // part of result.seconds spent assembling A
+  double assembleSeconds = 0;  // part of result.seconds spent classifying and assembling A
 };
 
 // Counts of IslandSolve::choice over a step, e.g. "dantzig:3 ldlt:1 none:2".
@@ -198,6 +198,7 @@ class RowSolver {
   Problem assembled_;  // reused across solves with assembleScratch_: no per-step allocation
   RowSystem::AssembleScratch assembleScratch_;
   bool haveAssembled_ = false;
+  double solveStart_ = 0;  // the current solve's start, until its primary's run() reads it
   Vector xFallback_;
   std::unordered_map<std::uint64_t, std::unique_ptr<Slot>> slots_;
   std::uint64_t calls_ = 0;
