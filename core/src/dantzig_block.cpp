@@ -287,9 +287,18 @@ bool BlockPivoting::factorCoupled(double rho, std::string& why) {
   coupled_.assign(n, 0.0);
   column_.assign(n, 0.0);
   kOuter_.assign(m + 1, 0);
-  kInner_.clear();
-  kVal_.clear();
-  ktVal_.clear();
+  int bound = m;  // entries of K at most: A's columns of C and a diagonal each
+  for (int c = 0; c < m; ++c)
+    bound += A.outerIndexPtr()[order_[c] + 1] - A.outerIndexPtr()[order_[c]];
+  kInner_.resize(bound);
+  kVal_.resize(bound);
+  ktVal_.resize(bound);
+  int nz = 0;
+  auto put = [&](int q, double v, double vt) {
+    kInner_[nz] = q;
+    kVal_[nz] = v;
+    ktVal_[nz++] = vt;
+  };
   for (int c = 0; c < m; ++c) {
     const int i = order_[c];
     // Column c of K: A(C, i) plus, when i is a normal, c_t A(C, t) for its sliding rows t;
@@ -313,19 +322,13 @@ bool BlockPivoting::factorCoupled(double rho, std::string& why) {
         kt += coeff_[k] * column_[sliding_[k]];
       const double extra = r == i ? rho : 0.0;
       diagonal |= r == i;
-      kInner_.push_back(pos_[r]);
-      kVal_.push_back(it.value() + coupled_[r] + extra);
-      ktVal_.push_back(kt + extra);
+      put(pos_[r], it.value() + coupled_[r] + extra, kt + extra);
     }
-    if (!diagonal) {
-      kInner_.push_back(c);
-      kVal_.push_back(rho);
-      ktVal_.push_back(rho);
-    }
+    if (!diagonal) put(c, rho, rho);
     for (SparseMatrix::InnerIterator it(A, i); it; ++it) column_[it.index()] = 0;
     for (int k = slidingHead_[i]; k >= 0; k = slidingNext_[k])
       for (SparseMatrix::InnerIterator it(A, sliding_[k]); it; ++it) coupled_[it.index()] = 0;
-    kOuter_[c + 1] = static_cast<int>(kInner_.size());
+    kOuter_[c + 1] = nz;
   }
   useSymLu_ = true;
   if (symLu_.factor(m, kOuter_, kInner_, kVal_, ktVal_, pivTol_)) return true;
