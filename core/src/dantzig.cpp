@@ -24,6 +24,9 @@ VMap vmap(std::vector<double>& v, int len, int offset = 0) { return VMap(v.data(
 
 bool isEquality(double lo, double hi) { return lo == -kInf && hi == kInf; }
 
+// Largest residual (residual.hpp) of a guess whose friction values set the first pass's bounds.
+constexpr double kTrustedGuess = 1e-2;
+
 }  // namespace
 
 struct DantzigSolver::Workspace {
@@ -676,7 +679,7 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
   blockSettled_ = false;
   const bool warm = !x.isZero(0.0);
   if (!wantsBlockStage(problem)) {
-    runPivoting(problem, x, result);
+    runPivoting(problem, x, result, false);
     return;
   }
   auto settle = [&](const detail::BlockPivoting::Report& rep) {
@@ -707,7 +710,8 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
     blockMessage = "cold trial: " + rep.message;
   }
   const bool warmStage = warm && problem.size() >= params_.autoWarmMinRows;
-  if (warmStage || params_.blockStage == DantzigParams::BlockStage::Always) {
+  const bool blockIterate = warmStage || params_.blockStage == DantzigParams::BlockStage::Always;
+  if (blockIterate) {
     const detail::BlockPivoting::Report rep =
         block_->run(problem, x, options(), std::max(1, params_.maxBlockSteps), false, symmetric);
     blockSteps_ += rep.steps;
@@ -718,18 +722,25 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
     // x holds the best iterate: its index sets warm start the incremental pivoting.
     blockMessage += (blockMessage.empty() ? "" : "; ") + rep.message;
   }
-  runPivoting(problem, x, result);
+  runPivoting(problem, x, result, blockIterate);
   result.iterations += blockSteps_;
   result.message = "block stage: " + blockMessage + "; pivoting: " + result.message;
 }
 
-void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& result) {
+void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& result, bool fromBlock) {
   const Options& opt = options();
   Workspace& ws = *ws_;
   const int n = problem.size();
   const bool exact = opt.frictionBounds == FrictionBounds::Exact;
   const bool useGuess = !x.isZero(0.0);
-  ws.build(problem, x, useGuess, exact);
+  // A guess's friction values fix the first pass's friction bounds only when the guess is
+  // close (the block stage's iterate, or a residual within kTrustedGuess): Bullet's cached
+  // impulses (residual 0.1-0.7, friction directions that turn between steps) gave bounds so far
+  // off that the second pass redid most pivots, where the first pass's cold bounds (as
+  // FixedOnce) needed half as many pivots in all.
+  const bool trustFriction =
+      useGuess && exact && (fromBlock || residual(problem, x) <= kTrustedGuess);
+  ws.build(problem, x, useGuess, trustFriction);
   ws.pivTol *= opt.pivotTolerance;
   ws.pivots = 0;
   ws.pivotLimit = opt.maxPivots > 0 ? opt.maxPivots : 50 * n + 100;
@@ -744,7 +755,7 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
     ws.set[p] = guessed ? Set::Clamped : Set::Unprocessed;
   }
   const bool friction = problem.hasFindex();
-  const bool firstFixedOnce = friction && !(useGuess && exact);
+  const bool firstFixedOnce = friction && !trustFriction;
   auto writeBack = [&] {
     for (int p = 0; p < n; ++p) x[ws.perm[p]] = ws.x[p];
   };
