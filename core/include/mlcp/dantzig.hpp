@@ -111,20 +111,21 @@
 // non-monotone line searches, other proximal weights (1e-3, 5e-2) or BPP-style set updates in
 // the damped phase changed that. n = 1160 (55 boxes): 40 steps (~1 ms each) then the pivoting
 // from the best iterate (~60-150 pivots, ~10 friction passes, ~20 ms): 55-105 ms per island,
-// against 165-220 ms for the pivoting alone from the guess (Never: ~2000 pivots, half of them in
-// the second friction pass because the first took its bounds from the guess). n = 280 (15
+// against 100-220 ms for the pivoting alone from the guess (Never: ~2000 pivots, half of them
+// in the second friction pass, when the first took its bounds from the guess; ~1700 with
+// FixedOnce's first pass, see Friction). n = 280 (15
 // boxes): Never takes ~3-4 ms (~250 pivots) where the 40 damped steps plus the pivoting took ~9
-// ms, hence autoWarmMinRows. Whole steps (tests/bench/bullet_bench, CPU time, same run): 15 boxes
-// 3.7 ms against stock btDantzigLCP's 5.2 ms; 55 boxes 112 ms against 398 ms (3.5x; the 20x
-// goal is not met: ~40 steps of ~1 ms, a third of each in the LU, then ~20 ms of pivoting, and
-// fewer steps need a better globalization than found so far). ODE piles (A holds ~14% nonzeros):
-// the all-clamped cold guess settles in 1 full step (n = 432: ~2.3 ms; n = 1728: ~30 ms) where the
-// stepper's warm guess needed 6-9 steps, hence Auto's cold trial first (it stops at its first
-// non-improving step, so it costs one factorization where it does not settle); ode_bench 20 5:
-// 16x faster than dWorldStep at 588 rows, 71x at 1728, same answers. Synthetic box
-// pyramids: a warm start settles in 1-2 full steps (55 boxes, n = 1200: about 8 ms per step
-// including assembly); from a cold start the trial does not settle and the incremental pivoting
-// runs from zero.
+// ms, hence autoWarmMinRows. Whole steps (tests/bench/bullet_bench, CPU ms, stock in the same
+// run, two runs): 15 boxes 3.8-4.2 ms against stock btDantzigLCP's 4.1-4.4 ms (even); 55 boxes
+// 79-100 ms against 383-468 ms (4.7-4.8x; the 20x goal is not met: ~40 steps of ~1 ms, a third
+// of each in the LU, then ~20 ms of pivoting; fewer steps need a better globalization than
+// found so far). ODE piles (A holds ~14% nonzeros): the all-clamped cold guess settles in 1 full
+// step (n = 432: ~2.3 ms; n = 1728: ~30 ms) where the stepper's warm guess needed 6-9 steps, hence
+// Auto's cold trial first (it stops at its first non-improving step, so it costs one factorization
+// where it does not settle); ode_bench 20 5: 9.5-16x faster than dWorldStep at 588 rows, 64-71x at
+// 1728, same answers. Synthetic box pyramids: a warm start settles in 1-2 full steps (55 boxes, n =
+// 1200: about 8 ms per step including assembly); from a cold start the trial does not settle and
+// the incremental pivoting runs from zero.
 //
 // Result::iterations counts pivots (direction computations: each row added or exchanged)
 // summed over all passes; Options::maxPivots (0: 50 n + 100) limits them per pass
