@@ -154,22 +154,12 @@ void RowSystem::assemble(bool sparse, Problem& p, AssembleScratch& scratch) cons
   }
   // Every entry of A as (row, column, value) in one fixed order: diag(cfm), then per body the
   // products of the rows touching it. Dense and sparse storage sum them in this order.
-  // M^-1 is symmetric, so each pair's product is computed once and written to both (i, j) and
-  // (j, i): half the dot products, and A exactly symmetric.
   auto forEachProduct = [&](auto&& add) {
     for (int i = 0; i < n; ++i) add(i, i, cfm[i]);
     for (std::size_t k = 0; k < bodies.size(); ++k) {
-      const auto& rowsOfBody = touching[k];
-      for (std::size_t a = 0; a < rowsOfBody.size(); ++a) {
-        const auto& [i, ji] = rowsOfBody[a];
+      for (const auto& [i, ji] : touching[k]) {
         const Vector6 mji = applyInverseMass(bodies[k], *ji);
-        add(i, i, ji->dot(mji));
-        for (std::size_t c = a + 1; c < rowsOfBody.size(); ++c) {
-          const auto& [j, jj] = rowsOfBody[c];
-          const double v = jj->dot(mji);
-          add(i, j, v);
-          add(j, i, v);
-        }
+        for (const auto& [j, jj] : touching[k]) add(i, j, jj->dot(mji));
       }
     }
   };
