@@ -387,3 +387,37 @@ TEST(BulletPlumbing, AutoPicksLdltForABilateralOnlyIsland) {
   }
   EXPECT_EQ(mine->totals().choices.toString(), "ldlt:60");
 }
+
+// Bullet 3's setup starts friction rows at 0; with persistent friction directions the island's
+// start takes last step's friction impulses from the manifold points (our answer, written back
+// by SI's finish): a box held by static friction on an incline starts each step where the last
+// one ended.
+TEST(BulletPlumbing, FrictionStartsFromLastStepsImpulseWhenDirectionsPersist) {
+  sc::World w(1.0 / 60.0, true);
+  w.info().m_solverMode |= SOLVER_ENABLE_FRICTION_DIRECTION_CACHING |
+                           SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION;
+  sc::incline(w, 0.3, 0.8);
+  w.step(30);
+  Settings s;
+  s.solver = "dantzig";
+  s.keepIslands = true;
+  w.setSolver(std::make_unique<ConstraintSolver>(s));
+  const auto* mine = static_cast<const ConstraintSolver*>(w.solver());
+  mlcp::Vector previous;
+  int compared = 0;
+  for (int step = 0; step < 20; ++step) {
+    w.step();
+    ASSERT_EQ(mine->islands().size(), 1u);
+    const mlcp::bullet::IslandRecord& rec = mine->islands()[0];
+    if (previous.size() == rec.start.size()) {
+      for (Eigen::Index i = 0; i < rec.start.size(); ++i) {
+        if (rec.system.findex[i] < 0) continue;
+        EXPECT_NEAR(rec.start[i], previous[i], 1e-9 * (1 + std::abs(previous[i])))
+            << "step " << step << " row " << i;
+        compared += std::abs(previous[i]) > 1e-3;
+      }
+    }
+    previous = rec.x;
+  }
+  EXPECT_GT(compared, 20);
+}

@@ -147,6 +147,21 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
                                      ? 1.0 / info.m_warmstartingFactor
                                      : 1.0;
   const bool warm = start != Start::Zero;
+  // Bullet 3's setup starts every friction row at 0 (setFrictionConstraintImpulse); the impulse
+  // it wrote back last step (m_appliedImpulseLateral1/2, kept with the manifold point) is the
+  // warm start, when the friction directions persist between steps.
+  const bool lateralCache =
+      start == Start::CachedImpulse && (info.m_solverMode & SOLVER_USE_WARMSTARTING) &&
+      (info.m_solverMode & (SOLVER_ENABLE_FRICTION_DIRECTION_CACHING |
+                            SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION));
+  // The cached impulse of friction row k: its contact's first friction row is lateral 1.
+  auto lateralImpulse = [&](const btSolverConstraint& f, int k) -> double {
+    const btSolverConstraint& contact = (*in.contacts)[f.m_frictionIndex];
+    const auto* point = static_cast<const btManifoldPoint*>(contact.m_originalContactPoint);
+    if (!point) return 0.0;
+    return static_cast<double>(k == contact.m_frictionIndex ? point->m_appliedImpulseLateral1
+                                                            : point->m_appliedImpulseLateral2);
+  };
   for (int i = 0; i < n; ++i) {
     if (rowIsland_[i] < 0) continue;
     Island& isl = islands_[rowIsland_[i]];
@@ -191,6 +206,8 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     }
     const double unscale = i >= nj ? unscaleContacts : 1.0;
     isl.start[r] = warm ? unscale * static_cast<double>(c.m_appliedImpulse) : 0.0;
+    if (lateralCache && i >= nj + nc && i < nj + nc + nf)
+      isl.start[r] = lateralImpulse(c, i - nj - nc);
     isl.splitStart[r] = warm ? static_cast<double>(c.m_appliedPushImpulse) : 0.0;
   }
 }

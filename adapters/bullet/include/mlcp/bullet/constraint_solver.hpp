@@ -29,7 +29,14 @@
 //     (Bullet's applied impulse divided by m_warmstartingFactor, 0.85: SI's setup has already
 //     applied the scaled impulse to the solver bodies, and the write-back below only applies
 //     the difference), or with Settings::siStart SI's own start (the applied impulse as it is),
-//     0 for joints (SI does not warm-start them).
+//     0 for joints (SI does not warm-start them). Bullet 3's setup starts friction rows at 0
+//     whatever the mode; the warm start takes last step's friction impulses from the manifold
+//     points (m_appliedImpulseLateral1/2) when the friction directions persist between steps
+//     (direction caching, or directions not from the sliding velocity; the scene loader's flags,
+//     55-box pyramid: residual of the start 1.0-1.2 against 2.1-2.6). With Bullet's default
+//     velocity-dependent direction the row's direction changes every step and friction starts
+//     at 0: last step's value along the old direction made the start worse (bullet_bench's
+//     55-box pyramid: residual of the start 0.3-1.1 against 0.2-0.7 from 0).
 //  5. solve and 6. check — mlcp::RowSolver (mlcp/row_solver.hpp), shared with the ODE adapter:
 //     it classifies the island (bilateral only, frictionless contacts, boxed, friction), runs
 //     the named solver or `auto`'s choice ("pgs" on the rows, others on an assembled A, dense up

@@ -32,7 +32,10 @@ enum class Start {
   Zero,            // a cold start
   CachedImpulse,   // last step's impulses, the warm start: contacts' and friction's applied
                    // impulse divided by m_warmstartingFactor (SI's setup applied the scaled
-                   // impulse), joints' as applied
+                   // impulse), joints' as applied; friction rows, which Bullet 3's setup starts
+                   // at 0, take the manifold point's m_appliedImpulseLateral1/2 (last step's
+                   // answer) when the directions persist (SOLVER_ENABLE_FRICTION_DIRECTION_CACHING
+                   // or SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION)
   AppliedImpulse,  // the applied impulses as they are (after SI's iterations: SI's answer)
 };
 
