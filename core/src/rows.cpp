@@ -251,13 +251,17 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
   // runs only to name what is wrong.
   if (!arraysAndBodiesValid(s)) return invalid(s.validate());
   const int n = s.size();
-  const int world = static_cast<int>(s.bodies.size());  // the zero-velocity slot
+  const int world = static_cast<int>(s.bodies.size());  // the first zero-velocity slot
   const unsigned slots = static_cast<unsigned>(world) + 1;
+  // Ground rows take the world slots in turn: one shared slot would chain them all through its
+  // store and load (see rows.hpp).
+  unsigned nextWorld = 0;
+  auto worldSlot = [&] { return world + static_cast<int>(nextWorld++ % kWorldSlots); };
   // x is the caller's until the input is known to be valid: a cold start reads zeros.
   const bool warm = opt.warmStart && x.size() == n && x.allFinite();
 
   packed_.resize(n);
-  velocity_.resize(world + 1);
+  velocity_.resize(world + kWorldSlots);
   for (BodyVelocity& v : velocity_) v.v.setZero();
   double d = 0;  // A_ii of the row that stopped the packing
   int bad = -1;  // that row
@@ -266,8 +270,8 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
     const ConstraintRow& r = s.rows[i];
     PackedRow& p = packed_[i];
     // "The world" (-1) becomes the zero-velocity slot (its J meets v = 0, its M^-1 J^T is 0).
-    p.a = r.bodyA >= 0 ? r.bodyA : world;
-    p.b = r.bodyB >= 0 ? r.bodyB : world;
+    p.a = r.bodyA >= 0 ? r.bodyA : worldSlot();
+    p.b = r.bodyB >= 0 ? r.bodyB : worldSlot();
     p.mA = r.bodyA >= 0 ? applyInverseMass(s.bodies[r.bodyA], r.jA) : Vector6::Zero();
     p.mB = r.bodyB >= 0 ? applyInverseMass(s.bodies[r.bodyB], r.jB) : Vector6::Zero();
     p.lo = s.lo[i];
@@ -289,7 +293,8 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
       velocity_[p.b].v += p.mB * xi;
     }
   }
-  velocity_[world].v.setZero();  // the world never moves (its blocks are zero anyway)
+  // The world never moves (its blocks are zero anyway).
+  for (int k = 0; k < kWorldSlots; ++k) velocity_[world + k].v.setZero();
   // The input is valid from here on (a non-positive A_ii is a failure, not invalid input):
   // x is the iterate (no copy).
   if (!warm) x.setZero(n);

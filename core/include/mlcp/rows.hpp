@@ -120,6 +120,8 @@ class RowPgs {
     Vector6 v;
     double pad[2];
   };
+  // Zero-velocity slots standing for "the world", taken by ground rows in turn.
+  static constexpr int kWorldSlots = 8;
   // w = J v + cfm x + b for every row, from the maintained velocities (see above).
   void slackFromVelocities(const RowSystem& system, const Vector& x);
 
