@@ -1,8 +1,11 @@
 #include "mlcp/ldlt.hpp"
 
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
-#include <sstream>
+#include <algorithm>
+#include <cmath>
 
 #include "sparse_pattern.hpp"
 
@@ -14,7 +17,112 @@ struct LdltSolver::Impl {
   Eigen::SimplicialLDLT<ColMajor> ldlt;
   Eigen::SparseLU<ColMajor> lu;
   detail::PatternCache pattern;  // tagged 1 for LDL^T, 0 for LU
+  // The dense path: L (unit lower, row-major so each row's envelope is contiguous) and D of
+  // A = L D L^T, each row's first nonzero column, Eigen's pivoting LDL^T and LU for what the
+  // envelope factorization cannot take; kept, so no allocation per solve once the size is seen.
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> L;
+  Vector d, w, rhs, correction;
+  std::vector<Eigen::Index> first;
+  Eigen::LDLT<DenseMatrix> denseLdlt;
+  Eigen::PartialPivLU<DenseMatrix> denseLu;
+
+  // Whether A equals A^T to 1e-14 relative to its largest entry (detail::isSymmetric's rule),
+  // recording each row's first nonzero column on the way.
+  bool symmetricEnvelope(const DenseMatrix& A);
+  // L D L^T without pivoting inside the envelope; false on a pivot <= 1e-13 relative.
+  bool factorEnvelope(const DenseMatrix& A);
+  // x = (L D L^T)^-1 r.
+  void solveEnvelope(const Vector& r, Vector& x) const;
 };
+
+bool LdltSolver::Impl::symmetricEnvelope(const DenseMatrix& A) {
+  const Eigen::Index n = A.rows();
+  const double tol = 1e-14 * std::max(1.0, A.cwiseAbs().maxCoeff());
+  first.assign(n, -1);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    first[j] = first[j] < 0 ? j : first[j];
+    for (Eigen::Index i = j + 1; i < n; ++i) {
+      if (std::abs(A(i, j) - A(j, i)) > tol) return false;
+      if (first[i] < 0 && A(i, j) != 0) first[i] = j;
+    }
+  }
+  return true;
+}
+
+bool LdltSolver::Impl::factorEnvelope(const DenseMatrix& A) {
+  const Eigen::Index n = A.rows();
+  L.resize(n, n);
+  d.resize(n);
+  w.resize(n);
+  const double pivotFloor = 1e-13 * std::max(1.0, A.diagonal().cwiseAbs().maxCoeff());
+  // Row by row (the envelope of L is A's): w_k = L_ik d_k, L_ij = (A_ij - w . L_j) / d_j.
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Eigen::Index fi = first[i];
+    for (Eigen::Index j = fi; j < i; ++j) {
+      const Eigen::Index k0 = std::max(fi, first[j]);
+      const double s =
+          A(i, j) - w.segment(k0, j - k0).dot(L.row(j).segment(k0, j - k0).transpose());
+      w[j] = s;
+      L(i, j) = s / d[j];
+    }
+    const double di = A(i, i) - w.segment(fi, i - fi).dot(L.row(i).segment(fi, i - fi).transpose());
+    if (!(std::abs(di) > pivotFloor)) return false;
+    d[i] = di;
+  }
+  return true;
+}
+
+void LdltSolver::Impl::solveEnvelope(const Vector& r, Vector& x) const {
+  const Eigen::Index n = r.size();
+  x = r;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Eigen::Index fi = first[i];
+    x[i] -= L.row(i).segment(fi, i - fi).dot(x.segment(fi, i - fi).transpose());
+  }
+  x.array() /= d.array();
+  for (Eigen::Index i = n - 1; i > 0; --i) {
+    const Eigen::Index fi = first[i];
+    x.segment(fi, i - fi) -= x[i] * L.row(i).segment(fi, i - fi).transpose();
+  }
+}
+
+void LdltSolver::runDense(const Problem& problem, Vector& x, Result& result) {
+  Impl& m = *impl_;
+  const DenseMatrix& A = problem.denseA();
+  m.rhs = -problem.b;
+  // Factor, solve, refine once (as the sparse path).
+  auto factorSolve = [&](auto& factorization) {
+    factorization.compute(A);
+    x = factorization.solve(m.rhs);
+    m.correction = m.rhs;
+    m.correction.noalias() -= A * x;
+    x += factorization.solve(m.correction);
+  };
+  result.iterations = 1;
+  result.status = Status::Converged;
+  const bool symmetric = m.symmetricEnvelope(A);
+  if (symmetric && m.factorEnvelope(A)) {
+    m.solveEnvelope(m.rhs, x);
+    m.correction = m.rhs;
+    m.correction.noalias() -= A * x;
+    m.solveEnvelope(m.correction, m.w);
+    x += m.w;
+    result.message = "dense LDL^T solve";
+  } else if (symmetric) {
+    // A (near-)zero pivot without pivoting: Eigen's LDL^T with diagonal pivoting, which drops
+    // (near-)zero pivots: a singular but consistent system still gets an answer, an
+    // inconsistent one a large residual, which the base reports as Failed.
+    factorSolve(m.denseLdlt);
+    const auto dd = m.denseLdlt.vectorD().cwiseAbs();
+    const bool singular = dd.minCoeff() <= 1e-14 * std::max(1.0, dd.maxCoeff());
+    result.message =
+        singular ? "dense pivoting LDL^T solve (A is singular)" : "dense pivoting LDL^T solve";
+  } else {
+    // A zero pivot of a singular A gives Inf/NaN, which the base reports.
+    factorSolve(m.denseLu);
+    result.message = "dense LU solve";
+  }
+}
 
 LdltSolver::LdltSolver() : impl_(std::make_unique<Impl>()) {}
 LdltSolver::~LdltSolver() = default;
@@ -33,6 +141,7 @@ void LdltSolver::run(const Problem& problem, Vector& x, Result& result) {
     result.message = "empty problem";
     return;
   }
+  if (!problem.isSparse()) return runDense(problem, x, result);
   ColMajor A = problem.toSparse();
   A.makeCompressed();
   const bool symmetric = detail::isSymmetric(A);

@@ -160,8 +160,8 @@ Result RowSolver::run(const RowSystem& rows, const std::string& name, const Opti
     x = start;
     return rowPgs_.solve(rows, x);
   }
-  // ldlt factors sparse storage whatever the size (a dense A would be converted every solve).
-  const bool sparse = name == "ldlt" || rows.size() > settings_.denseMaxRows;
+  // Every assembled-problem solver follows the storage (ldlt: dense or sparse LDL^T).
+  const bool sparse = rows.size() > settings_.denseMaxRows;
   if (!haveAssembled_ || assembled_.isSparse() != sparse) {
     const double t0 = since > 0 ? since : nowSeconds();
     assemble(rows, sparse);

@@ -72,7 +72,7 @@ struct RowSolverSettings {
   // answer. Default kDefaultAcceptResidual (1e-3).
   double acceptResidual = kDefaultAcceptResidual;
   // Islands with at most this many rows give matrix-based solvers a dense A, larger ones a
-  // sparse A (rows); ldlt, which factors sparse storage, always gets a sparse A. Default
+  // sparse A (rows); ldlt then factors dense or sparse LDL^T accordingly. Default
   // kDefaultDenseMaxRows (64).
   int denseMaxRows = kDefaultDenseMaxRows;
 };
