@@ -388,14 +388,16 @@ TEST(BulletPlumbing, AutoPicksLdltForABilateralOnlyIsland) {
   EXPECT_EQ(mine->totals().choices.toString(), "ldlt:60");
 }
 
-// Bullet 3's setup starts friction rows at 0; with persistent friction directions the island's
-// start takes last step's friction impulses from the manifold points (our answer, written back
-// by SI's finish): a box held by static friction on an incline starts each step where the last
-// one ended.
-TEST(BulletPlumbing, FrictionStartsFromLastStepsImpulseWhenDirectionsPersist) {
-  sc::World w(1.0 / 60.0, true);
-  w.info().m_solverMode |= SOLVER_ENABLE_FRICTION_DIRECTION_CACHING |
-                           SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION;
+// Bullet 3's setup starts friction rows at 0. With Bullet's default velocity-dependent friction
+// direction each friction row's direction changes every step; with direction caching (and two
+// directions) it does not. Either way the start is last step's friction impulse of the same
+// manifold point (a world vector: x times the row's direction, the linear part of J) along the
+// row's direction: a box held by static friction on an incline.
+static void frictionStartsFromLastStep(bool persistentDirections) {
+  sc::World w(1.0 / 60.0, persistentDirections);
+  if (persistentDirections)
+    w.info().m_solverMode |= SOLVER_ENABLE_FRICTION_DIRECTION_CACHING |
+                             SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION;
   sc::incline(w, 0.3, 0.8);
   w.step(30);
   Settings s;
@@ -403,21 +405,37 @@ TEST(BulletPlumbing, FrictionStartsFromLastStepsImpulseWhenDirectionsPersist) {
   s.keepIslands = true;
   w.setSolver(std::make_unique<ConstraintSolver>(s));
   const auto* mine = static_cast<const ConstraintSolver*>(w.solver());
-  mlcp::Vector previous;
+  // A row's direction: the linear part of J on the side that has a body (the ground has none).
+  auto direction = [](const mlcp::ConstraintRow& row) -> Eigen::Vector3d {
+    return row.bodyA >= 0 ? Eigen::Vector3d(row.jA.head<3>()) : Eigen::Vector3d(-row.jB.head<3>());
+  };
+  std::vector<Eigen::Vector3d> previous;  // friction impulse per row of last step (zero: none)
   int compared = 0;
   for (int step = 0; step < 20; ++step) {
     w.step();
     ASSERT_EQ(mine->islands().size(), 1u);
     const mlcp::bullet::IslandRecord& rec = mine->islands()[0];
-    if (previous.size() == rec.start.size()) {
-      for (Eigen::Index i = 0; i < rec.start.size(); ++i) {
+    const Eigen::Index n = rec.start.size();
+    if (static_cast<Eigen::Index>(previous.size()) == n) {
+      for (Eigen::Index i = 0; i < n; ++i) {
         if (rec.system.findex[i] < 0) continue;
-        EXPECT_NEAR(rec.start[i], previous[i], 1e-9 * (1 + std::abs(previous[i])))
+        const double expected = previous[i].dot(direction(rec.system.rows[i]));
+        EXPECT_NEAR(rec.start[i], expected, 1e-9 * (1 + std::abs(expected)))
             << "step " << step << " row " << i;
-        compared += std::abs(previous[i]) > 1e-3;
+        compared += std::abs(expected) > 1e-3;
       }
     }
-    previous = rec.x;
+    previous.assign(n, Eigen::Vector3d::Zero());
+    for (Eigen::Index i = 0; i < n; ++i)
+      if (rec.system.findex[i] >= 0) previous[i] = rec.x[i] * direction(rec.system.rows[i]);
   }
   EXPECT_GT(compared, 20);
+}
+
+TEST(BulletPlumbing, FrictionStartIsLastStepsFrictionImpulseAlongTheNewDirection) {
+  frictionStartsFromLastStep(false);
+}
+
+TEST(BulletPlumbing, FrictionStartIsLastStepsFrictionImpulseWhenDirectionsPersist) {
+  frictionStartsFromLastStep(true);
 }

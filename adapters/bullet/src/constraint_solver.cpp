@@ -52,6 +52,7 @@ void ConstraintSolver::prepareSolve(int numBodies, int numManifolds) {
   if (stepOpen_) finishStep();
   current_ = StepStats();
   records_.clear();
+  builder_.newStep();
   stepOpen_ = true;
 }
 
@@ -192,6 +193,7 @@ void ConstraintSolver::solveIsland(Island& island, std::uint64_t key, bool split
       c.m_appliedImpulse = xi;
     }
   }
+  if (!split) builder_.remember(island, x);
   if (settings_.keepIslands)
     records_.push_back({s, start, x, result, solved.choice, split, solved.fellBack});
   if (split) s.b.swap(island.splitB);

@@ -1,5 +1,7 @@
 #include "mlcp/bullet/islands.hpp"
 
+#include <BulletCollision/NarrowPhaseCollision/btPersistentManifold.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -18,6 +20,12 @@ double bound(btScalar v) {
   if (d >= 1e10) return kInf;
   if (d <= -1e10) return -kInf;
   return d;
+}
+
+// A friction row's direction (the impulse on body A per unit x). Bullet zeroes the normal of a
+// side without a rigid body (static ground), so it is taken from the side that has one.
+btVector3 frictionDirection(const btSolverConstraint& c) {
+  return c.m_contactNormal1.isZero() ? -c.m_contactNormal2 : c.m_contactNormal1;
 }
 
 }  // namespace
@@ -110,6 +118,7 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     isl.start.resize(m);
     isl.splitB.resize(m);
     isl.splitStart.resize(m);
+    isl.frictionPoint.assign(m, nullptr);
     isl.hasSplit = false;
   }
 
@@ -154,13 +163,20 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
       start == Start::CachedImpulse && (info.m_solverMode & SOLVER_USE_WARMSTARTING) &&
       (info.m_solverMode & (SOLVER_ENABLE_FRICTION_DIRECTION_CACHING |
                             SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION));
-  // The cached impulse of friction row k: its contact's first friction row is lateral 1.
-  auto lateralImpulse = [&](const btSolverConstraint& f, int k) -> double {
-    const btSolverConstraint& contact = (*in.contacts)[f.m_frictionIndex];
-    const auto* point = static_cast<const btManifoldPoint*>(contact.m_originalContactPoint);
-    if (!point) return 0.0;
-    return static_cast<double>(k == contact.m_frictionIndex ? point->m_appliedImpulseLateral1
-                                                            : point->m_appliedImpulseLateral2);
+  // The start of friction row k (point: its contact's manifold point, not null): last step's
+  // friction impulse of the same point along the row's direction, else the cached impulse when
+  // the directions persist (its contact's first friction row is lateral 1), else none.
+  auto frictionStart = [&](const btSolverConstraint& f, int k, const btManifoldPoint& point,
+                           double& x) {
+    const auto last = lastFriction_.find(&point);
+    if (last != lastFriction_.end() && point.m_lifeTime > last->second.lifeTime &&
+        (point.m_localPointA - last->second.localA).length() < gContactBreakingThreshold) {
+      x = static_cast<double>(last->second.impulse.dot(frictionDirection(f)));
+    } else if (lateralCache) {
+      const bool first = k == (*in.contacts)[f.m_frictionIndex].m_frictionIndex;
+      x = static_cast<double>(first ? point.m_appliedImpulseLateral1
+                                    : point.m_appliedImpulseLateral2);
+    }
   };
   for (int i = 0; i < n; ++i) {
     if (rowIsland_[i] < 0) continue;
@@ -206,9 +222,34 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     }
     const double unscale = i >= nj ? unscaleContacts : 1.0;
     isl.start[r] = warm ? unscale * static_cast<double>(c.m_appliedImpulse) : 0.0;
-    if (lateralCache && i >= nj + nc && i < nj + nc + nf)
-      isl.start[r] = lateralImpulse(c, i - nj - nc);
+    if (i >= nj + nc && i < nj + nc + nf) {
+      const auto* point = static_cast<const btManifoldPoint*>(
+          (*in.contacts)[c.m_frictionIndex].m_originalContactPoint);
+      isl.frictionPoint[r] = point;
+      if (point && start == Start::CachedImpulse)
+        frictionStart(c, i - nj - nc, *point, isl.start[r]);
+    }
     isl.splitStart[r] = warm ? static_cast<double>(c.m_appliedPushImpulse) : 0.0;
+  }
+}
+
+void IslandBuilder::newStep() {
+  lastFriction_.swap(thisFriction_);
+  thisFriction_.clear();
+}
+
+void IslandBuilder::remember(const Island& island, const Vector& x) {
+  for (int r = 0; r < static_cast<int>(island.frictionPoint.size()); ++r) {
+    const btManifoldPoint* point = island.frictionPoint[r];
+    if (!point) continue;
+    auto [it, added] = thisFriction_.try_emplace(point);
+    Friction& f = it->second;
+    if (added) {
+      f.impulse.setZero();
+      f.localA = point->m_localPointA;
+      f.lifeTime = point->m_lifeTime;
+    }
+    f.impulse += static_cast<btScalar>(x[r]) * frictionDirection(*island.rows[r]);
   }
 }
 

@@ -30,13 +30,18 @@
 //     applied the scaled impulse to the solver bodies, and the write-back below only applies
 //     the difference), or with Settings::siStart SI's own start (the applied impulse as it is),
 //     0 for joints (SI does not warm-start them). Bullet 3's setup starts friction rows at 0
-//     whatever the mode; the warm start takes last step's friction impulses from the manifold
-//     points (m_appliedImpulseLateral1/2) when the friction directions persist between steps
-//     (direction caching, or directions not from the sliding velocity; the scene loader's flags,
-//     55-box pyramid: residual of the start 1.0-1.2 against 2.1-2.6). With Bullet's default
-//     velocity-dependent direction the row's direction changes every step and friction starts
-//     at 0: last step's value along the old direction made the start worse (bullet_bench's
-//     55-box pyramid: residual of the start 0.3-1.1 against 0.2-0.7 from 0).
+//     whatever the mode, so friction rows start from last step's friction impulse of the same
+//     manifold point (kept by IslandBuilder::remember as a world vector) along this step's
+//     direction: with Bullet's default velocity-dependent direction the directions change
+//     every step. Else, when directions persist (SOLVER_ENABLE_FRICTION_DIRECTION_CACHING or
+//     SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION), from the manifold point's
+//     m_appliedImpulseLateral1/2 (e.g. the first step after SI). Measured on bullet_bench's
+//     55-box pyramid (dantzig after 30 SI steps) it changes little: friction at rest is mostly
+//     strictly inside its bounds, which a start of 0 guesses too; the block stage's steps at
+//     rest went from 6-24 to 5-23 (CPU ms per island 21-70 to 19-67). What stays wrong in the
+//     start at rest (residual 0.06-0.12, 1-2 normals in the wrong set) are the 1-2 manifold
+//     points Bullet creates every step with no cached impulse. With the scene loader's flags
+//     the start's residual is 1.0-1.2 instead of 2.1-2.6.
 //  5. solve and 6. check — mlcp::RowSolver (mlcp/row_solver.hpp), shared with the ODE adapter:
 //     it classifies the island (bilateral only, frictionless contacts, boxed, friction), runs
 //     the named solver or `auto`'s choice ("pgs" on the rows, others on an assembled A, dense up

@@ -18,6 +18,7 @@
 
 #include <BulletDynamics/ConstraintSolver/btSequentialImpulseConstraintSolver.h>
 
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -46,6 +47,8 @@ struct Island {
   Vector splitB;                          // b of the split-impulse problem (m_rhsPenetration)
   Vector splitStart;                      // applied push impulses
   bool hasSplit = false;                  // splitB has a non-zero entry
+  // Each friction row's manifold point (null for other rows), for IslandBuilder::remember.
+  std::vector<const btManifoldPoint*> frictionPoint;
 };
 
 // The pools of one solveGroup call, as btSequentialImpulseConstraintSolver holds them.
@@ -62,6 +65,17 @@ class IslandBuilder {
   // Splits the rows into islands. globalCfm and timeStep feed CfmModel::StockMlcp and Regularized.
   void build(const BulletRows& rows, const btContactSolverInfo& info, CfmModel cfm, Start start);
 
+  // Friction warm start across steps. Bullet 3 starts friction rows at 0, and with its default
+  // velocity-dependent friction direction a row's direction changes every step, so last step's
+  // value per row means nothing. remember() keeps each manifold point's friction impulse as a
+  // world vector (sum of x_r times the row's direction); the next step's build() starts each
+  // friction row of the same point at that vector's component along its new direction. A point
+  // is "the same" when Bullet kept it (the pointer, a larger m_lifeTime, m_localPointA within
+  // gContactBreakingThreshold: a removed point's slot is refilled by another point or a new one
+  // with m_lifeTime 0). Call newStep() once per simulation step, before its build() calls.
+  void newStep();
+  void remember(const Island& island, const Vector& x);
+
   int count() const { return count_; }
   Island& island(int k) { return islands_[k]; }
   // Rows whose bodies are all static or kinematic (left untouched: they move nothing).
@@ -76,6 +90,12 @@ class IslandBuilder {
   std::vector<int> findex_, dynamic_, parent_, islandOfRoot_, rowIsland_, rowLocal_, bodyLocal_;
   std::vector<int> bodyCount_;
   std::vector<std::pair<int, int>> rowBodies_;  // each row's dynamic bodies (-1: none)
+  struct Friction {
+    btVector3 impulse;  // world-space friction impulse on body A
+    btVector3 localA;   // the point's m_localPointA when remembered
+    int lifeTime = 0;
+  };
+  std::unordered_map<const btManifoldPoint*, Friction> lastFriction_, thisFriction_;
 };
 
 }  // namespace mlcp::bullet
