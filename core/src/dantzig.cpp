@@ -738,8 +738,8 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
   // impulses (residual 0.1-0.7, friction directions that turn between steps) gave bounds so far
   // off that the second pass redid most pivots, where the first pass's cold bounds (as
   // FixedOnce) needed half as many pivots in all.
-  const bool trustFriction =
-      useGuess && exact && (fromBlock || residual(problem, x) <= kTrustedGuess);
+  const bool trustFriction = useGuess && exact && problem.hasFindex() &&
+                             (fromBlock || residual(problem, x) <= kTrustedGuess);
   ws.build(problem, x, useGuess, trustFriction);
   ws.pivTol *= opt.pivotTolerance;
   ws.pivots = 0;
