@@ -11,6 +11,11 @@
 
 namespace mlcp {
 
+namespace {
+// Largest scaled residual at which the envelope LDL^T's answer is kept (see runDense).
+constexpr double kEnvelopeResidual = 1e-11;
+}  // namespace
+
 using ColMajor = Eigen::SparseMatrix<double, Eigen::ColMajor>;
 
 struct LdltSolver::Impl {
@@ -26,27 +31,35 @@ struct LdltSolver::Impl {
   Eigen::LDLT<DenseMatrix> denseLdlt;
   Eigen::PartialPivLU<DenseMatrix> denseLu;
 
-  // Whether A equals A^T to 1e-14 relative to its largest entry (detail::isSymmetric's rule),
-  // recording each row's first nonzero column on the way.
-  bool symmetricEnvelope(const DenseMatrix& A);
+  // Whether A equals A^T to 1e-14 relative to its largest entry (detail::isSymmetric's rule).
+  static bool isSymmetric(const DenseMatrix& A);
+  // Each row's first nonzero column (first).
+  void envelope(const DenseMatrix& A);
   // L D L^T without pivoting inside the envelope; false on a pivot <= 1e-13 relative.
   bool factorEnvelope(const DenseMatrix& A);
   // x = (L D L^T)^-1 r.
   void solveEnvelope(const Vector& r, Vector& x) const;
 };
 
-bool LdltSolver::Impl::symmetricEnvelope(const DenseMatrix& A) {
+bool LdltSolver::Impl::isSymmetric(const DenseMatrix& A) {
   const Eigen::Index n = A.rows();
-  const double tol = 1e-14 * std::max(1.0, A.cwiseAbs().maxCoeff());
-  first.assign(n, -1);
-  for (Eigen::Index j = 0; j < n; ++j) {
-    first[j] = first[j] < 0 ? j : first[j];
-    for (Eigen::Index i = j + 1; i < n; ++i) {
-      if (std::abs(A(i, j) - A(j, i)) > tol) return false;
-      if (first[i] < 0 && A(i, j) != 0) first[i] = j;
-    }
+  double asym = 0;
+  for (Eigen::Index j = 0; j < n; ++j)
+    for (Eigen::Index i = j + 1; i < n; ++i) asym = std::max(asym, std::abs(A(i, j) - A(j, i)));
+  return asym <= 1e-14 * std::max(1.0, A.cwiseAbs().maxCoeff());
+}
+
+void LdltSolver::Impl::envelope(const DenseMatrix& A) {
+  const Eigen::Index n = A.rows();
+  // Row i's first nonzero column, read as column i's first nonzero row (a contiguous scan that
+  // stops at the envelope): right for a symmetric pattern, and an unsymmetric A shows up in the
+  // residual that decides whether the answer is kept.
+  first.resize(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    Eigen::Index k = 0;
+    while (k < i && A(k, i) == 0) ++k;
+    first[i] = k;
   }
-  return true;
 }
 
 bool LdltSolver::Impl::factorEnvelope(const DenseMatrix& A) {
@@ -100,14 +113,32 @@ void LdltSolver::runDense(const Problem& problem, Vector& x, Result& result) {
   };
   result.iterations = 1;
   result.status = Status::Converged;
-  const bool symmetric = m.symmetricEnvelope(A);
-  if (symmetric && m.factorEnvelope(A)) {
+  // The envelope LDL^T reads A's lower triangle only and is kept when its refined answer
+  // solves the full A to kEnvelopeResidual (scaled as residual.hpp: ||A x + b|| / (1 + ||b||)):
+  // this checks symmetry in passing, at the cost of one product A x instead of an O(n^2)
+  // strided comparison. Otherwise the exact check sends A to a pivoting factorization.
+  m.envelope(A);
+  const bool factored = m.factorEnvelope(A);
+  if (factored) {
     m.solveEnvelope(m.rhs, x);
     m.correction = m.rhs;
     m.correction.noalias() -= A * x;
     m.solveEnvelope(m.correction, m.w);
     x += m.w;
-    result.message = "dense LDL^T solve";
+    m.correction = m.rhs;
+    m.correction.noalias() -= A * x;
+    if (m.correction.lpNorm<Eigen::Infinity>() <=
+        kEnvelopeResidual * (1 + m.rhs.lpNorm<Eigen::Infinity>())) {
+      result.message = "dense LDL^T solve";
+      return;
+    }
+  }
+  const bool symmetric = Impl::isSymmetric(A);
+  if (symmetric && factored) {
+    // Symmetric, no small pivot, but the answer missed kEnvelopeResidual (ill-conditioned):
+    // the pivoting LDL^T below may do better; the base's check has the final say either way.
+    factorSolve(m.denseLdlt);
+    result.message = "dense pivoting LDL^T solve (envelope LDL^T residual too large)";
   } else if (symmetric) {
     // A (near-)zero pivot without pivoting: Eigen's LDL^T with diagonal pivoting, which drops
     // (near-)zero pivots: a singular but consistent system still gets an answer, an
