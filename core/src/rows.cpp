@@ -274,9 +274,12 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
   const int n = s.size();
   const int world = static_cast<int>(s.bodies.size());  // the first zero-velocity slot
   const unsigned slots = static_cast<unsigned>(world) + 1;
-  // Ground rows take the world slots in turn: one shared slot would chain them all through its
-  // store and load (see rows.hpp).
+  // Ground rows take the world slots in turn (per run of rows on the same bodies): one shared
+  // slot would chain them all through its store and load (see rows.hpp).
   unsigned nextWorld = 0;
+  int runStart = 0;        // first row of the current run
+  int runA = 0, runB = 0;  // its slots (kept here: reading them back from packed_ right after
+                           // their 4-byte stores stalled store forwarding)
   auto worldSlot = [&] { return world + static_cast<int>(nextWorld++ % kWorldSlots); };
   // x is the caller's until the input is known to be valid: a cold start reads zeros.
   const bool warm = opt.warmStart && x.size() == n && x.allFinite();
@@ -291,8 +294,17 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
     const ConstraintRow& r = s.rows[i];
     PackedRow& p = packed_[i];
     // "The world" (-1) becomes the zero-velocity slot (its J meets v = 0, its M^-1 J^T is 0).
-    p.a = r.bodyA >= 0 ? r.bodyA : worldSlot();
-    p.b = r.bodyB >= 0 ? r.bodyB : worldSlot();
+    if (i > 0 && r.bodyA == s.rows[i - 1].bodyA && r.bodyB == s.rows[i - 1].bodyB &&
+        r.bodyA != r.bodyB) {
+      ++packed_[runStart].run;
+    } else {
+      runStart = i;
+      p.run = 1;
+      runA = r.bodyA >= 0 ? r.bodyA : worldSlot();
+      runB = r.bodyB >= 0 ? r.bodyB : worldSlot();
+    }
+    p.a = runA;
+    p.b = runB;
     double mA[6] = {}, mB[6] = {};
     const double dA = r.bodyA >= 0 ? inverseMassInto(s.bodies[r.bodyA], r.jA, mA) : 0.0;
     const double dB = r.bodyB >= 0 ? inverseMassInto(s.bodies[r.bodyB], r.jB, mB) : 0.0;
@@ -311,8 +323,8 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
     p.shift = step * s.b[i];
     // v = M^-1 J^T x of the start (from mA, mB, not from p.mA, p.mB just stored: see above).
     const double xi = warm ? x[i] : 0.0;
-    double* va = velocity_[p.a].v.data();
-    double* vb = velocity_[p.b].v.data();
+    double* va = velocity_[runA].v.data();
+    double* vb = velocity_[runB].v.data();
     for (int k = 0; k < 6; ++k) {
       p.mA[k] = mA[k];
       p.mB[k] = mB[k];
@@ -363,24 +375,38 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
     result.message = "empty problem";
   }
   double* xs = x.data();
+  // One row's update; va and vb are the same object when the row joins a body to itself.
+  auto visit = [&](const PackedRow& p, int i, Vector6& va, Vector6& vb) {
+    // One reduction for both bodies: the row's latency chain is the sweep's critical path.
+    const double jv = (p.sA.cwiseProduct(va) + p.sB.cwiseProduct(vb)).sum();
+    double lo = p.lo, hi = p.hi;
+    if (p.findex >= 0) {
+      const double normal = std::abs(xs[p.findex]);
+      lo *= normal;
+      hi *= normal;
+    }
+    // The new x is clamp(c - jv, lo, hi) with c = keep x - shift. The change that moves the
+    // velocities is clamped on its own, clamp((c - x) - jv, lo - x, hi - x) (the same up to
+    // round-off), so that the chain does not wait for the subtraction x_new - x.
+    const double xo = xs[i], c = p.keep * xo - p.shift;
+    const double dx = std::clamp((c - xo) - jv, lo - xo, hi - xo);
+    xs[i] = std::clamp(c - jv, lo, hi);
+    va += p.mA * dx;
+    vb += p.mB * dx;
+  };
   for (int sweep = 1; n > 0 && sweep <= opt.maxIterations; ++sweep) {
-    for (int i = 0; i < n; ++i) {
-      const PackedRow& p = packed_[i];
-      Vector6& va = velocity_[p.a].v;
-      Vector6& vb = velocity_[p.b].v;
-      // One reduction for both bodies: the row's latency chain is the sweep's critical path.
-      const double jv = (p.sA.cwiseProduct(va) + p.sB.cwiseProduct(vb)).sum();
-      double lo = p.lo, hi = p.hi;
-      if (p.findex >= 0) {
-        const double normal = std::abs(xs[p.findex]);
-        lo *= normal;
-        hi *= normal;
+    for (int i = 0; i < n;) {
+      const PackedRow& first = packed_[i];
+      if (first.a == first.b) {
+        visit(first, i, velocity_[first.a].v, velocity_[first.a].v);
+        ++i;
+        continue;
       }
-      const double xi = std::clamp(p.keep * xs[i] - p.shift - jv, lo, hi);
-      const double dx = xi - xs[i];
-      xs[i] = xi;
-      va += p.mA * dx;
-      vb += p.mB * dx;
+      // A run's velocities stay in registers (no store-load round trip between its rows).
+      Vector6 va = velocity_[first.a].v, vb = velocity_[first.b].v;
+      for (const int end = i + first.run; i < end; ++i) visit(packed_[i], i, va, vb);
+      velocity_[first.a].v = va;
+      velocity_[first.b].v = vb;
     }
     lastValid = false;
     if (!monitor.wantsCheck(sweep)) continue;

@@ -114,6 +114,7 @@ class RowPgs {
     Vector6 mA, mB;  // M^-1 J^T
     double keep, shift, lo, hi;
     int a, b, findex;
+    int run;  // first row of a run: how many rows from here join the same two bodies a != b
   };
   // A body's velocity change padded to one cache line.
   struct alignas(64) BodyVelocity {
