@@ -312,6 +312,9 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
     p.hi = s.hi[i];
     p.findex = s.findex.empty() ? -1 : s.findex[i];
     d = dA + dB + s.cfm[i];
+    // A row joining a body to itself: A_ii = (jA + jB) M^-1 (jA + jB) has the cross terms too.
+    if (r.bodyA == r.bodyB && r.bodyA >= 0)
+      for (int k = 0; k < 6; ++k) d += r.jA[k] * mB[k] + r.jB[k] * mA[k];
     if (!(d > 0)) {
       bad = i;
       break;

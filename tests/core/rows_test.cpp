@@ -144,6 +144,34 @@ TEST(RowPgs, AgreesWithPgsOnTheAssembledProblem) {
   EXPECT_LE((xr - xp).lpNorm<Eigen::Infinity>(), 1e-8);
 }
 
+// Rows the sweep treats apart: a row joining a body to itself (its diagonal has the cross terms
+// of jA and jB), a row on the world alone (A_ii = cfm), runs of rows on the same bodies broken
+// by them, and many ground rows sharing the world slots.
+TEST(RowPgs, AgreesWithPgsOnSelfJoinedAndWorldOnlyRows) {
+  RowSystem s = stackRows(4, 11);
+  s.rows[4].bodyB = s.rows[4].bodyA;  // inside a contact's run: splits it
+  s.rows[9].bodyB = s.rows[9].bodyA;  // a friction row of body 1 on itself
+  s.rows[13].bodyA = -1;              // body 2's contact row on nothing but the world
+  s.rows[13].bodyB = -1;
+  const Problem p = s.assemble(true);
+  EXPECT_LE((s.assemble(false).denseA() - denseByHand(s)).lpNorm<Eigen::Infinity>(), 1e-12);
+  for (int sweeps : {3, 40}) {
+    RowPgs rowPgs;
+    rowPgs.options().maxIterations = sweeps;
+    rowPgs.options().tolerance = 1e-300;  // runs every sweep
+    Vector xr;
+    const Result rr = rowPgs.solve(s, xr);
+    PgsSolver pgs;
+    pgs.options() = rowPgs.options();
+    Vector xp;
+    pgs.solve(p, xp);
+    EXPECT_LE((xr - xp).lpNorm<Eigen::Infinity>(), 1e-10 * (1 + xp.lpNorm<Eigen::Infinity>()))
+        << sweeps;
+    const Accuracy a = accuracy(p, xr);
+    EXPECT_NEAR(rr.residual, a.residual, 1e-12 * (1 + a.residual)) << sweeps;
+  }
+}
+
 TEST(RowPgs, WarmStartFromTheAnswerStopsAtOnce) {
   const RowSystem s = stackRows(2, 3);
   RowPgs pgs;
