@@ -87,7 +87,8 @@ ProblemClass classify(const RowSystem& rows);
 // `auto`'s choice for an island of this class and size at this requested tolerance (scaled
 // residual):
 //   Empty                       -> "none"
-//   Linear                      -> "ldlt"     one sparse LDL^T solve: exact, analysis reused
+//   Linear                      -> "ldlt"     one LDL^T solve: exact (dense up to denseMaxRows
+//                                             rows, sparse above with its analysis reused)
 //   StandardLcp, Boxed, Findex  -> "dantzig"  exact pivoting answer (residual ~1e-12)
 //     except rows > kAutoPivotingRows at tolerance >= kAutoPgsTolerance -> "pgs"
 // and RowSolver adds one rule with memory: an island whose dantzig answer broke down (failed,
@@ -107,12 +108,16 @@ ProblemClass classify(const RowSystem& rows);
 //   hinge_motor_limits (Boxed)          both dantzig 0.003-0.04 ms 1e-15 | pgs 0.004-0.008 1e-6
 // Tiny joint islands against ODE's own solver over the same span (`mlcp run --solver ode-world`:
 // the same assembly into a kept problem, dxSolveLCP, the same residual check), solver time per
-// step, medians of 300 steps: hinge_motor_limits (6 rows) auto 1.45 us vs 0.63 us;
-// pendulum_chain (33 rows) auto ~10.5 us vs ~8 us. Per solve (callgrind, instructions):
-// hinge 13.4k, of which dantzig 8.9k, Solver's validation and check 1.7k, assembly 1.6k, the
-// rest 1.3k (ODE's whole solve: ~6.7k); pendulum 98.5k, of which ldlt 72.6k (Eigen's sparse
-// LDL^T with the symmetry check and storage conversions) and assembly 15.1k. What is left for
-// tiny islands is inside the solvers, not in this class.
+// step, medians of 300 steps (shared machine: ranges of repeated runs), and instructions per
+// solve (callgrind, the adapter's whole island solve):
+//   pendulum_chain (33 rows, ldlt)     auto 5.0-5.2 us, 55k | ode-world 5.8-6.2 us, 77k
+//     (ldlt's dense envelope LDL^T (ldlt.hpp) ~25k, assembly 15k, validation and check ~8k;
+//     before it: sparse LDL^T, 9.7 us and 99.8k)
+//   hinge_motor_limits (6 rows, dantzig) auto 1.3 us, 12.1k | ode-world 0.65-1.1 us, 6.7k
+//     (dantzig ~7.3k of which set-up ~2k and Eigen's triangular solves on 1..6-row blocks
+//     ~1.7k; assembly 1.4k; validation and check 1.2k; ODE's dxSolveLCP alone 2.8k)
+// Bullet, the same scenes against bullet-mlcp-dantzig: pendulum 8.2 vs 20 us, hinge 1.7 vs
+// 2.4 us. What is left on the 6-row island is inside dantzig's pivoting, not in this class.
 // The memory rule dates from Bullet's zero-CFM friction rows (bullet::CfmModel::Engine), on which
 // dantzig failed 29 of 30 steps of pyramid_15 (70 ms, residual 0.12): with the rule auto went
 // from 47 ms to 8.6 ms there. With the default Regularized model dantzig's answers are accepted
