@@ -118,7 +118,7 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     isl.start.resize(m);
     isl.splitB.resize(m);
     isl.splitStart.resize(m);
-    isl.frictionPoint.assign(m, nullptr);
+    isl.point.assign(m, nullptr);
     isl.hasSplit = false;
   }
 
@@ -163,20 +163,13 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
       start == Start::CachedImpulse && (info.m_solverMode & SOLVER_USE_WARMSTARTING) &&
       (info.m_solverMode & (SOLVER_ENABLE_FRICTION_DIRECTION_CACHING |
                             SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION));
-  // The start of friction row k (point: its contact's manifold point, not null): last step's
-  // friction impulse of the same point along the row's direction, else the cached impulse when
-  // the directions persist (its contact's first friction row is lateral 1), else none.
-  auto frictionStart = [&](const btSolverConstraint& f, int k, const btManifoldPoint& point,
-                           double& x) {
-    const auto last = lastFriction_.find(&point);
-    if (last != lastFriction_.end() && point.m_lifeTime > last->second.lifeTime &&
-        (point.m_localPointA - last->second.localA).length() < gContactBreakingThreshold) {
-      x = static_cast<double>(last->second.impulse.dot(frictionDirection(f)));
-    } else if (lateralCache) {
-      const bool first = k == (*in.contacts)[f.m_frictionIndex].m_frictionIndex;
-      x = static_cast<double>(first ? point.m_appliedImpulseLateral1
-                                    : point.m_appliedImpulseLateral2);
-    }
+  // Last step's answer at this manifold point, if it is the same point (see remember()).
+  auto remembered = [&](const btManifoldPoint& point) -> const Remembered* {
+    const auto last = last_.find(&point);
+    if (last == last_.end() ||
+        (point.m_localPointA - last->second.localA).length() >= gContactBreakingThreshold)
+      return nullptr;
+    return &last->second;
   };
   for (int i = 0; i < n; ++i) {
     if (rowIsland_[i] < 0) continue;
@@ -222,34 +215,44 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     }
     const double unscale = i >= nj ? unscaleContacts : 1.0;
     isl.start[r] = warm ? unscale * static_cast<double>(c.m_appliedImpulse) : 0.0;
-    if (i >= nj + nc && i < nj + nc + nf) {
+    if (i >= nj && i < nj + nc + nf) {  // a contact or friction row
+      const bool contact = i < nj + nc;
       const auto* point = static_cast<const btManifoldPoint*>(
-          (*in.contacts)[c.m_frictionIndex].m_originalContactPoint);
-      isl.frictionPoint[r] = point;
-      if (point && start == Start::CachedImpulse)
-        frictionStart(c, i - nj - nc, *point, isl.start[r]);
+          contact ? c.m_originalContactPoint
+                  : (*in.contacts)[c.m_frictionIndex].m_originalContactPoint);
+      isl.point[r] = point;
+      if (point && start == Start::CachedImpulse) {
+        if (const Remembered* last = remembered(*point)) {
+          isl.start[r] = contact ? last->normal : last->friction.dot(frictionDirection(c));
+        } else if (!contact && lateralCache) {
+          const bool first = i - nj - nc == (*in.contacts)[c.m_frictionIndex].m_frictionIndex;
+          isl.start[r] = first ? point->m_appliedImpulseLateral1 : point->m_appliedImpulseLateral2;
+        }
+      }
     }
     isl.splitStart[r] = warm ? static_cast<double>(c.m_appliedPushImpulse) : 0.0;
   }
 }
 
 void IslandBuilder::newStep() {
-  lastFriction_.swap(thisFriction_);
-  thisFriction_.clear();
+  last_.swap(this_);
+  this_.clear();
 }
 
 void IslandBuilder::remember(const Island& island, const Vector& x) {
-  for (int r = 0; r < static_cast<int>(island.frictionPoint.size()); ++r) {
-    const btManifoldPoint* point = island.frictionPoint[r];
+  for (int r = 0; r < static_cast<int>(island.point.size()); ++r) {
+    const btManifoldPoint* point = island.point[r];
     if (!point) continue;
-    auto [it, added] = thisFriction_.try_emplace(point);
-    Friction& f = it->second;
+    auto [it, added] = this_.try_emplace(point);
+    Remembered& m = it->second;
     if (added) {
-      f.impulse.setZero();
-      f.localA = point->m_localPointA;
-      f.lifeTime = point->m_lifeTime;
+      m.friction.setZero();
+      m.localA = point->m_localPointA;
     }
-    f.impulse += static_cast<btScalar>(x[r]) * frictionDirection(*island.rows[r]);
+    if (island.system.findex[r] < 0)
+      m.normal = x[r];
+    else
+      m.friction += static_cast<btScalar>(x[r]) * frictionDirection(*island.rows[r]);
   }
 }
 

@@ -29,19 +29,20 @@
 //     (Bullet's applied impulse divided by m_warmstartingFactor, 0.85: SI's setup has already
 //     applied the scaled impulse to the solver bodies, and the write-back below only applies
 //     the difference), or with Settings::siStart SI's own start (the applied impulse as it is),
-//     0 for joints (SI does not warm-start them). Bullet 3's setup starts friction rows at 0
-//     whatever the mode, so friction rows start from last step's friction impulse of the same
-//     manifold point (kept by IslandBuilder::remember as a world vector) along this step's
-//     direction: with Bullet's default velocity-dependent direction the directions change
-//     every step. Else, when directions persist (SOLVER_ENABLE_FRICTION_DIRECTION_CACHING or
-//     SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION), from the manifold point's
-//     m_appliedImpulseLateral1/2 (e.g. the first step after SI). Measured on bullet_bench's
-//     55-box pyramid (dantzig after 30 SI steps) it changes little: friction at rest is mostly
-//     strictly inside its bounds, which a start of 0 guesses too; the block stage's steps at
-//     rest went from 6-24 to 5-23 (CPU ms per island 21-70 to 19-67). What stays wrong in the
-//     start at rest (residual 0.06-0.12, 1-2 normals in the wrong set) are the 1-2 manifold
-//     points Bullet creates every step with no cached impulse. With the scene loader's flags
-//     the start's residual is 1.0-1.2 instead of 2.1-2.6.
+//     0 for joints (SI does not warm-start them). Contacts and friction then take our own last
+//     answer at the same manifold point where there is one (IslandBuilder::remember): Bullet 3
+//     starts friction rows at 0 whatever the mode, its default friction direction follows the
+//     sliding velocity and changes every step (friction starts at last step's friction impulse
+//     vector along the new direction), and it re-creates some points of a resting stack every
+//     step with no cached impulse. Without a remembered answer, friction rows start from the
+//     point's m_appliedImpulseLateral1/2 when the directions persist (direction caching, or
+//     directions not from the velocity). Measured (bullet_bench's 55-box pyramid, dantzig, 60
+//     steps after 30 SI steps): once the stack has come to rest under the exact answers (~30
+//     steps) the start's residual is 4e-5-1e-3 instead of 0.06-0.12 and the block stage settles
+//     in 3 steps (~15 ms CPU per island) instead of 6-24 (22-70 ms). The first ~20 steps after
+//     SI are unchanged: the stack moves from SI's approximate state to the exact answers'
+//     (answers change by 0.1-1 per step; start residual 0.2-0.7) and the block stage does not
+//     settle within its 40 steps.
 //  5. solve and 6. check — mlcp::RowSolver (mlcp/row_solver.hpp), shared with the ODE adapter:
 //     it classifies the island (bilateral only, frictionless contacts, boxed, friction), runs
 //     the named solver or `auto`'s choice ("pgs" on the rows, others on an assembled A, dense up

@@ -47,8 +47,9 @@ struct Island {
   Vector splitB;                          // b of the split-impulse problem (m_rhsPenetration)
   Vector splitStart;                      // applied push impulses
   bool hasSplit = false;                  // splitB has a non-zero entry
-  // Each friction row's manifold point (null for other rows), for IslandBuilder::remember.
-  std::vector<const btManifoldPoint*> frictionPoint;
+  // Each contact and friction row's manifold point (null for other rows), for
+  // IslandBuilder::remember.
+  std::vector<const btManifoldPoint*> point;
 };
 
 // The pools of one solveGroup call, as btSequentialImpulseConstraintSolver holds them.
@@ -65,14 +66,18 @@ class IslandBuilder {
   // Splits the rows into islands. globalCfm and timeStep feed CfmModel::StockMlcp and Regularized.
   void build(const BulletRows& rows, const btContactSolverInfo& info, CfmModel cfm, Start start);
 
-  // Friction warm start across steps. Bullet 3 starts friction rows at 0, and with its default
-  // velocity-dependent friction direction a row's direction changes every step, so last step's
-  // value per row means nothing. remember() keeps each manifold point's friction impulse as a
-  // world vector (sum of x_r times the row's direction); the next step's build() starts each
-  // friction row of the same point at that vector's component along its new direction. A point
-  // is "the same" when Bullet kept it (the pointer, a larger m_lifeTime, m_localPointA within
-  // gContactBreakingThreshold: a removed point's slot is refilled by another point or a new one
-  // with m_lifeTime 0). Call newStep() once per simulation step, before its build() calls.
+  // Warm start across steps from our own answers, per manifold point. Bullet 3 starts friction
+  // rows at 0, and with its default velocity-dependent friction direction a row's direction
+  // changes every step, so last step's value per row means nothing; and a point Bullet removes
+  // and re-creates at the same place (m_lifeTime 0, which happens every step to some points of
+  // a resting stack) has lost its cached normal impulse. remember() keeps each point's normal
+  // impulse and friction impulse (a world vector: the sum of x_r times the row's direction);
+  // the next step's build() starts the point's contact row at that normal impulse and its
+  // friction rows at the vector's components along their new directions. A point is "the
+  // same" when it sits in the same slot (pointer) with m_localPointA within
+  // gContactBreakingThreshold of the remembered one: Bullet's own rule for matching a new
+  // point to a cached one (a removed point's slot refilled by another point is farther away).
+  // Call newStep() once per simulation step, before its build() calls.
   void newStep();
   void remember(const Island& island, const Vector& x);
 
@@ -90,12 +95,12 @@ class IslandBuilder {
   std::vector<int> findex_, dynamic_, parent_, islandOfRoot_, rowIsland_, rowLocal_, bodyLocal_;
   std::vector<int> bodyCount_;
   std::vector<std::pair<int, int>> rowBodies_;  // each row's dynamic bodies (-1: none)
-  struct Friction {
-    btVector3 impulse;  // world-space friction impulse on body A
-    btVector3 localA;   // the point's m_localPointA when remembered
-    int lifeTime = 0;
+  struct Remembered {
+    double normal = 0;   // the contact row's impulse
+    btVector3 friction;  // world-space friction impulse on body A
+    btVector3 localA;    // the point's m_localPointA when remembered
   };
-  std::unordered_map<const btManifoldPoint*, Friction> lastFriction_, thisFriction_;
+  std::unordered_map<const btManifoldPoint*, Remembered> last_, this_;
 };
 
 }  // namespace mlcp::bullet
