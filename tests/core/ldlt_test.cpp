@@ -49,6 +49,31 @@ TEST(LdltDense, EnvelopeFactorMatchesTheSparsePath) {
   }
 }
 
+TEST(LdltSparse, NonSymmetricGoesToLuEveryTime) {
+  test::Generator g(5);
+  DenseMatrix A = chainMatrix(10, 3, g);
+  A(4, 1) += 0.5;  // one asymmetric entry inside the pattern
+  Vector b(A.rows());
+  for (int i = 0; i < b.size(); ++i) b[i] = g.uniform(-1, 1);
+  Problem p = linearProblem(A, b);
+  p.setA(p.toSparse());
+  LdltSolver solver;
+  Vector x;
+  for (int repeat = 0; repeat < 3; ++repeat) {
+    const Result r = solver.solve(p, x);
+    ASSERT_TRUE(r.converged()) << r.message;
+    EXPECT_EQ(r.message, "sparse LU solve");
+    EXPECT_LE(residual(p, x), 1e-13);
+  }
+  // Symmetric again: back to LDL^T.
+  Problem q = linearProblem(chainMatrix(10, 3, g), b);
+  q.setA(q.toSparse());
+  const Result r = solver.solve(q, x);
+  ASSERT_TRUE(r.converged()) << r.message;
+  EXPECT_EQ(r.message, "sparse LDL^T solve");
+  EXPECT_LE(residual(q, x), 1e-13);
+}
+
 TEST(LdltDense, ZeroLeadingPivotUsesThePivotingFactorization) {
   DenseMatrix A(3, 3);
   A << 0, 1, 0, 1, 0, 2, 0, 2, 1;  // symmetric, indefinite, A_00 = 0

@@ -23,10 +23,14 @@
 //   (isSymmetric's A - A^T alone 27k), Eigen's dense LDLT 82k (its unblocked factorization
 //   calls a gemv per column), the envelope path ~25k (factor 6.6k, two solves 7.2k, two
 //   products A x 4.8k, envelope scan 2.9k).
+//   The sparse path likewise tries LDL^T first and runs the exact symmetry check (A - A^T)
+//   only when the answer misses 1e-11 (a pattern found non-symmetric goes to the check and LU
+//   directly next time).
 //   Block-tridiagonal SPD chains (blocks of 3 and 5 rows), whole solve() with the base's checks,
-//   dense vs sparse: 33 rows 5.4 vs 10 us, 63 rows 13 vs 23 us, 126 rows 38 vs 39 us, 200 rows
-//   87-97 vs 68-108 us: dense wins to ~125 rows on a band and always on a full matrix, so
-//   RowSolver's 64-row limit leaves it margin.
+//   dense vs sparse (us, shared machine, ranges of 3 runs): 3-row blocks 33 rows 5.4-6.6 vs
+//   10-12, 63 rows 8-16 vs 9-17, 96 rows 16-34 vs 13-20, 198 rows 75 vs 43; 5-row blocks 60 rows
+//   9-12 vs 13-20, 125 rows 28-37 vs 28-39. Dense wins to 60-100 rows on a thin band, further on
+//   a wider one and always on a full matrix: RowSolver's 64-row limit sits at the crossover.
 #pragma once
 
 #include <memory>
