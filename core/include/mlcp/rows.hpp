@@ -89,11 +89,21 @@ class RowSystem {
 // of x, so v = M^-1 J^T x up to round-off and w = A x + b is exact up to round-off as well. The
 // check thus costs about a tenth of a sweep instead of a second pass over the rows to rebuild v
 // (tests compare it with accuracy() on the assembled problem).
-// Measured through the Bullet drop-in (bullet_bench --pgs-vs-si, 210-box pyramid, ~4250 rows,
-// CPU time per step): packing 0.20 ms (~45 ns a row: the 240-byte packed row is written to
-// memory the engine's other work has evicted), a sweep 0.053 ms (~12 ns a row; the sweep is
-// bound by the latency chain through the velocities of bodies shared by consecutive rows),
-// the check 0.055 ms.
+// The sweep is bound by the latency chain through the velocities of bodies shared by
+// consecutive rows (load v, dot, clamp, update v, store), not by memory. Three things keep the
+// chain short: ground rows take 8 zero-velocity world slots in turn (one shared slot chained
+// every ground row through its store and load), a run of consecutive rows on the same two
+// bodies (a contact's normal and friction rows in ODE's order) keeps their velocities in
+// registers, and the velocity change is clamped on its own (below).
+// Measured through the Bullet drop-in (bullet_bench --pgs-vs-si, 210-box pyramid, 4720 rows,
+// 10 sweeps): before this session's changes packing 0.20 ms, a sweep 0.053 ms (~11 ns a row),
+// the check 0.055 ms. Packing then lost a quarter of its time to store-forwarding stalls
+// (Eigen's M^-1 J^T temporary read back from the stack; now computed in scalars): perf samples
+// against the unchanged collision work say packing is ~30% cheaper since (~0.14 ms); of
+// RowPgs' samples the sweeps are now ~68%, packing ~18%, the check (slackFromVelocities and
+// accuracy) ~9%. The Bullet sweeps did not get measurably faster from the runs (perf share, noisy;
+// Bullet orders a manifold's normals, then its friction rows), ODE's did (ode_pgs_bench, 108 rows:
+// solve 46-48 us -> 31-42 us on a loaded machine).
 class RowPgs {
  public:
   Options& options() { return options_; }
@@ -109,6 +119,9 @@ class RowPgs {
   // shift = step b_i: only the product with v depends on the rows just visited, so the row's
   // latency chain (load v, dot, clamp, update v) holds one subtraction instead of a
   // multiplication and three additions (sweeps ~20% faster; the same iterates up to round-off).
+  // The change moving v is clamped apart, dx = clamp((c - x_i) - J v', lo - x_i, hi - x_i) with
+  // c = keep x_i - shift, while x_i itself becomes clamp(c - J v', lo, hi): the chain does not
+  // wait for x_new - x_i, v and x agree up to round-off, and x stays exactly within its bounds.
   struct PackedRow {
     Vector6 sA, sB;  // step * J
     Vector6 mA, mB;  // M^-1 J^T
