@@ -15,8 +15,13 @@
 // globalCfm is 1e-5 (what Bullet's demos use with direct solvers; with 0 a box face's four
 // contact points make A singular). A configuration whose step is predicted (n^3 from the
 // previous size for pivoting methods) or measured to take more than 1 s is skipped.
+// --settle N runs N untimed steps with the configuration's own solver between the switch and
+// the timed steps: by default (0) the timed steps are the pyramid moving from SI's approximate
+// answers to the solver's own (exact solvers move it for ~40 steps, which no warm start helps);
+// with --settle 60 they are the pyramid at rest under that solver, the steady state of a demo.
+// The README reports both.
 //
-//   bullet_bench [--steps N] [--warmup N] [--sizes 15,55,210] [--csv file]
+//   bullet_bench [--steps N] [--warmup N] [--settle N] [--sizes 15,55,210] [--csv file]
 //   bullet_bench --pgs-vs-si [--sweeps 10,50] [--steps N]   (ours pgs / SI, stepped alternately)
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -79,7 +84,7 @@ struct Row {
   std::string note;
 };
 
-Row run(const Config& cfg, int boxes, int warmup, int steps) {
+Row run(const Config& cfg, int boxes, int warmup, int settle, int steps) {
   sc::World w;
   w.info().m_globalCfm = 1e-5;
   sc::pyramid(w, boxes);
@@ -97,6 +102,10 @@ Row run(const Config& cfg, int boxes, int warmup, int steps) {
   auto* timed = static_cast<Timed*>(w.solver());
   auto* ours = dynamic_cast<mlcp::bullet::ConstraintSolver*>(timed->inner());
   auto* stock = dynamic_cast<sc::StockMlcp*>(timed->inner());
+  w.step(settle);  // untimed: the pyramid comes to rest under this solver
+  const double seconds0 = timed->seconds, cpu0 = timed->cpuSeconds;
+  const mlcp::bullet::StepStats totals0 = ours ? ours->totals() : mlcp::bullet::StepStats();
+  const int stockFallbacks0 = stock ? stock->fallbacks() : 0;
 
   Row row;
   double measure = 0, worst = 0;
@@ -122,16 +131,16 @@ Row run(const Config& cfg, int boxes, int warmup, int steps) {
       break;
     }
   }
-  row.ms = (timed->seconds - measure) * 1e3 / done;
-  row.cpuMs = (timed->cpuSeconds - measure) * 1e3 / done;
+  row.ms = (timed->seconds - seconds0 - measure) * 1e3 / done;
+  row.cpuMs = (timed->cpuSeconds - cpu0 - measure) * 1e3 / done;
   row.residual = worst;
   row.iterations /= done;
   if (ours) {
-    row.fallbacks = ours->totals().fallbacks;
-    row.assembleMs = ours->totals().assembleSeconds * 1e3 / done;
-    row.solveMs = ours->totals().seconds * 1e3 / done;
+    row.fallbacks = ours->totals().fallbacks - totals0.fallbacks;
+    row.assembleMs = (ours->totals().assembleSeconds - totals0.assembleSeconds) * 1e3 / done;
+    row.solveMs = (ours->totals().seconds - totals0.seconds) * 1e3 / done;
   }
-  if (stock) row.fallbacks = stock->fallbacks();
+  if (stock) row.fallbacks = stock->fallbacks() - stockFallbacks0;
   return row;
 }
 
@@ -230,10 +239,12 @@ std::vector<int> parseSizes(const std::string& s) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Per-step solver time and residual: our solvers vs Bullet's, on box pyramids."};
-  int steps = 20, warmup = 30;
+  int steps = 20, warmup = 30, settle = 0;
   std::string sizes = "15,55,210", csvPath, only;
   app.add_option("--steps", steps, "timed steps per configuration")->capture_default_str();
   app.add_option("--warmup", warmup, "SI steps before timing")->capture_default_str();
+  app.add_option("--settle", settle, "untimed steps of each configuration's own solver")
+      ->capture_default_str();
   app.add_option("--sizes", sizes, "pyramid sizes (triangular numbers)")->capture_default_str();
   app.add_option("--csv", csvPath, "also write the table as CSV");
   app.add_option("--only", only, "run only configurations whose label contains this");
@@ -283,9 +294,9 @@ int main(int argc, char** argv) {
     std::map<std::string, Row> rows;
     int n = 0;
     std::printf(
-        "\npyramid of %d boxes (%d warm-up SI steps, %d timed steps, dt 1/60, "
-        "10 iterations, globalCfm 1e-5)\n",
-        boxes, warmup, steps);
+        "\npyramid of %d boxes (%d warm-up SI steps, %d untimed own steps, %d timed steps, "
+        "dt 1/60, 10 iterations, globalCfm 1e-5)\n",
+        boxes, warmup, settle, steps);
     std::printf("%-22s %10s %10s %12s %10s %10s %12s %10s  %s\n", "solver", "ms/step", "solve ms",
                 "residual", "fallbacks", "iter/step", "assemble ms", "cpu ms", "note");
     for (const Config& c : configs) {
@@ -303,7 +314,7 @@ int main(int argc, char** argv) {
         std::snprintf(buf, sizeof buf, "skipped: predicted %.0f s/step (> 1 s)", predicted);
         r.note = buf;
       } else {
-        r = run(c, boxes, warmup, steps);
+        r = run(c, boxes, warmup, settle, steps);
       }
       if (r.rows > 0) n = r.rows;
       previous[c.label] = {std::max(n, 1),
