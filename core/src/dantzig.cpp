@@ -27,6 +27,10 @@ bool isEquality(double lo, double hi) { return lo == -kInf && hi == kInf; }
 // Largest residual (residual.hpp) of a guess whose friction values set the first pass's bounds.
 constexpr double kTrustedGuess = 1e-2;
 
+// Sizes (rows of a product or of the clamped block) up to which plain loops beat Eigen's
+// vectorized kernels: islands of a few joints.
+constexpr int kSmall = 8;
+
 }  // namespace
 
 struct DantzigSolver::Workspace {
@@ -69,9 +73,14 @@ struct DantzigSolver::Workspace {
     return (symmetric ? dense : denseT).data() + size_t(i) * n;
   }
   double rowDot(int i, const std::vector<double>& v, int len) const {
-    if (!sparse)
-      return Eigen::Map<const Vector>(denseRow(i), len)
-          .dot(Eigen::Map<const Vector>(v.data(), len));
+    if (!sparse) {
+      const double* row = denseRow(i);
+      if (len > kSmall)
+        return Eigen::Map<const Vector>(row, len).dot(Eigen::Map<const Vector>(v.data(), len));
+      double s = 0;
+      for (int k = 0; k < len; ++k) s += row[k] * v[k];
+      return s;
+    }
     double s = 0;
     for (int k = rowPtr[i]; k < rowPtr[i + 1]; ++k) s += rowVal[k] * v[rowIdx[k]];
     return s;
@@ -109,15 +118,36 @@ struct DantzigSolver::Workspace {
   Strided lower(std::vector<double>& f) { return Strided(f.data(), m, m, Eigen::OuterStride<>(n)); }
   std::vector<double>& upperT() { return symmetric ? L : Ut; }
   // y <- L^{-1} y ./ D  (the new column of U for an entering index, given A_Cj in y).
+  // Up to kSmall rows, plain loops: Eigen's blocked solves cost more in set-up than in flops
+  // there (the column-wise forward loop is Eigen's own order, so the same round-off).
   void forward(std::vector<double>& f, std::vector<double>& y) {
     if (m == 0) return;
-    lower(f).triangularView<Eigen::UnitLower>().solveInPlace(vmap(y, m));
-    vmap(y, m).array() /= vmap(D, m).array();
+    if (m > kSmall) {
+      lower(f).triangularView<Eigen::UnitLower>().solveInPlace(vmap(y, m));
+    } else {
+      for (int k = 0; k < m; ++k) {
+        const double yk = y[k];
+        if (yk == 0) continue;
+        const double* col = f.data() + size_t(k) * n;
+        for (int i = k + 1; i < m; ++i) y[i] -= yk * col[i];
+      }
+    }
+    for (int c = 0; c < m; ++c) y[c] /= D[c];
   }
   // y <- U^{-1} y.
   void backward(std::vector<double>& y) {
     if (m == 0) return;
-    lower(upperT()).triangularView<Eigen::UnitLower>().transpose().solveInPlace(vmap(y, m));
+    if (m > kSmall) {
+      lower(upperT()).triangularView<Eigen::UnitLower>().transpose().solveInPlace(vmap(y, m));
+      return;
+    }
+    const double* f = upperT().data();
+    for (int i = m - 2; i >= 0; --i) {
+      const double* col = f + size_t(i) * n;
+      double s = 0;
+      for (int k = i + 1; k < m; ++k) s += col[k] * y[k];
+      y[i] -= s;
+    }
   }
   // y <- A_CC^{-1} y.
   void solveCC(std::vector<double>& y) {
@@ -265,9 +295,12 @@ void DantzigSolver::Workspace::build(const Problem& pb, const Vector& guess, boo
     inv[i] = p;
   }
 
-  // resize + fill inline: the out-of-line assign() of twenty vectors was a tenth of a 6-row solve.
-  for (std::vector<double>* v : {&diag, &b, &lo, &hi, &muLo,   &muHi, &x,  &w,  &xStart, &a,
-                                 &r,    &u, &l,  &z,  &dxFull, &dwN,  &xs, &ys, &D,      &normal}) {
+  // Only dxFull (kept zero between steps), w, normal and diag (a sparse row may lack its
+  // diagonal) are read before they are written.
+  for (std::vector<double>* v :
+       {&b, &lo, &hi, &muLo, &muHi, &x, &xStart, &a, &r, &u, &l, &z, &dwN, &xs, &ys, &D})
+    v->resize(n);
+  for (std::vector<double>* v : {&w, &dxFull, &normal, &diag}) {
     v->resize(n);
     std::fill(v->begin(), v->end(), 0.0);
   }
@@ -322,10 +355,16 @@ void DantzigSolver::Workspace::buildDense(const Problem& pb) {
     for (int i = j + 1; i < n; ++i) asym = std::max(asym, std::abs(A(i, j) - A(j, i)));
   symmetric = asym <= 1e-14 * aMax;
   dense.resize(size_t(n) * n);
-  for (int q = 0; q < n; ++q) {
-    const double* src = A.data() + size_t(perm[q]) * n;
-    double* dst = dense.data() + size_t(q) * n;
-    for (int p = 0; p < n; ++p) dst[p] = src[perm[p]];
+  bool identity = true;  // the usual case of a joint island: equality rows come first
+  for (int p = 0; p < n && identity; ++p) identity = perm[p] == p;
+  if (identity) {
+    std::memcpy(dense.data(), A.data(), sizeof(double) * size_t(n) * n);
+  } else {
+    for (int q = 0; q < n; ++q) {
+      const double* src = A.data() + size_t(perm[q]) * n;
+      double* dst = dense.data() + size_t(q) * n;
+      for (int p = 0; p < n; ++p) dst[p] = src[perm[p]];
+    }
   }
   if (!symmetric) {
     denseT.resize(size_t(n) * n);
