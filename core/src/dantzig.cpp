@@ -250,6 +250,12 @@ struct DantzigSolver::Workspace {
   Outcome pass(bool fixedOnce, bool reuseFactors);
   bool bulk(bool reuseFactors);
   Outcome finish();
+  // x_C -= A_CC^{-1} (b + A x)_C: the clamped rows' residual made zero with the factors.
+  void solveClamped() {
+    for (int c = 0; c < m; ++c) a[c] = b[C[c]] + rowDot(C[c], x, n);
+    solveCC(a);
+    for (int c = 0; c < m; ++c) x[C[c]] -= a[c];
+  }
   void freshW() {
     for (int p = 0; p < n; ++p) w[p] = b[p] + rowDot(p, x, n);
   }
@@ -592,9 +598,7 @@ bool DantzigSolver::Workspace::bulk(bool reuseFactors) {
   }
   for (int c = 0; c < m; ++c) span = std::max(span, C[c] + 1);
   while (m > 0) {
-    for (int c = 0; c < m; ++c) a[c] = b[C[c]] + rowDot(C[c], x, n);
-    solveCC(a);
-    for (int c = 0; c < m; ++c) x[C[c]] -= a[c];
+    solveClamped();
     violators.clear();
     for (int c = 0; c < m; ++c)
       if (x[C[c]] < lo[C[c]] || x[C[c]] > hi[C[c]]) violators.push_back(c);
@@ -652,13 +656,8 @@ Outcome DantzigSolver::Workspace::pass(bool fixedOnce, bool reuseFactors) {
 // drifted are driven again (at most a few rounds).
 Outcome DantzigSolver::Workspace::finish() {
   for (int round = 0; round < 3; ++round) {
+    solveClamped();
     freshW();
-    if (m > 0) {
-      for (int c = 0; c < m; ++c) a[c] = w[C[c]];
-      solveCC(a);
-      for (int c = 0; c < m; ++c) x[C[c]] -= a[c];
-      freshW();
-    }
     violators.clear();
     for (int p : N) {
       const bool bad = (set[p] == Set::AtLo && w[p] < -epsW) ||
