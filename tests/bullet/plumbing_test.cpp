@@ -442,3 +442,38 @@ TEST(BulletPlumbing, FrictionStartIsLastStepsFrictionImpulseAlongTheNewDirection
 TEST(BulletPlumbing, FrictionStartIsLastStepsFrictionImpulseWhenDirectionsPersist) {
   frictionStartsFromLastStep(true);
 }
+
+// Nothing remembered yet (the first step after stock SI): with persistent friction directions the
+// friction rows start from the impulses SI wrote back to the manifold points
+// (m_appliedImpulseLateral1/2), i.e. from SI's own last friction answer row by row.
+TEST(BulletPlumbing, FirstStepAfterSiStartsFrictionFromTheCachedLateralImpulses) {
+  sc::World w(1.0 / 60.0, true);
+  w.info().m_solverMode |= SOLVER_ENABLE_FRICTION_DIRECTION_CACHING |
+                           SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION;
+  sc::incline(w, 0.3, 0.8);
+  Settings si;
+  si.solver = "si";
+  si.keepIslands = true;
+  w.setSolver(std::make_unique<ConstraintSolver>(si));
+  w.step(30);
+  const auto* stock = static_cast<const ConstraintSolver*>(w.solver());
+  ASSERT_EQ(stock->islands().size(), 1u);
+  const mlcp::bullet::IslandRecord last = stock->islands()[0];  // SI's answer of step 30
+
+  Settings s;
+  s.solver = "dantzig";
+  s.keepIslands = true;
+  w.setSolver(std::make_unique<ConstraintSolver>(s));
+  const auto* mine = static_cast<const ConstraintSolver*>(w.solver());
+  w.step();
+  ASSERT_EQ(mine->islands().size(), 1u);
+  const mlcp::bullet::IslandRecord& rec = mine->islands()[0];
+  ASSERT_EQ(rec.start.size(), last.x.size());
+  int compared = 0;
+  for (Eigen::Index i = 0; i < rec.start.size(); ++i) {
+    if (rec.system.findex[i] < 0) continue;
+    EXPECT_NEAR(rec.start[i], last.x[i], 1e-9 * (1 + std::abs(last.x[i]))) << "row " << i;
+    compared += std::abs(last.x[i]) > 1e-3;
+  }
+  EXPECT_GT(compared, 0);
+}
