@@ -21,21 +21,37 @@
 // start, impulses and integration) plus the step's own (ODE's island search and arena).
 // QuickStep cannot be split from outside.
 //
-// Accuracy. Ours: the scaled natural-map residual (mlcp::accuracy) of every island's answer,
-// worst over the steps. QuickStep's residual cannot be measured from outside: its lambda lives in
-// the step's arena and is not returned, and joint feedback gives J^T lambda summed per body,
-// which would have to be inverted on rows in QuickStep's internal order. Both methods are
-// therefore also compared by the velocity error after the step: max over bodies and components
-// of |v - v_ref| (m/s, rad/s) against the converged reference from the same state (g h = 0.098
-// m/s for scale). It is the error of the constraint impulses as the bodies feel it.
+// Accuracy, on the very MLCP our stepper builds (StepperOptions::keepProblems: the rows,
+// right-hand side, bounds and findex RowPgs received) and by the one function that measures
+// every answer (mlcp::accuracy on rows.assemble(), the scaled natural-map residual), worst over
+// islands per step, then worst and median over the timed steps:
+//   - ours: the applied lambda (recomputed; "recheck" is its largest difference from what
+//     IslandStats::residual reported, the sanity check of the kept problem);
+//   - QuickStep: its lambda recovered from joint feedback (tests/ode/feedback_lambda.hpp).
+//     ODE does not return QuickStep's multipliers, but stage 4b writes f1 t1 f2 t2 = J^T lambda
+//     per joint with the J copied before the SOR scales it, lambda in force units as ours (its
+//     rhs and cfm are dxStepIsland's: c/h - J (M^-1 f_ext + v/h), cfm/h). A fourth pile, set
+//     to the same state, is stepped by dWorldQuickStep with a feedback on every contact and
+//     ODE's random generator reset to the seed the timed QuickStep started from (QuickStep
+//     shuffles its rows with dRandInt every 8th sweep): its step must end bitwise in the timed
+//     pile's state, or the bench stops. Joint k of that pile is the contact joint k of ours
+//     (dCollide is deterministic; position, normal, depth and bodies are compared, or the bench
+//     stops); per joint, lambda is the least-squares solution of J_k^T lambda = feedback on
+//     our rows of that joint ("fit": the largest scaled misfit, ~1e-16 when exact).
+// The velocity error after the step is kept too: max over bodies and components of
+// |v - v_ref| (m/s, rad/s) against the converged reference from the same state (g h = 0.098
+// m/s for scale), the error of the constraint impulses as the bodies feel it.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <unordered_map>
 #include <vector>
 
 #include "mlcp/ode/stepper.hpp"
+#include "mlcp/residual.hpp"
+#include "ode/feedback_lambda.hpp"
 #include "ode/ode_scenes.hpp"
 
 using namespace mlcp::ode;
@@ -54,6 +70,55 @@ double median(std::vector<double> v) {
   return v.empty() ? NAN : v[v.size() / 2];
 }
 
+double worst(const std::vector<double>& v) {
+  double w = 0;
+  for (double x : v) w = std::max(w, x);
+  return w;
+}
+
+[[noreturn]] void fail(const char* what, int base, int step) {
+  std::fprintf(stderr, "ode_pgs_bench: base %d, step %d: %s\n", base, step, what);
+  std::exit(1);
+}
+
+struct Residuals {
+  double quick = 0, ours = 0;  // worst over the step's islands
+  double recheck = 0, fit = 0;
+};
+
+// QuickStep's lambda (from `probe`'s contact feedback) and ours on every island problem our
+// stepper kept this step (see the header comment).
+Residuals residuals(const Stepper& pgs, const Scene& ours, const Scene& probe, int base, int step) {
+  const auto &oc = ours.contactRecords(), &pc = probe.contactRecords();
+  if (oc.size() != pc.size()) fail("the piles have different contacts", base, step);
+  std::unordered_map<dJointID, std::size_t> contactOf;
+  for (std::size_t k = 0; k < oc.size(); ++k) {
+    const dContactGeom &a = oc[k].geom, &b = pc[k].geom;
+    bool same = a.depth == b.depth && oc[k].body0 == pc[k].body0 && oc[k].body1 == pc[k].body1;
+    for (int d = 0; d < 3; ++d) same = same && a.pos[d] == b.pos[d] && a.normal[d] == b.normal[d];
+    if (!same) fail("contact k differs between the piles", base, step);
+    contactOf[oc[k].joint] = k;
+  }
+  Residuals r;
+  for (const IslandProblem& p : pgs.lastProblems()) {
+    mlcp::Vector quick = mlcp::Vector::Constant(p.rows.size(), NAN);
+    for (const IslandProblem::JointRange& j : p.joints) {
+      const auto it = contactOf.find(j.joint);
+      if (it == contactOf.end()) fail("a joint that is not a recorded contact", base, step);
+      r.fit = std::max(
+          r.fit, lambdaFromFeedback(p.rows, j.first, j.count, *pc[it->second].feedback, quick));
+    }
+    if (!quick.allFinite()) fail("rows without a recovered lambda", base, step);
+    const mlcp::Problem problem = p.rows.assemble(true);
+    const double ourResidual = mlcp::accuracy(problem, p.lambda).residual;
+    r.ours = std::max(r.ours, ourResidual);
+    r.quick = std::max(r.quick, mlcp::accuracy(problem, quick).residual);
+    r.recheck =
+        std::max(r.recheck, std::abs(ourResidual - pgs.lastStep().islands.at(p.island).residual));
+  }
+  return r;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -66,13 +131,19 @@ int main(int argc, char** argv) {
 
   std::printf(
       "| base | rows | sweeps | QuickStep ms | ours pgs ms | pgs / QuickStep | QuickStep max |dv| "
-      "| pgs max |dv| | pgs residual | reference residual | ours: solve ms | ours: rest ms "
-      "|\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+      "| pgs max |dv| | QuickStep residual worst (median) | pgs residual worst (median) "
+      "| reference residual | ours: solve ms | ours: rest ms | fit | recheck |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (int base : {3, 6, 12}) {
     if (only > 0 && base != only) continue;
-    auto ref = boxPyramid(base), quick = boxPyramid(base), ours = boxPyramid(base);
-    dWorldSetQuickStepNumIterations(quick->world, sweeps);
-    dWorldSetQuickStepW(quick->world, 1.3);
+    auto ref = boxPyramid(base), quick = boxPyramid(base), probe = boxPyramid(base),
+         ours = boxPyramid(base);
+    for (Scene* s : {quick.get(), probe.get()}) {
+      dWorldSetQuickStepNumIterations(s->world, sweeps);
+      dWorldSetQuickStepW(s->world, 1.3);
+    }
+    probe->recordContacts = probe->contactFeedback = true;
+    ours->recordContacts = true;
 
     StepperOptions tight;
     tight.solver.maxIterations = referenceSweeps;
@@ -87,17 +158,20 @@ int main(int argc, char** argv) {
     fixed.solver.checkEvery = sweeps;
     fixed.solver.tolerance = 0;
     fixed.fallback = "";
+    fixed.keepProblems = true;  // swapped out, not copied: no measurable cost (stepper.hpp)
     Stepper pgs("pgs", fixed);
 
     auto stepRef = [&](dWorldID w, dReal dt) { reference.step(w, dt); };
     for (int k = 0; k < warmup; ++k) ref->step(stepRef, h);
 
-    std::vector<double> tQuick, tPgs, tSolve, tRest;
-    double dvQuick = 0, dvPgs = 0, resPgs = 0, resRef = 0;
+    std::vector<double> tQuick, tPgs, tSolve, tRest, resQuick, resPgs;
+    double dvQuick = 0, dvPgs = 0, resRef = 0, fit = 0, recheck = 0;
     int rows = 0;
     for (int k = 0; k < steps; ++k) {
       copyState(*ref, *quick);
+      copyState(*ref, *probe);
       copyState(*ref, *ours);
+      const unsigned long seed = dRandGetSeed();
       quick->step(
           [&](dWorldID w, dReal dt) {
             const double t0 = cpuNow();
@@ -105,6 +179,10 @@ int main(int argc, char** argv) {
             tQuick.push_back(1e3 * (cpuNow() - t0));
           },
           h);
+      dRandSetSeed(seed);
+      probe->step([](dWorldID w, dReal dt) { dWorldQuickStep(w, dt); }, h);
+      if (quick->state() != probe->state())
+        fail("QuickStep with feedback did not repeat the timed step", base, k);
       ours->step(
           [&](dWorldID w, dReal dt) {
             const double t0 = cpuNow();
@@ -116,17 +194,23 @@ int main(int argc, char** argv) {
             tRest.push_back(1e3 * (pgs.lastStep().seconds - solve));
           },
           h);
+      const Residuals r = residuals(pgs, *ours, *probe, base, k);
+      resQuick.push_back(r.quick);
+      resPgs.push_back(r.ours);
+      fit = std::max(fit, r.fit);
+      recheck = std::max(recheck, r.recheck);
       ref->step(stepRef, h);
       dvQuick = std::max(dvQuick, velocityDifference(*quick, *ref));
       dvPgs = std::max(dvPgs, velocityDifference(*ours, *ref));
-      resPgs = std::max(resPgs, pgs.lastStep().maxResidual());
       resRef = std::max(resRef, reference.lastStep().maxResidual());
       rows = pgs.lastStep().rows();
     }
     const double q = median(tQuick), p = median(tPgs);
     std::printf(
-        "| %d | %d | %d | %.3f | %.3f | %.2fx | %.2e | %.2e | %.2e | %.1e | %.3f | %.3f |\n", base,
-        rows, sweeps, q, p, p / q, dvQuick, dvPgs, resPgs, resRef, median(tSolve), median(tRest));
+        "| %d | %d | %d | %.3f | %.3f | %.2fx | %.2e | %.2e | %.2e (%.2e) | %.2e (%.2e) | %.1e "
+        "| %.3f | %.3f | %.0e | %.0e |\n",
+        base, rows, sweeps, q, p, p / q, dvQuick, dvPgs, worst(resQuick), median(resQuick),
+        worst(resPgs), median(resPgs), resRef, median(tSolve), median(tRest), fit, recheck);
     std::fflush(stdout);
   }
   return 0;

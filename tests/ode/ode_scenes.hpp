@@ -88,11 +88,28 @@ class Scene {
   // Collide, step, drop the contacts: one frame of an ODE program.
   void step(const StepFn& stepFn, dReal h) {
     lastContacts_ = 0;
+    contactRecords_.clear();
     dSpaceCollide(space, this, &Scene::nearCallback);
     stepFn(world, h);
     dJointGroupEmpty(contacts);
   }
   int lastContacts() const { return lastContacts_; }
+
+  // This step's contact joints in creation order (dCollide's, deterministic), kept while
+  // recordContacts is set, each with a dJointFeedback when contactFeedback is set too: the
+  // benchmark matches contacts across identically built piles and reads their forces.
+  struct ContactRecord {
+    dJointID joint;
+    dContactGeom geom;
+    int body0, body1;          // indices in `bodies` of the joint's two bodies, -1 for none
+    dJointFeedback* feedback;  // null unless contactFeedback
+  };
+  bool recordContacts = false, contactFeedback = false;
+  const std::vector<ContactRecord>& contactRecords() const { return contactRecords_; }
+  int bodyIndex(dBodyID b) const {
+    const auto it = std::find(bodies.begin(), bodies.end(), b);
+    return b && it != bodies.end() ? static_cast<int>(it - bodies.begin()) : -1;
+  }
 
   // Position, quaternion, linear and angular velocity of every body, in body order.
   std::vector<double> state() const {
@@ -140,10 +157,25 @@ class Scene {
       for (int k = 0; k < 3; ++k) c[i].fdir1[k] = s->surface.fdir1[k];
       dJointID j = dJointCreateContact(s->world, s->contacts, &c[i]);
       dJointAttach(j, ba, bb);
+      if (s->recordContacts) s->record(j, c[i].geom);
     }
     s->lastContacts_ += n;
   }
+  void record(dJointID j, const dContactGeom& geom) {
+    dJointFeedback* fb = nullptr;
+    if (contactFeedback) {
+      // One feedback per contact slot, reused every step.
+      if (contactRecords_.size() == contactFeedbacks_.size())
+        contactFeedbacks_.push_back(std::make_unique<dJointFeedback>());
+      fb = contactFeedbacks_[contactRecords_.size()].get();
+      dJointSetFeedback(j, fb);
+    }
+    contactRecords_.push_back(
+        {j, geom, bodyIndex(dJointGetBody(j, 0)), bodyIndex(dJointGetBody(j, 1)), fb});
+  }
   int lastContacts_ = 0;
+  std::vector<ContactRecord> contactRecords_;
+  std::vector<std::unique_ptr<dJointFeedback>> contactFeedbacks_;
 };
 
 // --- the scenes ---------------------------------------------------------------------------------

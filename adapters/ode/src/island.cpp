@@ -520,5 +520,6 @@ void mlcp::ode::Stepper::Impl::runIsland(const dxStepperProcessingCallContext* c
   // Stage 6: store impulses and integrate.
   storeImpulses(body, nb, w, w.x, h, w.bodyTmp);
   st.islandSeconds = nowSeconds() - t0;
+  if (options.keepProblems && m > 0) keepProblem(w, static_cast<int>(stats.islands.size()));
   stats.islands.push_back(std::move(st));
 }

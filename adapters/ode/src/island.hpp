@@ -103,6 +103,9 @@ struct mlcp::ode::Stepper::Impl {
   StepStats stats;
   WarmStartCache warm;
   IslandWork work;
+  // StepperOptions::keepProblems: this step's islands, and last step's entries whose buffers
+  // the island workspace takes in turn.
+  std::vector<IslandProblem> problems, spareProblems;
   std::mutex mutex;  // islands may run on ODE's worker threads
 
   // dstepper_fn_t and dmemestimate_fn_t: they find the Impl of the world being stepped.
@@ -112,5 +115,7 @@ struct mlcp::ode::Stepper::Impl {
   static unsigned estimateMaxCallCount(unsigned activeThreads, unsigned allowedThreads);
 
   void runIsland(const dxStepperProcessingCallContext* context);
+  // Swaps the island's rows and answer into a kept IslandProblem (after integration).
+  void keepProblem(IslandWork& w, int island);
   sizeint memoryFor(dxBody* const* body, unsigned nb, dxJoint* const* joint, unsigned nj) const;
 };

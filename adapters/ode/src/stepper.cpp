@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <iterator>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -127,6 +128,7 @@ const std::string& Stepper::solverName() const { return impl_->name; }
 const StepperOptions& Stepper::options() const { return impl_->options; }
 mlcp::Options& Stepper::solverOptions() { return impl_->options.solver; }
 const StepStats& Stepper::lastStep() const { return impl_->stats; }
+const std::vector<IslandProblem>& Stepper::lastProblems() const { return impl_->problems; }
 void Stepper::resetWarmStart() { impl_->warm.clear(); }
 RowSolver* Stepper::rowSolver() { return impl_->primary.solver.get(); }
 
@@ -135,6 +137,12 @@ bool Stepper::step(dWorldID world, dReal h) {
   if (!(h > 0)) throw std::invalid_argument("mlcp::ode::Stepper::step: step size must be > 0");
   const double t0 = nowSeconds();
   impl_->stats.islands.clear();
+  if (!impl_->problems.empty()) {
+    // Reversed, so that island k takes last step's island k's buffers (sizes match).
+    auto& spare = impl_->spareProblems;
+    std::move(impl_->problems.rbegin(), impl_->problems.rend(), std::back_inserter(spare));
+    impl_->problems.clear();
+  }
   ActiveScope scope(world, impl_.get());
   // dWorldStep's two calls, with our estimator and island stepper.
   dxWorldProcessIslandsInfo islands;
@@ -147,6 +155,18 @@ bool Stepper::step(dWorldID world, dReal h) {
 
 void Stepper::Impl::stepIsland(const dxStepperProcessingCallContext* context) {
   activeStepper(context->m_world)->runIsland(context);
+}
+
+void Stepper::Impl::keepProblem(IslandWork& w, int island) {
+  if (spareProblems.empty()) spareProblems.emplace_back();
+  problems.push_back(std::move(spareProblems.back()));
+  spareProblems.pop_back();
+  IslandProblem& kept = problems.back();
+  kept.island = island;
+  std::swap(kept.rows, w.rows);
+  kept.lambda.swap(w.x);
+  kept.joints.clear();
+  for (const JointRows& jr : w.joints) kept.joints.push_back({jr.joint, jr.offset, jr.m});
 }
 
 sizeint Stepper::Impl::estimateMemory(dxBody* const* body, unsigned nb, dxJoint* const* joint,

@@ -51,6 +51,7 @@
 
 #include "mlcp/result.hpp"
 #include "mlcp/row_solver.hpp"
+#include "mlcp/rows.hpp"
 
 namespace mlcp::ode {
 
@@ -82,6 +83,14 @@ struct StepperOptions {
   // on the same island problem after the primary; its residual and time go to IslandStats,
   // its answer is discarded. "" for none. Default "".
   std::string reference;
+  // Diagnostics: keep each island's problem of the last step as the solver received it, with
+  // the answer applied (Stepper::lastProblems), e.g. to measure another solver's lambda on the
+  // very same MLCP. The rows are swapped out of the island workspace after integration, not
+  // copied (the workspace takes the buffers kept two steps ago, of the same sizes on a steady
+  // scene): the cost is a few pointer swaps and a copy of the joint list per island, and the
+  // trajectory is bitwise the one with the option off. Nothing is kept for the forwarding
+  // solvers ("ode-step", "ode-quickstep"). Default false.
+  bool keepProblems = false;
 };
 
 struct IslandStats {
@@ -106,6 +115,26 @@ struct IslandStats {
   // applied one, relative to the largest constraint force.
   double referenceDifference = kNotComputed;
   double referenceSeconds = 0;
+};
+
+// One island's problem as the solver received it (StepperOptions::keepProblems).
+struct IslandProblem {
+  int island = 0;  // index in StepStats::islands
+  // w = (J M^-1 J^T + diag(cfm)) x + b, lo <= x <= hi, findex island-global: stages 1-3's rows,
+  // joints ordered unbounded | mixed | LCP. rows.assemble() is the Problem whose
+  // mlcp::accuracy(problem, lambda).residual IslandStats::residual reports (up to round-off).
+  RowSystem rows;
+  // The constraint forces applied to the bodies (ODE's lambda: N, or N m on angular rows), per
+  // row of `rows`; feedback holds J^T lambda per joint and body.
+  Vector lambda;
+  // Each active joint's rows in `rows`. Map answers by joint, never by row position: the row
+  // order is the stepper's (by class), not the island's joint order.
+  struct JointRange {
+    dJointID joint;  // as during the step: contact joints are usually destroyed right after it
+                     // (dJointGroupEmpty), so compare it, dereference it only before that
+    int first, count;
+  };
+  std::vector<JointRange> joints;
 };
 
 struct StepStats {
@@ -137,6 +166,9 @@ class Stepper {
   mlcp::Options& solverOptions();
   // Statistics of the last step (cleared at the start of each step).
   const StepStats& lastStep() const;
+  // The islands with rows of the last step, in step order, when StepperOptions::keepProblems
+  // is set (empty otherwise; replaced at the start of each step).
+  const std::vector<IslandProblem>& lastProblems() const;
   // Forget the warm-start cache (e.g. after teleporting bodies).
   void resetWarmStart();
   // The shared island solver of a core primary (null for "ode-..."): its capture hook writes
