@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <stdexcept>
 
 #include "mlcp/io.hpp"
@@ -87,6 +88,13 @@ constexpr std::size_t kSlotLimit = 1024;
 }  // namespace
 
 namespace {
+// s == literal, sizes first (std::string == const char* measures the literal on every call,
+// and solve() compares names on every island).
+template <std::size_t N>
+bool equals(const std::string& s, const char (&literal)[N]) {
+  return s.size() == N - 1 && std::memcmp(s.data(), literal, N - 1) == 0;
+}
+
 // x as `std::ostream << x` writes it (%g, 6 digits).
 std::string shortNumber(double x) {
   char text[32];
@@ -136,6 +144,8 @@ Solver* RowSolver::assembledSolver(Slot& island, const std::string& name) {
   for (auto& [n, solver] : island.solvers)
     if (n == name) return solver.get();
   island.solvers.emplace_back(name, makeSolver(name));
+  // solve() times the whole island (assembly, solve, check) with fewer clock reads.
+  island.solvers.back().second->setTimed(false);
   return island.solvers.back().second.get();
 }
 
@@ -155,7 +165,7 @@ Result RowSolver::run(const RowSystem& rows, const std::string& name, const Opti
   solveStart_ = 0;
   Options o = options;
   o.warmStart = true;
-  if (name == "pgs") {
+  if (equals(name, "pgs")) {
     rowPgs_.options() = o;
     x = start;
     return rowPgs_.solve(rows, x);
@@ -205,11 +215,11 @@ IslandSolve RowSolver::solve(const RowSystem& rows, const Vector& start, Vector&
   }
   if (!capturePrefix_.empty()) capture(rows);
 
-  const bool autoChoice = settings_.solver == "auto";
+  const bool autoChoice = equals(settings_.solver, "auto");
   out.requested = autoChoice ? chooseSolver(out.problemClass, n, settings_.options.tolerance)
                              : settings_.solver;
   Slot& island = slot(key);
-  if (autoChoice && out.requested == "dantzig" && island.pgsFirst > 0) {
+  if (autoChoice && island.pgsFirst > 0 && equals(out.requested, "dantzig")) {
     --island.pgsFirst;
     out.requested = "pgs";
   }
@@ -221,7 +231,7 @@ IslandSolve RowSolver::solve(const RowSystem& rows, const Vector& start, Vector&
     // out) keeps dantzig for the next solve; a breakdown or a far miss sends the island to pgs.
     const bool nearMiss = r.status != Status::Failed && r.status != Status::NumericalIssue &&
                           r.residual <= kAutoNearMiss * settings_.acceptResidual;
-    if (autoChoice && out.requested == "dantzig" && !nearMiss)
+    if (autoChoice && !nearMiss && equals(out.requested, "dantzig"))
       island.pgsFirst = kAutoPgsAfterRejection;
     // Built on every rejection (a fixed-sweep pgs near the limit: every step), so without an
     // ostringstream, whose locale set-up cost more than a small island's sweep.

@@ -83,19 +83,20 @@ Result Solver::solveWithGuess(const Problem& problem, const Vector& guess, Vecto
 }
 
 Result Solver::runChecked(const Problem& problem, Vector& x) {
-  const double t0 = nowSeconds();
+  const double t0 = timed_ ? nowSeconds() : 0.0;
+  auto elapsed = [&] { return timed_ ? nowSeconds() - t0 : 0.0; };
   Result r;
   if (std::string why = problem.validate(); !why.empty()) {
     r.status = Status::InvalidInput;
     r.message = why;
-    r.seconds = nowSeconds() - t0;
+    r.seconds = elapsed();
     return r;
   }
   r.status = Status::Failed;
   r.solver = name();
   run(problem, start_, r);
   if (r.status == Status::InvalidInput || r.status == Status::Unsupported) {
-    r.seconds = nowSeconds() - t0;
+    r.seconds = elapsed();
     return r;  // x untouched: nothing was solved
   }
   if (problem.isSparse())
@@ -105,7 +106,7 @@ Result Solver::runChecked(const Problem& problem, Vector& x) {
   slack_ += problem.b;
   applyAccuracy(r, accuracy(problem, start_, slack_), options_.tolerance);
   x.swap(start_);
-  r.seconds = nowSeconds() - t0;
+  r.seconds = elapsed();
   return r;
 }
 

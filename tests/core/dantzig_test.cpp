@@ -8,6 +8,7 @@
 #include <random>
 
 #include "../core/src/dantzig_block.hpp"  // SymmetricPatternLu (internal)
+#include "../core/src/dantzig_small.hpp"  // the tiny dense path (internal)
 #include "common/contact_scenes.hpp"
 #include "common/generators.hpp"
 #include "mlcp/registry.hpp"
@@ -340,6 +341,113 @@ TEST(Dantzig, EmptyProblem) {
   Problem p(DenseMatrix(0, 0), Vector(0));
   Vector x;
   EXPECT_TRUE(s.solve(p, x).converged());
+}
+
+// ---- the path for tiny dense islands (core/src/dantzig_small.hpp) ----
+
+// A small boxed / linear / standard problem with an exactly symmetric SPD A.
+KnownProblem smallProblem(Generator& g, int n, int kind) {
+  DenseMatrix A = g.spd(n);
+  A = (0.5 * (A + A.transpose())).eval();
+  return kind == 0 ? g.linear(A) : kind == 1 ? g.standard(A) : g.boxed(A);
+}
+
+// Taken, the path's answer solves the problem and is the general path's (the same problem
+// stored sparse, which the path never takes); declined, x is untouched. Guesses: the solution
+// (taken unless a row sits exactly on a bound with w = 0), a perturbed solution (either), zero
+// (taken only for equality-only problems), random.
+TEST(DantzigSmall, AnswersAreTheGeneralPathsOrDeclined) {
+  Generator g(31);
+  int taken = 0, declined = 0;
+  for (int trial = 0; trial < 240; ++trial) {
+    const KnownProblem kp = smallProblem(g, 1 + trial % detail::kSmallDenseRows, trial % 3);
+    const Problem& p = kp.problem;
+    ASSERT_TRUE(detail::smallDenseApplies(p));
+    Problem sparse = p;
+    sparse.setA(p.toSparse());
+    ASSERT_FALSE(detail::smallDenseApplies(sparse));
+    const int n = p.size();
+    const Vector guesses[] = {kp.solution, kp.solution + 1e-3 * Vector::Random(n), Vector::Zero(n),
+                              2 * Vector::Random(n)};
+    for (const Vector& guess : guesses) {
+      Vector x = guess;
+      if (!detail::solveSmallDense(p, 1e-12, x)) {
+        ++declined;
+        EXPECT_TRUE((x.array() == guess.array()).all()) << "a declined guess was changed";
+        continue;
+      }
+      ++taken;
+      const Accuracy a = accuracy(p, x);
+      EXPECT_LE(a.residual, 1e-10) << kp.name << " n=" << n;
+      EXPECT_LE(a.boundViolation, 0.0) << kp.name;
+      DantzigSolver general;
+      Vector y;
+      const Result r = general.solveWithGuess(sparse, guess, y);
+      ASSERT_TRUE(r.converged()) << r.message;
+      EXPECT_LE((x - y).lpNorm<Eigen::Infinity>(), 1e-12 * (1 + y.lpNorm<Eigen::Infinity>()))
+          << kp.name << " n=" << n;
+    }
+  }
+  EXPECT_GT(taken, 300);
+  EXPECT_GT(declined, 100);
+}
+
+// A guess whose index sets are wrong is declined, and DantzigSolver pivots from it instead.
+TEST(DantzigSmall, WrongGuessFallsToPivoting) {
+  // x in [0, 1], w = x - 2: the answer is x = 1 (at hi), not the guessed interior 0.5.
+  Problem p(DenseMatrix::Identity(1, 1), Vector::Constant(1, -2.0));
+  p.hi[0] = 1;
+  Vector x = Vector::Constant(1, 0.5);
+  EXPECT_FALSE(detail::solveSmallDense(p, 1e-12, x));
+  EXPECT_EQ(x[0], 0.5);
+  DantzigSolver s;
+  Vector y;
+  const Result r = s.solveWithGuess(p, Vector::Constant(1, 0.5), y);
+  ASSERT_TRUE(r.converged()) << r.message;
+  EXPECT_EQ(y[0], 1.0);
+  EXPECT_GE(r.iterations, 1);
+  // Non-symmetric A: declined (the general path has the L D U factors for it).
+  Problem q(DenseMatrix{{2.0, 0.5}, {0.0, 2.0}}, Vector::Constant(2, -1.0));
+  q.lo.setConstant(-kInf);
+  Vector z = Vector::Constant(2, 0.1);
+  EXPECT_FALSE(detail::solveSmallDense(q, 1e-12, z));
+  ASSERT_TRUE(s.solveWithGuess(q, z, y).converged());
+  EXPECT_LE(residual(q, y), 1e-12);
+}
+
+// One solver object reused over islands whose size, bounds pattern and row order change (in
+// and out of the small path, warm and cold) answers exactly as a fresh solver per problem:
+// nothing of a previous solve leaks into the next.
+TEST(DantzigSmall, ReuseAcrossSizesAndBoundPatternsMatchesAFreshSolver) {
+  Generator g(32);
+  DantzigSolver reused;
+  for (int trial = 0; trial < 120; ++trial) {
+    const int n = 1 + g.pick(12);
+    KnownProblem kp = smallProblem(g, n, g.pick(3));
+    if (trial % 4 == 3) {  // the same rows in another order: another permutation
+      Eigen::PermutationMatrix<Eigen::Dynamic> P(n);
+      P.setIdentity();
+      for (int i = n - 1; i > 0; --i) std::swap(P.indices()[i], P.indices()[g.pick(i + 1)]);
+      const DenseMatrix A = P * kp.problem.denseA() * P.transpose();
+      kp.problem.setA(A);
+      kp.problem.b = P * kp.problem.b;
+      kp.problem.lo = P * kp.problem.lo;
+      kp.problem.hi = P * kp.problem.hi;
+      kp.solution = P * kp.solution;
+    }
+    const Vector guess = trial % 5 == 0   ? Vector::Zero(n)
+                         : trial % 5 == 1 ? Vector(2 * Vector::Random(n))
+                                          : Vector(kp.solution + 1e-4 * Vector::Random(n));
+    Vector a, b;
+    const Result ra = reused.solveWithGuess(kp.problem, guess, a);
+    DantzigSolver fresh;
+    const Result rb = fresh.solveWithGuess(kp.problem, guess, b);
+    ASSERT_EQ(ra.status, rb.status) << ra.message << " | " << rb.message;
+    EXPECT_EQ(ra.iterations, rb.iterations);
+    EXPECT_TRUE((a.array() == b.array()).all()) << "trial " << trial << " n=" << n;
+    EXPECT_TRUE(ra.converged()) << ra.message;
+    EXPECT_LE(residual(kp.problem, a), 1e-9);
+  }
 }
 
 // ---- the sparse block stage on engine-like contact scenes (tests/common/contact_scenes.hpp) ----

@@ -1,0 +1,200 @@
+#include "dantzig_small.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace mlcp::detail {
+
+namespace {
+
+bool isEquality(double lo, double hi) { return lo == -kInf && hi == kInf; }
+
+// The guessed block's factors A_CC = L D L^T (columns n apart) and the operations of
+// DantzigSolver's general path on them, written the same way (see dantzig_small.hpp). The size
+// n is a template argument: the products over n rows compile to straight-line code.
+template <int n>
+struct Factors {
+  int m = 0;
+  const double* a = nullptr;  // A in processing order, column-major n x n
+  double L[n * n], D[n];
+  int C[n];
+
+  int size() const { return m < n ? m : n; }  // m, visibly at most n for the compiler
+
+  double rowDot(int i, const double* v) const {
+    const double* row = a + i * n;  // A is symmetric: column i is row i
+    double s = 0;
+    for (int k = 0; k < n; ++k) s += row[k] * v[k];
+    return s;
+  }
+  // y <- D^-1 L^-1 y.
+  void forward(double* y) const {
+    const int m = size();
+    if (m == 0) return;
+    for (int k = 0; k < m; ++k) {
+      const double yk = y[k];
+      if (yk == 0) continue;
+      const double* col = L + k * n;
+      for (int i = k + 1; i < m; ++i) y[i] -= yk * col[i];
+    }
+    for (int c = 0; c < m; ++c) y[c] /= D[c];
+  }
+  // y <- L^-T y.
+  void backward(double* y) const {
+    const int m = size();
+    if (m == 0) return;
+    for (int i = m - 2; i >= 0; --i) {
+      const double* col = L + i * n;
+      double s = 0;
+      for (int k = i + 1; k < m; ++k) s += col[k] * y[k];
+      y[i] -= s;
+    }
+  }
+  // Borders the factors with position p; false when its Schur pivot is at most pivTol.
+  bool join(int p, double pivTol) {
+    if (m >= n) return false;  // (never: each position joins once)
+    double u[n];
+    const double* col = a + p * n;
+    for (int c = 0; c < m; ++c) u[c] = col[C[c]];
+    forward(u);
+    double s = 0;
+    for (int c = 0; c < m; ++c) s += u[c] * u[c] * D[c];
+    const double pivot = col[p] - s;
+    if (!(std::abs(pivot) > pivTol)) return false;
+    for (int c = 0; c < m; ++c) L[m + c * n] = u[c];
+    D[m] = pivot;
+    C[m++] = p;
+    return true;
+  }
+  // x_C -= A_CC^-1 (b + A x)_C.
+  void solveClamped(const double* b, double* x) const {
+    double r[n];
+    for (int c = 0; c < m; ++c) r[c] = b[C[c]] + rowDot(C[c], x);
+    forward(r);
+    backward(r);
+    for (int c = 0; c < m; ++c) x[C[c]] -= r[c];
+  }
+};
+
+enum class At : unsigned char { Clamped, Lo, Hi, Fixed };
+
+}  // namespace
+
+bool smallDenseApplies(const Problem& problem) {
+  const int n = problem.size();
+  return n > 0 && n <= kSmallDenseRows && !problem.isSparse() && !problem.hasFindex();
+}
+
+namespace {
+
+template <int n>
+bool solveFixed(const Problem& pb, double pivotTolerance, Vector& xInOut) {
+  const DenseMatrix& A = pb.denseA();
+  const bool useGuess = !xInOut.isZero(0.0);
+
+  // Processing order: 0 equality rows, 1 rows guessed clamped, 2 the others (counting sort).
+  int group[n], perm[n], start[4] = {0, 0, 0, 0};
+  for (int i = 0; i < n; ++i) {
+    const double lo = pb.lo[i], hi = pb.hi[i], g = xInOut[i];
+    group[i] = isEquality(lo, hi) ? 0 : useGuess && g > lo && g < hi ? 1 : 2;
+    ++start[group[i] + 1];
+  }
+  start[2] += start[1];
+  start[3] += start[2];
+  bool identity = true;
+  int groupAt[n];
+  for (int i = 0; i < n; ++i) {
+    const int p = start[group[i]]++;
+    perm[p] = i;
+    groupAt[p] = group[i];
+    identity = identity && p == i;
+  }
+
+  double aMax = 0, asym = 0;
+  const double* a = A.data();
+  for (int j = 0; j < n; ++j) {
+    aMax = std::max(aMax, std::abs(a[j + j * n]));
+    for (int i = j + 1; i < n; ++i) {
+      const double lower = a[i + j * n], upper = a[j + i * n];
+      aMax = std::max({aMax, std::abs(lower), std::abs(upper)});
+      asym = std::max(asym, std::abs(lower - upper));
+    }
+  }
+  if (!(asym <= 1e-14 * aMax)) return false;  // the general path's non-symmetric factors
+
+  Factors<n> f;
+  double permuted[n * n];
+  if (identity) {
+    f.a = a;
+  } else {
+    for (int q = 0; q < n; ++q)
+      for (int p = 0; p < n; ++p) permuted[p + q * n] = A(perm[p], perm[q]);
+    f.a = permuted;
+  }
+  double b[n], lo[n], hi[n], x[n], w[n];
+  double dMax = 0;
+  for (int p = 0; p < n; ++p) {
+    const int i = perm[p];
+    b[p] = pb.b[i];
+    lo[p] = pb.lo[i];
+    hi[p] = pb.hi[i];
+    x[p] = std::clamp(useGuess ? xInOut[i] : 0.0, lo[p], hi[p]);
+    dMax = std::max(dMax, std::abs(f.a[p + p * n]));
+  }
+  const double pivTol = (dMax > 0 ? dMax : aMax > 0 ? aMax : 1.0) * pivotTolerance;
+  const double epsW = 1e-12 * (1.0 + pb.b.lpNorm<Eigen::Infinity>());
+
+  // The guessed block: factor, solve x_C with the others at their start, all inside bounds.
+  for (int p = 0; p < n; ++p)
+    if (groupAt[p] <= 1 && !f.join(p, pivTol)) return false;
+  if (f.m > 0) {
+    f.solveClamped(b, x);
+    for (int c = 0; c < f.m; ++c)
+      if (x[f.C[c]] < lo[f.C[c]] || x[f.C[c]] > hi[f.C[c]]) return false;
+  }
+  // The other rows, in order, stay at their bound when their w allows it.
+  At at[n];
+  for (int p = 0; p < n; ++p) {
+    at[p] = At::Clamped;
+    if (groupAt[p] <= 1) continue;
+    const double wp = b[p] + f.rowDot(p, x);
+    if (lo[p] == hi[p]) {
+      x[p] = lo[p];
+      at[p] = At::Fixed;
+    } else if (x[p] <= lo[p] && wp >= -epsW) {
+      x[p] = lo[p];
+      at[p] = At::Lo;
+    } else if (x[p] >= hi[p] && wp <= epsW) {
+      x[p] = hi[p];
+      at[p] = At::Hi;
+    } else {
+      return false;  // the row would be driven: the general path pivots
+    }
+  }
+  // One step of iterative refinement, then every row at a bound checked with a fresh w.
+  f.solveClamped(b, x);
+  for (int p = 0; p < n; ++p) w[p] = b[p] + f.rowDot(p, x);
+  for (int p = 0; p < n; ++p)
+    if ((at[p] == At::Lo && w[p] < -epsW) || (at[p] == At::Hi && w[p] > epsW)) return false;
+  for (int p = 0; p < n; ++p) xInOut[perm[p]] = x[p];
+  return true;
+}
+
+}  // namespace
+
+bool solveSmallDense(const Problem& pb, double pivotTolerance, Vector& x) {
+  static_assert(kSmallDenseRows == 8, "one instance per size below");
+  switch (pb.size()) {
+    case 1: return solveFixed<1>(pb, pivotTolerance, x);
+    case 2: return solveFixed<2>(pb, pivotTolerance, x);
+    case 3: return solveFixed<3>(pb, pivotTolerance, x);
+    case 4: return solveFixed<4>(pb, pivotTolerance, x);
+    case 5: return solveFixed<5>(pb, pivotTolerance, x);
+    case 6: return solveFixed<6>(pb, pivotTolerance, x);
+    case 7: return solveFixed<7>(pb, pivotTolerance, x);
+    case 8: return solveFixed<8>(pb, pivotTolerance, x);
+    default: return false;
+  }
+}
+
+}  // namespace mlcp::detail

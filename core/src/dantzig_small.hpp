@@ -1,0 +1,35 @@
+// DantzigSolver's path for tiny dense islands (a joint or two: up to kSmallDenseRows rows, no
+// friction coupling). Internal to the library.
+//
+// A joint island's warm start nearly always guesses the index sets right: the equality rows and
+// the rows strictly inside their bounds are clamped, the others stay at their bound. For that
+// case DantzigSolver's general pivoting (dantzig.cpp) does one bordered LDL^T of the guessed
+// block, solves x_C, checks the other rows' w, refines x_C once and checks again: the method
+// costs a few hundred flops, its general workspace (permuted copy of A, index-set bookkeeping,
+// twenty reused vectors) several times that. This path is the same steps on fixed-size arrays:
+// the same processing order (equality rows, guessed clamped rows, the others; each group in
+// the caller's order), the same factor, the same sums in the same order, the same tolerances,
+// so its answer is the general path's to the bit. It gives up (returns false, x untouched)
+// wherever the general path would pivot or fall back: a guessed row whose Schur pivot is at
+// most the pivot tolerance, a solved x_C outside its bounds, a row at a bound whose w points
+// the wrong way (before or after the refinement), an A that is not symmetric; DantzigSolver
+// then runs the general path from the same start. Declining costs at most this path's work.
+#pragma once
+
+#include "mlcp/problem.hpp"
+
+namespace mlcp::detail {
+
+// Largest island this path takes, in rows (the general path's plain-loop size, kSmall).
+inline constexpr int kSmallDenseRows = 8;
+
+// Whether the path applies: dense A, 1..kSmallDenseRows rows, no findex.
+bool smallDenseApplies(const Problem& problem);
+
+// Solves the problem from x (the start; all zero = cold) with the guessed index sets.
+// pivotTolerance: Options::pivotTolerance (relative to max |A_ii|). True with the answer in x
+// when every row's complementarity condition holds (to 1e-12 (1 + ||b||_inf) in w); false,
+// x untouched, otherwise.
+bool solveSmallDense(const Problem& problem, double pivotTolerance, Vector& x);
+
+}  // namespace mlcp::detail
