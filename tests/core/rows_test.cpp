@@ -237,6 +237,129 @@ TEST(RowPgs, RejectsBadRows) {
   EXPECT_EQ(s.validate(), "");
 }
 
+// The engine entry point (RowPgs::solve with a row fill) must pack what solve(RowSystem) packs
+// from the same values: the same iterates bit for bit, the same result, and the velocity change
+// M^-1 J^T (x - base) per body.
+RowPgs::Row rowOf(const RowSystem& s, int i, double start, double base) {
+  RowPgs::Row r;
+  r.bodyA = s.rows[i].bodyA;
+  r.bodyB = s.rows[i].bodyB;
+  r.jA = s.rows[i].jA;
+  r.jB = s.rows[i].jB;
+  r.b = s.b[i];
+  r.cfm = s.cfm[i];
+  r.lo = s.lo[i];
+  r.hi = s.hi[i];
+  r.findex = s.findex.empty() ? -1 : s.findex[i];
+  r.start = start;
+  r.base = base;
+  return r;
+}
+
+Result solveFromRows(RowPgs& pgs, const RowSystem& s, const Vector& start, const Vector& base,
+                     Vector& x) {
+  int calls = 0;
+  const Result r = pgs.solve(
+      s.bodies, s.size(),
+      [&](int first, int count, RowPgs::Row* out) {
+        ++calls;
+        for (int k = 0; k < count; ++k)
+          out[k] = rowOf(s, first + k, start[first + k], base[first + k]);
+      },
+      x);
+  EXPECT_GE(calls, (s.size() + 63) / 64);
+  return r;
+}
+
+// Rows in reverse order: every friction row's findex points forward (checked after the pass).
+RowSystem reversed(const RowSystem& s) {
+  RowSystem r = s;
+  const int n = s.size();
+  for (int i = 0; i < n; ++i) {
+    const int j = n - 1 - i;
+    r.rows[i] = s.rows[j];
+    r.b[i] = s.b[j];
+    r.lo[i] = s.lo[j];
+    r.hi[i] = s.hi[j];
+    r.cfm[i] = s.cfm[j];
+    r.findex[i] = s.findex[j] < 0 ? -1 : n - 1 - s.findex[j];
+  }
+  return r;
+}
+
+TEST(RowPgs, PackingFromAnEnginesRowsEqualsPackingFromTheRowSystem) {
+  for (const RowSystem& s : {stackRows(30, 9), reversed(stackRows(12, 10))}) {
+    const int n = s.size();
+    ASSERT_GT(n, 64);  // several batches
+    std::mt19937 rng(1);
+    std::uniform_real_distribution<double> u(0, 0.5);
+    Vector start(n), base(n);
+    for (int i = 0; i < n; ++i) {
+      start[i] = s.findex[i] < 0 ? u(rng) : 0.1 * u(rng);
+      base[i] = i % 3 ? start[i] : 0.5 * start[i];
+    }
+    for (bool warm : {false, true}) {
+      RowPgs a, b;
+      for (RowPgs* p : {&a, &b}) {
+        p->options().maxIterations = 7;
+        p->options().warmStart = warm;
+      }
+      Vector xa = start, xb;
+      const Result ra = a.solve(s, xa);
+      const Result rb = solveFromRows(b, s, start, base, xb);
+      EXPECT_FALSE(a.velocityChanges());
+      ASSERT_TRUE(b.velocityChanges());
+      EXPECT_EQ(ra.status, rb.status);
+      EXPECT_EQ(ra.iterations, rb.iterations);
+      EXPECT_EQ(ra.residual, rb.residual);
+      ASSERT_EQ(xa.size(), xb.size());
+      for (int i = 0; i < n; ++i) EXPECT_EQ(xa[i], xb[i]) << "row " << i << " warm " << warm;
+      // The reported residual is that of x on the assembled problem.
+      EXPECT_NEAR(rb.residual, accuracy(s.assemble(true), xb).residual, 1e-12 * (1 + rb.residual));
+      // Cold or warm, x - base is what the engine's bodies lack.
+      const std::vector<Vector6> dv = s.bodyVelocities(xb - base);
+      for (int k = 0; k < static_cast<int>(s.bodies.size()); ++k)
+        EXPECT_LE((b.velocityChange(k) - dv[k]).lpNorm<Eigen::Infinity>(),
+                  1e-12 * (1 + dv[k].lpNorm<Eigen::Infinity>()))
+            << "body " << k;
+    }
+  }
+}
+
+// Bad rows and a zero diagonal through the engine entry point: the slow path says what
+// solve(RowSystem) says, and velocityChange is not offered.
+TEST(RowPgs, EngineRowsWithFaultsGetTheRowSystemsAnswer) {
+  auto both = [](const RowSystem& s) {
+    const Vector start = Vector::Constant(s.size(), 0.2);
+    RowPgs a, b;
+    a.options().warmStart = b.options().warmStart = true;
+    Vector xa = start, xb;
+    const Result ra = a.solve(s, xa);
+    const Result rb = solveFromRows(b, s, start, start, xb);
+    EXPECT_FALSE(b.velocityChanges());
+    EXPECT_EQ(ra.status, rb.status);
+    EXPECT_EQ(ra.message, rb.message);
+    return rb;
+  };
+  RowSystem s = stackRows(30, 4);
+  s.rows[100].bodyA = 99;
+  EXPECT_EQ(both(s).status, Status::InvalidInput);
+  s = reversed(stackRows(3, 4));
+  s.findex[0] = 1;  // forward, onto a friction row
+  EXPECT_EQ(both(s).status, Status::InvalidInput);
+  s = stackRows(30, 4);
+  s.findex[101] = 100;  // backward, onto a friction row
+  EXPECT_EQ(both(s).status, Status::InvalidInput);
+  s = stackRows(30, 4);
+  s.rows[70].jA.setZero();
+  s.rows[70].jB.setZero();
+  s.cfm[70] = 0;
+  EXPECT_EQ(both(s).status, Status::Failed);
+  s = stackRows(3, 4);
+  s.rows[2].jA[0] = std::nan("");
+  EXPECT_EQ(both(s).status, Status::InvalidInput);
+}
+
 TEST(RowPgs, ZeroRowIsAFailureNotAConvergence) {
   RowSystem s = stackRows(1, 5);
   s.rows[0].jA.setZero();

@@ -75,6 +75,7 @@ void ConstraintSolver::finishStep() {
   totals_.fallbacks += current_.fallbacks;
   totals_.failures += current_.failures;
   totals_.choices.add(current_.choices);
+  totals_.packedIslands += current_.packedIslands;
   worst(totals_, current_);
 }
 
@@ -125,7 +126,8 @@ btScalar ConstraintSolver::solveGroupCacheFriendlyIterations(
     const Start start = !settings_.warmStart ? Start::Zero
                         : settings_.siStart  ? Start::AppliedImpulse
                                              : Start::CachedImpulse;
-    builder_.build(rows, info, settings_.cfm, start);
+    fastPgs_ = settings_.solver == "pgs" && !settings_.keepIslands && !shared_;
+    builder_.build(rows, info, settings_.cfm, start, !fastPgs_);
     current_.inertRows += builder_.inertRows();
     for (int k = 0; k < builder_.count(); ++k) {
       Island& island = builder_.island(k);
@@ -155,7 +157,49 @@ void ConstraintSolver::measureSi(int sweeps) {
   }
 }
 
+bool ConstraintSolver::solveIslandFast(Island& island, bool split) {
+  const double t0 = nowSeconds();
+  pgs_.options() = rows_->options();
+  pgs_.options().warmStart = true;  // as RowSolver runs it: from the start given
+  const int n = static_cast<int>(island.rows.size());
+  Result r = pgs_.solve(
+      island.system.bodies, n,
+      [&](int first, int count, RowPgs::Row* out) {
+        builder_.fill(island, first, count, out, split);
+      },
+      x_);
+  if (!pgs_.velocityChanges() || !acceptable(r, settings_.acceptResidual)) return false;
+  r.solver = "pgs";
+  r.seconds = nowSeconds() - t0;
+  record(r, n, "pgs");
+  current_.packedIslands += 1;
+  // Store impulses: the bodies take M^-1 J^T (x - applied) at once (RowPgs::velocityChange),
+  // what the per-row internalApplyImpulse calls sum to.
+  for (int k = 0; k < static_cast<int>(island.solverBody.size()); ++k) {
+    btSolverBody& body = m_tmpSolverBodyPool[island.solverBody[k]];
+    const Vector6 dv = pgs_.velocityChange(k);
+    const btVector3 linear(dv[0], dv[1], dv[2]), angular(dv[3], dv[4], dv[5]);
+    if (split) {
+      body.internalGetPushVelocity() += linear;
+      body.internalGetTurnVelocity() += angular;
+    } else {
+      body.internalGetDeltaLinearVelocity() += linear;
+      body.internalGetDeltaAngularVelocity() += angular;
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    btSolverConstraint& c = *island.rows[i];
+    (split ? c.m_appliedPushImpulse : c.m_appliedImpulse) = static_cast<btScalar>(x_[i]);
+  }
+  if (!split) builder_.remember(island, x_);
+  return true;
+}
+
 void ConstraintSolver::solveIsland(Island& island, std::uint64_t key, bool split) {
+  if (fastPgs_) {
+    if (solveIslandFast(island, split)) return;
+    builder_.fillSystem(island);
+  }
   RowSystem& s = island.system;
   const int n = s.size();
   // The split problem shares A and the bounds; only b and the start differ.

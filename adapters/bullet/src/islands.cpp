@@ -4,7 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
+#include <cstdint>
 
 #include "mlcp/bullet/constraint_solver.hpp"
 
@@ -39,12 +39,18 @@ int IslandBuilder::find(int k) {
 }
 
 void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info, CfmModel cfm,
-                          Start start) {
+                          Start start, bool system) {
   const btAlignedObjectArray<btSolverBody>& bodies = *in.bodies;
   const int nb = bodies.size();
   const int nj = in.joints->size(), nc = in.contacts->size(), nf = in.friction->size(),
             nr = in.rolling->size();
   const int n = nj + nc + nf + nr;
+  in_ = in;
+  cfm_ = cfm;
+  start_ = start;
+  nj_ = nj;
+  nc_ = nc;
+  nf_ = nf;
 
   dynamic_.resize(nb);
   parent_.resize(nb);
@@ -59,13 +65,18 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
   all_.resize(n);
   findex_.resize(n);
   rowBodies_.resize(n);
+  int lastA = -1, lastB = -1;  // the last pair joined (a manifold's rows repeat it)
   auto add = [&](int i, btSolverConstraint& c, int f) {
     all_[i] = &c;
     findex_[i] = f;
     const int a = c.m_solverBodyIdA >= 0 ? dynamic_[c.m_solverBodyIdA] : -1;
     const int b = c.m_solverBodyIdB >= 0 ? dynamic_[c.m_solverBodyIdB] : -1;
     rowBodies_[i] = {a, b};
-    if (a >= 0 && b >= 0) parent_[find(a)] = find(b);
+    if (a >= 0 && b >= 0 && (a != lastA || b != lastB)) {
+      parent_[find(a)] = find(b);
+      lastA = a;
+      lastB = b;
+    }
   };
   for (int i = 0; i < nj; ++i) add(i, (*in.joints)[i], -1);
   for (int i = 0; i < nc; ++i) add(nj + i, (*in.contacts)[i], -1);
@@ -78,51 +89,14 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     add(nj + nc + nf + i, c, nj + c.m_frictionIndex);
   }
 
-  // Islands numbered by first appearance in row order; rows keep their relative order.
+  // Islands numbered by first appearance in row order; rows keep their relative order, bodies
+  // are numbered by first use in their island's rows.
   islandOfRoot_.assign(nb, -1);
   bodyLocal_.assign(nb, -1);
   rowIsland_.resize(n);
   rowLocal_.resize(n);
   count_ = 0;
   inert_ = 0;
-  std::vector<int>& rowsPer = bodyCount_;  // reused: rows per island
-  rowsPer.clear();
-  for (int i = 0; i < n; ++i) {
-    const auto [a, b] = rowBodies_[i];
-    if (a < 0 && b < 0) {
-      rowIsland_[i] = -1;
-      ++inert_;
-      continue;
-    }
-    const int root = find(a >= 0 ? a : b);
-    if (islandOfRoot_[root] < 0) {
-      islandOfRoot_[root] = count_++;
-      rowsPer.push_back(0);
-    }
-    rowIsland_[i] = islandOfRoot_[root];
-    rowLocal_[i] = rowsPer[rowIsland_[i]]++;
-  }
-  if (static_cast<int>(islands_.size()) < count_) islands_.resize(count_);
-  for (int k = 0; k < count_; ++k) {
-    Island& isl = islands_[k];
-    const int m = rowsPer[k];
-    RowSystem& s = isl.system;
-    s.rows.resize(m);
-    s.bodies.clear();
-    s.b.resize(m);
-    s.lo.resize(m);
-    s.hi.resize(m);
-    s.cfm.resize(m);
-    s.findex.resize(m);
-    isl.rows.resize(m);
-    isl.start.resize(m);
-    isl.splitB.resize(m);
-    isl.splitStart.resize(m);
-    isl.point.assign(m, nullptr);
-    isl.hasSplit = false;
-  }
-
-  // A dynamic body's local index in its island, created on first use.
   auto localBody = [&](Island& isl, int d) -> int {
     if (d < 0) return -1;
     if (bodyLocal_[d] < 0) {
@@ -136,9 +110,89 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
         for (int c = 0; c < 3; ++c) m.invInertia(r, c) = af[r] * I[r][c] * af[c];
       bodyLocal_[d] = static_cast<int>(isl.system.bodies.size());
       isl.system.bodies.push_back(m);
+      isl.solverBody.push_back(d);
     }
     return bodyLocal_[d];
   };
+  for (int i = 0; i < n; ++i) {
+    const auto [a, b] = rowBodies_[i];
+    if (a < 0 && b < 0) {
+      rowIsland_[i] = -1;
+      ++inert_;
+      continue;
+    }
+    const int root = find(a >= 0 ? a : b);
+    if (islandOfRoot_[root] < 0) {
+      islandOfRoot_[root] = count_++;
+      if (static_cast<int>(islands_.size()) < count_) islands_.resize(count_);
+      Island& isl = islands_[count_ - 1];
+      isl.system.bodies.clear();
+      isl.system.findex.clear();
+      isl.solverBody.clear();
+      isl.rows.clear();
+      isl.rowIndex.clear();
+      isl.point.clear();
+      isl.last.clear();
+      isl.points = 0;
+      isl.hasSplit = false;
+      isl.filled = false;
+    }
+    const int k = islandOfRoot_[root];
+    Island& isl = islands_[k];
+    const int r = static_cast<int>(isl.rows.size());
+    rowIsland_[i] = k;
+    rowLocal_[i] = r;
+    localBody(isl, a);
+    localBody(isl, b);
+    btSolverConstraint& c = *all_[i];
+    isl.rows.push_back(&c);
+    isl.rowIndex.push_back(i);
+    isl.system.findex.push_back(findex_[i] >= 0 ? rowLocal_[findex_[i]] : -1);
+    const btManifoldPoint* point = nullptr;
+    const Remembered* last = nullptr;
+    if (i >= nj && i < nj + nc + nf) {  // a contact or friction row
+      const bool contact = i < nj + nc;
+      point = static_cast<const btManifoldPoint*>(
+          contact ? c.m_originalContactPoint
+                  : (*in.contacts)[c.m_frictionIndex].m_originalContactPoint);
+      // Last step's answer at this manifold point, if it is the same point (see remember());
+      // a friction row's point is its contact row's.
+      if (!contact) {
+        last = static_cast<const Remembered*>(isl.last[rowLocal_[findex_[i]]]);
+      } else if (point) {
+        ++isl.points;
+        if (start == Start::CachedImpulse) {
+          last = lookup(point);
+          if (last && (point->m_localPointA - last->localA).length() >= gContactBreakingThreshold)
+            last = nullptr;
+        }
+      }
+    }
+    isl.point.push_back(point);
+    isl.last.push_back(last);
+  }
+
+  stockCfm_ = info.m_globalCfm / info.m_timeStep;
+  // SI starts contacts and friction from the cached impulse times m_warmstartingFactor (0.85); a
+  // solver that can use a guess gets the cached impulse itself.
+  unscaleContacts_ = (start == Start::CachedImpulse && info.m_warmstartingFactor > 0 &&
+                      (info.m_solverMode & SOLVER_USE_WARMSTARTING))
+                         ? 1.0 / info.m_warmstartingFactor
+                         : 1.0;
+  // Bullet 3's setup starts every friction row at 0 (setFrictionConstraintImpulse); the impulse
+  // it wrote back last step (m_appliedImpulseLateral1/2, kept with the manifold point) is the
+  // warm start, when the friction directions persist between steps.
+  lateralCache_ = start == Start::CachedImpulse && (info.m_solverMode & SOLVER_USE_WARMSTARTING) &&
+                  (info.m_solverMode & (SOLVER_ENABLE_FRICTION_DIRECTION_CACHING |
+                                        SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION));
+  if (system)
+    for (int k = 0; k < count_; ++k) fillSystem(islands_[k]);
+}
+
+void IslandBuilder::convert(int i, RowPgs::Row& out, bool split) {
+  const btAlignedObjectArray<btSolverBody>& bodies = *in_.bodies;
+  const btSolverConstraint& c = *all_[i];
+  const int a = rowBodies_[i].first, b = rowBodies_[i].second;
   // One side's Jacobian block: [n * linearFactor; r x n].
   auto jacobian = [](Vector6& j, const btVector3& normal, const btVector3& linearFactor,
                      const btVector3& torqueAxis) {
@@ -147,113 +201,146 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
       j[3 + k] = torqueAxis[k];
     }
   };
+  out.bodyA = a >= 0 ? bodyLocal_[a] : -1;
+  out.bodyB = b >= 0 ? bodyLocal_[b] : -1;
+  if (a >= 0)
+    jacobian(out.jA, c.m_contactNormal1, bodies[c.m_solverBodyIdA].m_linearFactor,
+             c.m_relpos1CrossNormal);
+  else
+    out.jA.setZero();
+  if (b >= 0)
+    jacobian(out.jB, c.m_contactNormal2, bodies[c.m_solverBodyIdB].m_linearFactor,
+             c.m_relpos2CrossNormal);
+  else
+    out.jB.setZero();
+  // rhs and cfm are stored pre-multiplied by 1 / A_ii; undo it (as btMLCPSolver does).
+  const double jd = c.m_jacDiagABInv;
+  const bool scaled = !btFuzzyZero(c.m_jacDiagABInv);
+  out.b = scaled ? -c.m_rhs / jd : 0.0;
+  const double splitB = scaled ? -c.m_rhsPenetration / jd : 0.0;
+  if (cfm_ == CfmModel::StockMlcp)
+    out.cfm = stockCfm_;
+  else
+    out.cfm = scaled ? std::max(0.0, c.m_cfm / jd) : 0.0;
+  if (cfm_ == CfmModel::Regularized && findex_[i] >= 0 && out.cfm == 0) out.cfm = stockCfm_;
+  out.findex = findex_[i] >= 0 ? rowLocal_[findex_[i]] : -1;
+  if (findex_[i] >= 0) {
+    out.lo = -std::abs(static_cast<double>(c.m_friction));
+    out.hi = std::abs(static_cast<double>(c.m_friction));
+  } else if (i >= nj_) {  // contact
+    out.lo = 0;
+    out.hi = kInf;
+  } else {
+    out.lo = bound(c.m_lowerLimit);
+    out.hi = bound(c.m_upperLimit);
+  }
+  const bool warm = start_ != Start::Zero;
+  if (split) {
+    out.b = splitB;
+    out.base = static_cast<double>(c.m_appliedPushImpulse);
+    out.start = warm ? out.base : 0.0;
+    return;
+  }
+  Island& isl = islands_[rowIsland_[i]];
+  if (splitB != 0) isl.hasSplit = true;
+  out.base = static_cast<double>(c.m_appliedImpulse);
+  const double unscale = i >= nj_ ? unscaleContacts_ : 1.0;
+  out.start = warm ? unscale * out.base : 0.0;
+  const btManifoldPoint* point = isl.point[rowLocal_[i]];
+  if (point && start_ == Start::CachedImpulse) {
+    const bool contact = i < nj_ + nc_;
+    if (const auto* last = static_cast<const Remembered*>(isl.last[rowLocal_[i]])) {
+      out.start = contact ? last->normal : last->friction.dot(frictionDirection(c));
+    } else if (!contact && lateralCache_) {
+      const bool first = i - nj_ - nc_ == (*in_.contacts)[c.m_frictionIndex].m_frictionIndex;
+      out.start = first ? point->m_appliedImpulseLateral1 : point->m_appliedImpulseLateral2;
+    }
+  }
+}
 
-  const double stockCfm = info.m_globalCfm / info.m_timeStep;
-  // SI starts contacts and friction from the cached impulse times m_warmstartingFactor (0.85); a
-  // solver that can use a guess gets the cached impulse itself.
-  const double unscaleContacts = (start == Start::CachedImpulse && info.m_warmstartingFactor > 0 &&
-                                  (info.m_solverMode & SOLVER_USE_WARMSTARTING))
-                                     ? 1.0 / info.m_warmstartingFactor
-                                     : 1.0;
-  const bool warm = start != Start::Zero;
-  // Bullet 3's setup starts every friction row at 0 (setFrictionConstraintImpulse); the impulse
-  // it wrote back last step (m_appliedImpulseLateral1/2, kept with the manifold point) is the
-  // warm start, when the friction directions persist between steps.
-  const bool lateralCache =
-      start == Start::CachedImpulse && (info.m_solverMode & SOLVER_USE_WARMSTARTING) &&
-      (info.m_solverMode & (SOLVER_ENABLE_FRICTION_DIRECTION_CACHING |
-                            SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION));
-  // Last step's answer at this manifold point, if it is the same point (see remember()).
-  auto remembered = [&](const btManifoldPoint& point) -> const Remembered* {
-    const auto last = last_.find(&point);
-    if (last == last_.end() ||
-        (point.m_localPointA - last->second.localA).length() >= gContactBreakingThreshold)
-      return nullptr;
-    return &last->second;
-  };
-  for (int i = 0; i < n; ++i) {
-    if (rowIsland_[i] < 0) continue;
-    Island& isl = islands_[rowIsland_[i]];
-    RowSystem& s = isl.system;
-    const int r = rowLocal_[i];
-    btSolverConstraint& c = *all_[i];
-    isl.rows[r] = &c;
-    ConstraintRow& row = s.rows[r];
-    row.bodyA = localBody(isl, rowBodies_[i].first);
-    row.bodyB = localBody(isl, rowBodies_[i].second);
-    if (row.bodyA >= 0)
-      jacobian(row.jA, c.m_contactNormal1, bodies[c.m_solverBodyIdA].m_linearFactor,
-               c.m_relpos1CrossNormal);
-    else
-      row.jA.setZero();
-    if (row.bodyB >= 0)
-      jacobian(row.jB, c.m_contactNormal2, bodies[c.m_solverBodyIdB].m_linearFactor,
-               c.m_relpos2CrossNormal);
-    else
-      row.jB.setZero();
-    // rhs and cfm are stored pre-multiplied by 1 / A_ii; undo it (as btMLCPSolver does).
-    const double jd = c.m_jacDiagABInv;
-    const bool scaled = !btFuzzyZero(c.m_jacDiagABInv);
-    s.b[r] = scaled ? -c.m_rhs / jd : 0.0;
-    isl.splitB[r] = scaled ? -c.m_rhsPenetration / jd : 0.0;
-    if (isl.splitB[r] != 0) isl.hasSplit = true;
-    if (cfm == CfmModel::StockMlcp)
-      s.cfm[r] = stockCfm;
-    else
-      s.cfm[r] = scaled ? std::max(0.0, c.m_cfm / jd) : 0.0;
-    if (cfm == CfmModel::Regularized && findex_[i] >= 0 && s.cfm[r] == 0) s.cfm[r] = stockCfm;
-    s.findex[r] = findex_[i] >= 0 ? rowLocal_[findex_[i]] : -1;
-    if (findex_[i] >= 0) {
-      s.lo[r] = -std::abs(static_cast<double>(c.m_friction));
-      s.hi[r] = std::abs(static_cast<double>(c.m_friction));
-    } else if (i >= nj) {  // contact
-      s.lo[r] = 0;
-      s.hi[r] = kInf;
-    } else {
-      s.lo[r] = bound(c.m_lowerLimit);
-      s.hi[r] = bound(c.m_upperLimit);
-    }
-    const double unscale = i >= nj ? unscaleContacts : 1.0;
-    isl.start[r] = warm ? unscale * static_cast<double>(c.m_appliedImpulse) : 0.0;
-    if (i >= nj && i < nj + nc + nf) {  // a contact or friction row
-      const bool contact = i < nj + nc;
-      const auto* point = static_cast<const btManifoldPoint*>(
-          contact ? c.m_originalContactPoint
-                  : (*in.contacts)[c.m_frictionIndex].m_originalContactPoint);
-      isl.point[r] = point;
-      if (point && start == Start::CachedImpulse) {
-        if (const Remembered* last = remembered(*point)) {
-          isl.start[r] = contact ? last->normal : last->friction.dot(frictionDirection(c));
-        } else if (!contact && lateralCache) {
-          const bool first = i - nj - nc == (*in.contacts)[c.m_frictionIndex].m_frictionIndex;
-          isl.start[r] = first ? point->m_appliedImpulseLateral1 : point->m_appliedImpulseLateral2;
-        }
-      }
-    }
-    isl.splitStart[r] = warm ? static_cast<double>(c.m_appliedPushImpulse) : 0.0;
+void IslandBuilder::fill(Island& island, int first, int count, RowPgs::Row* out, bool split) {
+  for (int j = 0; j < count; ++j) convert(island.rowIndex[first + j], out[j], split);
+}
+
+void IslandBuilder::fillSystem(Island& isl) {
+  if (isl.filled) return;
+  isl.filled = true;
+  const int m = static_cast<int>(isl.rows.size());
+  // toSystem replaces bodies and findex with the same values.
+  const std::vector<BodyInverseMass> bodies = isl.system.bodies;
+  RowPgs::toSystem(
+      bodies, m,
+      [&](int first, int count, RowPgs::Row* out) { fill(isl, first, count, out, false); },
+      isl.system, isl.start);
+  isl.splitB.resize(m);
+  isl.splitStart.resize(m);
+  RowPgs::Row push;
+  for (int r = 0; r < m; ++r) {
+    convert(isl.rowIndex[r], push, true);
+    isl.splitB[r] = push.b;
+    isl.splitStart[r] = push.start;
   }
 }
 
 void IslandBuilder::newStep() {
-  last_.swap(this_);
+  std::swap(last_, this_);
   this_.clear();
+  cursor_ = 0;
+  indexed_ = false;
 }
 
 void IslandBuilder::remember(const Island& island, const Vector& x) {
-  for (int r = 0; r < static_cast<int>(island.point.size()); ++r) {
+  const int n = static_cast<int>(island.point.size());
+  entry_.assign(n, -1);
+  for (int r = 0; r < n; ++r) {
     const btManifoldPoint* point = island.point[r];
     if (!point) continue;
-    auto [it, added] = this_.try_emplace(point);
-    Remembered& m = it->second;
-    if (added) {
+    // A friction row's point is its contact row's (earlier in the island): the same entry.
+    const int f = island.system.findex[r];
+    int e = f >= 0 ? entry_[f] : -1;
+    if (e < 0) {
+      e = static_cast<int>(this_.size());
+      this_.emplace_back();
+      Remembered& m = this_.back();
+      m.point = point;
       m.friction.setZero();
       m.localA = point->m_localPointA;
+      entry_[r] = e;
     }
-    if (island.system.findex[r] < 0)
+    Remembered& m = this_[e];
+    if (f < 0)
       m.normal = x[r];
     else
       m.friction += static_cast<btScalar>(x[r]) * frictionDirection(*island.rows[r]);
   }
+}
+
+const IslandBuilder::Remembered* IslandBuilder::lookup(const btManifoldPoint* point) {
+  if (cursor_ < last_.size() && last_[cursor_].point == point) return &last_[cursor_++];
+  // Fibonacci hashing of the address into a table at most half full.
+  auto home = [&](const btManifoldPoint* p) {
+    const auto h =
+        static_cast<std::uint64_t>(reinterpret_cast<std::uintptr_t>(p)) * 0x9E3779B97F4A7C15ull;
+    return static_cast<std::size_t>(h >> 32) & (index_.size() - 1);
+  };
+  if (!indexed_) {
+    indexed_ = true;
+    std::size_t size = 64;
+    while (size < 2 * last_.size()) size *= 2;
+    index_.assign(size, {nullptr, -1});
+    for (int e = 0; e < static_cast<int>(last_.size()); ++e) {
+      std::size_t k = home(last_[e].point);
+      while (index_[k].first && index_[k].first != last_[e].point) k = (k + 1) & (size - 1);
+      index_[k] = {last_[e].point, e};  // a point met twice: its later entry
+    }
+  }
+  for (std::size_t k = home(point); index_[k].first; k = (k + 1) & (index_.size() - 1)) {
+    if (index_[k].first == point) {
+      cursor_ = static_cast<std::size_t>(index_[k].second) + 1;
+      return &last_[index_[k].second];
+    }
+  }
+  return nullptr;
 }
 
 }  // namespace mlcp::bullet

@@ -17,6 +17,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -111,6 +112,36 @@ class RowPgs {
   // Solve from x (used when options().warmStart and x has the right size, else from zero).
   Result solve(const RowSystem& system, Vector& x);
 
+  // Packing straight from an engine's own rows, without a RowSystem copy (one pass where the
+  // adapter would otherwise write a RowSystem and the packing read it back). The rows are
+  // fetched in order, in batches: fill(first, count, out) writes rows first .. first+count-1.
+  // Each row is packed bitwise as solve(RowSystem) packs the same values, and validated by the
+  // same rules as it is packed; when a row is invalid or has A_ii <= 0 the rows are fetched once
+  // more into a RowSystem and solve(RowSystem) gives the answer and the message (the slow path).
+  // x is output only (size rows): it starts from the rows' `start` (from zero without
+  // options().warmStart or with a non-finite start).
+  struct Row {
+    int bodyA = -1, bodyB = -1;  // indices into bodies, -1 = world
+    Vector6 jA, jB;              // [linear; angular] Jacobian blocks
+    double b = 0, cfm = 0, lo = 0, hi = 0;
+    int findex = -1;
+    double start = 0;  // x_i's warm start
+    double base = 0;   // the part of x_i the engine's bodies already carry (velocityChange)
+  };
+  using RowFill = std::function<void(int first, int count, Row* out)>;
+  Result solve(const std::vector<BodyInverseMass>& bodies, int rows, const RowFill& fill,
+               Vector& x);
+  // After solve(bodies, rows, fill, x) took the fast path: body k's M^-1 J^T (x - base),
+  // [linear; angular], from the velocities the sweeps maintain (what an engine adds to its
+  // body's velocity to apply the answer, instead of one impulse per row). velocityChanges()
+  // is false after the slow path or solve(RowSystem).
+  bool velocityChanges() const { return baseValid_; }
+  // The rows fill gives, as a RowSystem with these bodies, and their starts: the slow path's
+  // copy, for callers that need a RowSystem after all.
+  static void toSystem(const std::vector<BodyInverseMass>& bodies, int rows, const RowFill& fill,
+                       RowSystem& system, Vector& start);
+  Vector6 velocityChange(int body) const { return velocity_[body].v - base_[body].v; }
+
  private:
   // Everything the sweep reads per row, in one stream: bodies remapped so that "the world" is
   // a zero-velocity slot (no branches in the inner loop), M^-1 J^T, and the update
@@ -136,13 +167,37 @@ class RowPgs {
   };
   // Zero-velocity slots standing for "the world", taken by ground rows in turn.
   static constexpr int kWorldSlots = 8;
+  // Longest run of rows on the same two bodies swept as one (longer ones are split): its
+  // couplings take (kMaxRun - 1) kMaxRun / 2 numbers. 8 = a box face's 4 contacts' friction rows.
+  static constexpr int kMaxRun = 8;
   // w = J v + cfm x + b for every row, from the maintained velocities (see above).
-  void slackFromVelocities(const RowSystem& system, const Vector& x);
+  void slackFromVelocities(const Vector& x);
+  // Fills packed_ and velocity_ from rowAt(i) (rows.cpp); false at the first invalid row or
+  // non-positive A_ii (bad_, badDiagonal_ say which).
+  template <class RowAt>
+  bool pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& rowAt, bool warm, double* x,
+            bool withBase);
+  // The sweeps and checks on packed_ from x; lo, hi, findex and bNorm for the check.
+  Result iterate(Vector& x, const Vector& lo, const Vector& hi, const std::vector<int>& findex,
+                 double bNorm, double t0);
 
   Options options_;
   std::vector<PackedRow> packed_;  // reused between solves
-  std::vector<BodyVelocity> velocity_;
+  // Per row 1 / step, for the check only (kept apart: the sweep's stream stays 240 bytes a row):
+  // w_i = scale_i ((1 - keep) x_i + shift + sA va + sB vb).
+  std::vector<double> scale_;
+  // Per row of a run after its first, its couplings to the run's earlier rows k, in row order:
+  // step_i J_i M^-1 J_k^T (sA_i . mA_k + sB_i . mB_k).
+  std::vector<double> coupling_;
+  std::vector<BodyVelocity> velocity_, base_;
   Vector w_;
+  // The engine path's copies of what the check reads (the RowSystem path reads the system's).
+  Vector lo_, hi_;
+  std::vector<int> findex_;
+  std::vector<Row> batch_;
+  bool baseValid_ = false;
+  int bad_ = -1;            // the row that stopped pack()
+  double badDiagonal_ = 0;  // its A_ii, or NaN when the row was invalid
 };
 
 }  // namespace mlcp

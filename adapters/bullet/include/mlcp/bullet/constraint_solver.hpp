@@ -155,6 +155,7 @@ struct StepStats {
   int failures = 0;            // islands whose returned answer is still rejected
   std::string message;         // why the first rejected answer was rejected ("" if none)
   ChoiceCounts choices;        // which solver answered, per island ("dantzig:3 ldlt:1")
+  int packedIslands = 0;       // of `islands`: "pgs" answers packed straight from Bullet's rows
 };
 
 class ConstraintSolver : public btSequentialImpulseConstraintSolver {
@@ -171,7 +172,11 @@ class ConstraintSolver : public btSequentialImpulseConstraintSolver {
   // With Settings::keepIslands: the problems of the last step.
   const std::vector<IslandRecord>& islands() const { return records_; }
   // The shared island solver (null with "si"): its capture hook writes each island's problem.
-  RowSolver* rowSolver() { return rows_.get(); }
+  // Once it has been asked for, "pgs" islands go through it too (see fastPgs below).
+  RowSolver* rowSolver() {
+    shared_ = true;
+    return rows_.get();
+  }
 
   void prepareSolve(int numBodies, int numManifolds) override;
   void allSolved(const btContactSolverInfo& info, btIDebugDraw* debugDrawer) override;
@@ -185,6 +190,9 @@ class ConstraintSolver : public btSequentialImpulseConstraintSolver {
 
  private:
   void solveIsland(Island& island, std::uint64_t key, bool split);
+  // "pgs" packed straight from Bullet's rows and written back per body; false when the answer
+  // was not accepted (the island then goes through rows_ like every other solver).
+  bool solveIslandFast(Island& island, bool split);
   void measureSi(int sweeps);
   void record(const Result& r, int rows, const std::string& choice);
   void finishStep();
@@ -192,6 +200,11 @@ class ConstraintSolver : public btSequentialImpulseConstraintSolver {
   Settings settings_;
   std::unique_ptr<RowSolver> rows_;
   bool si_ = false;
+  // "pgs" islands skip the RowSystem copy and RowSolver (solver "pgs", no keepIslands, and
+  // nobody asked for rowSolver()); same iterates, same verification rule (acceptable()).
+  bool fastPgs_ = false;
+  bool shared_ = false;
+  RowPgs pgs_;
   IslandBuilder builder_;
   StepStats current_, last_, totals_;
   bool stepOpen_ = false;

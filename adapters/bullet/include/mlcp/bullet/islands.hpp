@@ -12,13 +12,16 @@
 //
 // Two passes over Bullet's rows (288 bytes each, in double precision): the first reads only the
 // body indices (union-find; each row's dynamic bodies kept in a compact array for the island
-// numbering), the second converts each row into its island. ~40 ns a row (210-box pyramid),
-// mostly first touches of Bullet's rows and the scattered writes of the RowSystem's arrays.
+// numbering, which also lists each island's rows, bodies and manifold points), the second
+// converts each row: into its island's RowSystem (build with system = true, or fillSystem
+// later), or straight into RowPgs' packing through fill() (the "pgs" path: no RowSystem copy).
+// Both write the same values (one conversion function). The RowSystem copy cost ~40 ns a row
+// (210-box pyramid), mostly first touches of Bullet's rows and the scattered writes of its
+// arrays.
 #pragma once
 
 #include <BulletDynamics/ConstraintSolver/btSequentialImpulseConstraintSolver.h>
 
-#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -41,8 +44,13 @@ enum class Start {
 };
 
 struct Island {
-  RowSystem system;                       // w = A x + b with b from m_rhs
+  // w = A x + b with b from m_rhs. Its bodies and findex are always filled; the rest only with
+  // build(..., system = true) or after fillSystem() (`filled`).
+  RowSystem system;
+  bool filled = false;
   std::vector<btSolverConstraint*> rows;  // Bullet's row for each system row
+  std::vector<int> rowIndex;              // the builder's index of each row (for fill())
+  std::vector<int> solverBody;            // Bullet's solver body of each system body
   Vector start;                           // applied impulses (warm start)
   Vector splitB;                          // b of the split-impulse problem (m_rhsPenetration)
   Vector splitStart;                      // applied push impulses
@@ -50,6 +58,10 @@ struct Island {
   // Each contact and friction row's manifold point (null for other rows), for
   // IslandBuilder::remember.
   std::vector<const btManifoldPoint*> point;
+  // Each contact and friction row's remembered answer from last step (null: none), found once
+  // per point by build().
+  std::vector<const void*> last;
+  int points = 0;  // contact rows with a manifold point
 };
 
 // The pools of one solveGroup call, as btSequentialImpulseConstraintSolver holds them.
@@ -64,7 +76,17 @@ struct BulletRows {
 class IslandBuilder {
  public:
   // Splits the rows into islands. globalCfm and timeStep feed CfmModel::StockMlcp and Regularized.
-  void build(const BulletRows& rows, const btContactSolverInfo& info, CfmModel cfm, Start start);
+  // With system = false only each island's bodies, findex, rows and points are written; the
+  // rows reach a solver through fill() or fillSystem().
+  void build(const BulletRows& rows, const btContactSolverInfo& info, CfmModel cfm, Start start,
+             bool system = true);
+  // Rows first .. first+count-1 of the island as RowPgs takes them (the same values fillSystem
+  // writes; split: b from m_rhsPenetration, the applied push impulse as start and base); base is
+  // the impulse Bullet's bodies already carry (m_appliedImpulse / m_appliedPushImpulse). The
+  // primary problem's fill sets island.hasSplit.
+  void fill(Island& island, int first, int count, RowPgs::Row* out, bool split);
+  // The island's RowSystem, start, splitB and splitStart (once per build).
+  void fillSystem(Island& island);
 
   // Warm start across steps from our own answers, per manifold point. Bullet 3 starts friction
   // rows at 0, and with its default velocity-dependent friction direction a row's direction
@@ -88,6 +110,8 @@ class IslandBuilder {
 
  private:
   int find(int k);
+  // Global row i's values; split: the split-impulse problem's b, start and base.
+  void convert(int i, RowPgs::Row& out, bool split);
 
   std::vector<Island> islands_;
   int count_ = 0, inert_ = 0;
@@ -95,12 +119,30 @@ class IslandBuilder {
   std::vector<int> findex_, dynamic_, parent_, islandOfRoot_, rowIsland_, rowLocal_, bodyLocal_;
   std::vector<int> bodyCount_;
   std::vector<std::pair<int, int>> rowBodies_;  // each row's dynamic bodies (-1: none)
+  // What convert() needs of the last build() call.
+  BulletRows in_;
+  CfmModel cfm_{};
+  Start start_ = Start::Zero;
+  int nj_ = 0, nc_ = 0, nf_ = 0;
+  double stockCfm_ = 0, unscaleContacts_ = 1;
+  bool lateralCache_ = false;
   struct Remembered {
+    const btManifoldPoint* point = nullptr;
     double normal = 0;   // the contact row's impulse
     btVector3 friction;  // world-space friction impulse on body A
     btVector3 localA;    // the point's m_localPointA when remembered
   };
-  std::unordered_map<const btManifoldPoint*, Remembered> last_, this_;
+  // Last step's entry for this point, or null. Points come in nearly the same order every step
+  // (manifolds and their point slots persist), so the entry after the last one found is tried
+  // first; only a miss builds the address index over last_ (once per step). (An
+  // std::unordered_map cleared every step allocated a node per point per step, and a hash
+  // table probed per point cost a cache miss per lookup.)
+  const Remembered* lookup(const btManifoldPoint* point);
+  std::vector<Remembered> last_, this_;  // in the order remember() met the points
+  std::size_t cursor_ = 0;               // where lookup() tries first
+  bool indexed_ = false;                 // index_ holds last_
+  std::vector<std::pair<const btManifoldPoint*, int>> index_;  // open addressing, null = empty
+  std::vector<int> entry_;  // remember(): each contact row's entry in this_
 };
 
 }  // namespace mlcp::bullet
