@@ -753,7 +753,11 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
   // (ODE) settle in one step there, often sooner than from a warm guess whose sets are off by
   // a few rows; when they do not settle the trial is dropped (its iterate is a worse start than
   // none: synthetic pyramids from cold), so it costs at most autoColdSteps factorizations.
-  if (params_.blockStage == DantzigParams::BlockStage::Auto) {
+  // A guess within kTrustedGuess (an engine's own last answers at rest) skips it: its sets are
+  // right up to a few rows, where the cold sets are not (Bullet's resting pyramid).
+  const bool trusted = warm && params_.blockStage == DantzigParams::BlockStage::Auto &&
+                       residual(problem, x) <= kTrustedGuess;
+  if (params_.blockStage == DantzigParams::BlockStage::Auto && !trusted) {
     Vector trial = Vector::Zero(problem.size());
     const detail::BlockPivoting::Report rep =
         block_->run(problem, trial, options(),
@@ -767,7 +771,7 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
     }
     blockMessage = "cold trial: " + rep.message;
   }
-  const bool warmStage = warm && problem.size() >= params_.autoWarmMinRows;
+  const bool warmStage = warm && (trusted || problem.size() >= params_.autoWarmMinRows);
   const bool blockIterate = warmStage || params_.blockStage == DantzigParams::BlockStage::Always;
   if (blockIterate) {
     const detail::BlockPivoting::Report rep =

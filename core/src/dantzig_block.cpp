@@ -406,6 +406,42 @@ int BlockPivoting::setsAt(const Problem& pb, const Vector& x, const Vector& w) {
   return changed;
 }
 
+// mirror_ for a new pattern of A. Rows are visited in increasing order, so with sorted rows and a
+// symmetric pattern the next unvisited entry of row j is (j, i) when (i, j) is visited.
+void BlockPivoting::mirrorPattern() {
+  const SparseMatrix& A = *a_;
+  const int n = static_cast<int>(A.outerSize());
+  const int* outer = A.outerIndexPtr();
+  const int* inner = A.innerIndexPtr();
+  mirror_.clear();
+  if (!A.isCompressed()) return;
+  mirror_.resize(A.nonZeros());
+  std::vector<int> next(outer, outer + n);
+  for (int i = 0; i < n; ++i)
+    for (int k = outer[i]; k < outer[i + 1]; ++k) {
+      const int j = inner[k];
+      const int m = next[j]++;
+      if ((k > outer[i] && inner[k - 1] >= j) || m >= outer[j + 1] || inner[m] != i) {
+        mirror_.clear();
+        return;
+      }
+      mirror_[k] = m;
+    }
+}
+
+// Whether A = A^T to 1e-14 relative to its largest entry (isSymmetric's test) on a mirrored
+// pattern: one pass over the values, no transposed copy (which cost ~2 ms per step at n = 1160).
+bool BlockPivoting::symmetricValues() const {
+  const double* v = a_->valuePtr();
+  const int nz = static_cast<int>(a_->nonZeros());
+  double scale = 1, gap = 0;
+  for (int k = 0; k < nz; ++k) {
+    scale = std::max(scale, std::abs(v[k]));
+    gap = std::max(gap, std::abs(v[k] - v[mirror_[k]]));
+  }
+  return gap <= 1e-14 * scale;
+}
+
 BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Options& opt,
                                          int maxSteps, bool trial, bool symmetryKnown) {
   Report rep;
@@ -416,12 +452,6 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
     A_ = pb.toSparse();
     a_ = &A_;
   }
-  if (!symmetryKnown && !isSymmetric(*a_)) {
-    rep.message = "A is not symmetric";
-    return rep;
-  }
-  rep.symmetric = true;
-  problemFindex_ = pb.findex.empty() ? std::vector<int>(n, -1) : pb.findex;
   // A fill-reducing order of all of A; every clamped block is factored in the induced order,
   // whose fill is at most A's, so the ordering is computed once per pattern of A.
   if (!aPattern_.same(*a_)) {
@@ -430,7 +460,14 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
     Eigen::AMDOrdering<int>()(pattern, perm);
     byRank_.assign(perm.indices().data(), perm.indices().data() + n);
     aPattern_.remember(*a_);
+    mirrorPattern();
   }
+  if (!symmetryKnown && !(mirror_.empty() ? isSymmetric(*a_) : symmetricValues())) {
+    rep.message = "A is not symmetric";
+    return rep;
+  }
+  rep.symmetric = true;
+  problemFindex_ = pb.findex.empty() ? std::vector<int>(n, -1) : pb.findex;
   double dMax = 0;
   for (int i = 0; i < n; ++i) dMax = std::max(dMax, std::abs(pb.diagonal(i)));
   pivTol_ = opt.pivotTolerance * (dMax > 0 ? dMax : 1.0);

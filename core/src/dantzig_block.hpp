@@ -66,9 +66,15 @@ class BlockPivoting {
   double meritAt(const Problem& pb, const Vector& x, const Vector& w) const;
   double frictionBound(const Problem& pb, int t, Set s, const Vector& x) const;
 
+  void mirrorPattern();
+  bool symmetricValues() const;
+
   SparseMatrix A_;  // row-major copy when the problem is stored dense
   const SparseMatrix* a_ = nullptr;
   PatternCache aPattern_, kPattern_;
+  // Per entry of A's pattern the index of its mirror entry (j, i), computed with the ordering;
+  // empty when the pattern is not symmetric or a row is not sorted (then isSymmetric decides).
+  std::vector<int> mirror_;
   std::vector<int> byRank_;         // the rows in a fill-reducing order of A
   std::vector<int> problemFindex_;  // findex, -1 filled
   std::vector<Set> set_;

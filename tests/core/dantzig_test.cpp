@@ -543,6 +543,59 @@ TEST(DantzigBlock, AutoColdTrialSettlesOrIsDropped) {
   }
 }
 
+// Auto with a guess already close to the answer (an engine's own last answers at rest) skips
+// the cold trial: the guess that solves the problem costs no factorization at all, a guess
+// from the previous time step settles in the block stage alone.
+TEST(DantzigBlock, AutoTrustedGuessSkipsTheColdTrial) {
+  test::PyramidSpec spec;
+  spec.levels = 5;
+  test::BoxPyramid pyramid(spec);
+  DantzigSolver autoStage = withStage(DantzigParams::BlockStage::Auto);
+  autoStage.options().tolerance = 1e-12;
+  const Problem p0 = pyramid.rows().assemble(true);
+  ASSERT_GE(p0.size(), autoStage.params().autoMinRows);
+  ASSERT_LT(p0.size(), autoStage.params().autoWarmMinRows);
+  DantzigSolver dense = withStage(DantzigParams::BlockStage::Never);
+  dense.options().tolerance = 1e-13;
+  Vector x, y;
+  ASSERT_TRUE(dense.solve(p0, x).converged());
+  ASSERT_TRUE(autoStage.solveWithGuess(p0, x, y).converged());
+  EXPECT_EQ(autoStage.blockSteps(), 0);
+  EXPECT_TRUE(autoStage.blockSettled());
+  pyramid.nextStep(1e-4);
+  const Problem p1 = pyramid.rows().assemble(true);
+  ASSERT_LE(residual(p1, x), 1e-2);
+  const Result r = autoStage.solveWithGuess(p1, x, y);
+  ASSERT_TRUE(r.converged()) << r.message;
+  EXPECT_LE(accuracy(p1, y).residual, 1e-12);
+  EXPECT_TRUE(autoStage.blockSettled()) << r.message;
+  EXPECT_EQ(r.message.find("cold trial"), std::string::npos) << r.message;
+}
+
+// The block stage runs only on a symmetric A: values made nonsymmetric on the same (symmetric)
+// pattern are refused, and the pivoting still answers.
+TEST(DantzigBlock, NonsymmetricValuesOnASymmetricPatternSkipTheStage) {
+  test::PyramidSpec spec;
+  spec.levels = 4;
+  const Problem symmetric = test::BoxPyramid(spec).rows().assemble(true);
+  DantzigSolver s = withStage(DantzigParams::BlockStage::Always);
+  Vector x;
+  ASSERT_TRUE(s.solve(symmetric, x).converged());
+  EXPECT_GT(s.blockSteps(), 0);
+  SparseMatrix A = symmetric.sparseA();
+  for (int i = 0; i < A.outerSize(); ++i)
+    for (SparseMatrix::InnerIterator it(A, i); it; ++it)
+      if (it.index() > i) it.valueRef() *= 1 + 1e-9;
+  Problem skewed = symmetric;
+  skewed.setA(A);
+  const Result r = s.solve(skewed, x);
+  ASSERT_TRUE(r.converged()) << r.message;
+  EXPECT_EQ(s.blockSteps(), 0);
+  EXPECT_LE(accuracy(skewed, x).residual, 1e-9);
+  ASSERT_TRUE(s.solve(symmetric, x).converged());  // same pattern again: the stage runs
+  EXPECT_GT(s.blockSteps(), 0);
+}
+
 // Sliding contacts (sideways velocities) exercise the sliding rows' low-rank update.
 TEST(DantzigBlock, SlidingPyramidWarmStart) {
   test::PyramidSpec spec;

@@ -145,10 +145,11 @@ class BlockPivoting;
 // Parameters of DantzigSolver beyond Options (see "Block stage" above).
 struct DantzigParams {
   enum class BlockStage {
-    // n >= autoMinRows and at most autoMaxDensity n^2 nonzeros in A: first a trial of
-    // autoColdSteps from the cold guess (dropped when it does not settle), then warm starts with
-    // n >= autoWarmMinRows get up to maxBlockSteps from their guess; the others pivot from
-    // their guess (cold starts: from zero).
+    // n >= autoMinRows and at most autoMaxDensity n^2 nonzeros in A: a warm guess whose
+    // residual is within 1e-2 (an engine's own last answers at rest) gets up to maxBlockSteps
+    // from it at once; otherwise first a trial of autoColdSteps from the cold guess (dropped
+    // when it does not settle), then warm starts with n >= autoWarmMinRows get up to
+    // maxBlockSteps from their guess; the others pivot from their guess (cold: from zero).
     Auto,
     Always,  // whenever it applies (Exact friction, symmetric A), cold starts too
     Never,   // incremental pivoting only (the dense path)
