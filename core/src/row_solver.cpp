@@ -173,9 +173,13 @@ Result RowSolver::run(const RowSystem& rows, const std::string& name, const Opti
   // Every assembled-problem solver follows the storage (ldlt: dense or sparse LDL^T).
   const bool sparse = rows.size() > settings_.denseMaxRows;
   if (!haveAssembled_ || assembled_.isSparse() != sparse) {
-    const double t0 = since > 0 ? since : nowSeconds();
-    assemble(rows, sparse);
-    report.assembleSeconds += nowSeconds() - t0;
+    if (settings_.timeAssembly) {
+      const double t0 = since > 0 ? since : nowSeconds();
+      assemble(rows, sparse);
+      report.assembleSeconds += nowSeconds() - t0;
+    } else {
+      assemble(rows, sparse);
+    }
   }
   Solver* solver = assembledSolver(island, name);
   solver->setOptions(o);
