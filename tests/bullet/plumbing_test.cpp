@@ -229,9 +229,13 @@ TEST(BulletPlumbing, PgsPackedFromBulletsRowsMatchesThePgsOfTheRowSolver) {
       EXPECT_NEAR(a.residual, b.residual, 1e-9 * (1 + b.residual)) << "step " << i;
       EXPECT_EQ(a.choices.toString(), b.choices.toString()) << "step " << i;
       EXPECT_LT(stateDifference(fast, copied), 1e-9) << "step " << i;
-      pushed += a.islands > a.groups;
+      // At most two components (the pyramid, the sunk box): more islands are split-impulse
+      // problems.
+      pushed += a.islands > 2;
     }
-    if (split) EXPECT_GT(pushed, 0);  // split-impulse problems were solved
+    if (split) {
+      EXPECT_GT(pushed, 0);  // split-impulse problems were solved
+    }
   }
 }
 
