@@ -127,16 +127,24 @@ void RowSolver::setCapture(const std::string& prefix) {
 }
 
 RowSolver::Slot& RowSolver::slot(std::uint64_t key) {
+  // The same island as last time (one island, or a run of steps of it): no hash lookup.
+  if (lastSlot_ && key == lastKey_) {
+    lastSlot_->lastUse = calls_;
+    return *lastSlot_;
+  }
   auto it = slots_.find(key);
   if (it == slots_.end()) {
     if (slots_.size() >= kSlotLimit) {
       // Forget islands that have not been solved for a while (they merged, split or slept).
+      lastSlot_ = nullptr;
       for (auto old = slots_.begin(); old != slots_.end();)
         old = old->second->lastUse + kSlotLimit < calls_ ? slots_.erase(old) : std::next(old);
     }
     it = slots_.emplace(key, std::make_unique<Slot>()).first;
   }
   it->second->lastUse = calls_;
+  lastKey_ = key;
+  lastSlot_ = it->second.get();
   return *it->second;
 }
 

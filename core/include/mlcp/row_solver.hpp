@@ -218,6 +218,8 @@ class RowSolver {
   double solveStart_ = 0;  // the current solve's start, until its primary's run() reads it
   Vector xFallback_;
   std::unordered_map<std::uint64_t, std::unique_ptr<Slot>> slots_;
+  std::uint64_t lastKey_ = 0;  // the key of lastSlot_
+  Slot* lastSlot_ = nullptr;   // the island solved last (slots_ owns it)
   std::uint64_t calls_ = 0;
   std::string capturePrefix_;
   std::vector<std::string> captured_;
