@@ -741,14 +741,14 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
     runPivoting(problem, x, result, false);
     return;
   }
+  std::string blockMessage;
   auto settle = [&](const detail::BlockPivoting::Report& rep) {
     blockSettled_ = true;
     ws.passes = 1;
     result.status = Status::Converged;
     result.iterations = blockSteps_;
-    result.message = rep.message;
+    result.message = blockMessage.empty() ? rep.message : blockMessage + "; " + rep.message;
   };
-  std::string blockMessage;
   bool symmetric = false;  // known after a first run of the block stage
   // Auto first tries a few full steps from the cold guess (every row clamped): resting piles
   // (ODE) settle in one step there, often sooner than from a warm guess whose sets are off by
@@ -756,15 +756,23 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
   // none: synthetic pyramids from cold), so it costs at most autoColdSteps factorizations.
   // A guess within kTrustedGuess (an engine's own last answers at rest) skips it: its sets are
   // right up to a few rows, where the cold sets are not (Bullet's resting pyramid).
-  const bool trusted = warm && params_.blockStage == DantzigParams::BlockStage::Auto &&
-                       residual(problem, x) <= kTrustedGuess;
-  if (params_.blockStage == DantzigParams::BlockStage::Auto && !trusted) {
+  // A warm solve also skips it while the last trial of this solver missed (an engine whose
+  // cold sets are never right: Bullet's moving pyramid), re-trying every autoColdRetry solves.
+  const bool autoStage = params_.blockStage == DantzigParams::BlockStage::Auto;
+  const bool trusted = warm && autoStage && residual(problem, x) <= kTrustedGuess;
+  bool coldTrial = autoStage && !trusted;
+  if (coldTrial && warm && coldMissed_ > 0) {
+    coldTrial = coldMissed_ % std::max(1, params_.autoColdRetry) == 0;
+    ++coldMissed_;
+  }
+  if (coldTrial) {
     Vector trial = Vector::Zero(problem.size());
     const detail::BlockPivoting::Report rep =
         block_->run(problem, trial, options(),
                     std::max(1, std::min(params_.autoColdSteps, params_.maxBlockSteps)), true);
     symmetric = rep.symmetric;
     blockSteps_ += rep.steps;
+    coldMissed_ = rep.settled ? 0 : 1;
     if (rep.settled) {
       x = trial;
       settle(rep);

@@ -572,6 +572,31 @@ TEST(DantzigBlock, AutoTrustedGuessSkipsTheColdTrial) {
   EXPECT_EQ(r.message.find("cold trial"), std::string::npos) << r.message;
 }
 
+// Auto's cold trial after a miss: warm solves of the same solver skip it until autoColdRetry
+// solves have passed (Bullet's moving pyramid never settles from the cold sets), then try again.
+TEST(DantzigBlock, AutoColdTrialAfterAMissIsRetriedEveryAutoColdRetrySolves) {
+  test::PyramidSpec spec;
+  spec.levels = 4;
+  spec.sideVelocity = 0.5;
+  test::BoxPyramid pyramid(spec);
+  pyramid.nextStep(1e-4);
+  const Problem p = pyramid.rows().assemble(true);
+  DantzigSolver autoStage = withStage(DantzigParams::BlockStage::Auto);
+  autoStage.params().autoColdRetry = 3;
+  Vector exact, x;
+  ASSERT_TRUE(withStage(DantzigParams::BlockStage::Never).solve(p, exact).converged());
+  const Vector guess = 0.5 * exact;  // a poor guess (residual above 1e-2)
+  ASSERT_GT(residual(p, guess), 1e-2);
+  for (int solve = 0; solve < 7; ++solve) {
+    const Result r = autoStage.solveWithGuess(p, guess, x);
+    ASSERT_TRUE(r.converged()) << r.message;
+    EXPECT_LE(accuracy(p, x).residual, autoStage.options().tolerance);
+    const bool tried = r.message.find("cold trial") != std::string::npos;
+    if (solve == 0) ASSERT_TRUE(tried) << "the cold trial settled: pick a scene where it misses";
+    EXPECT_EQ(tried, solve % 3 == 0) << "solve " << solve << ": " << r.message;
+  }
+}
+
 // The block stage runs only on a symmetric A: values made nonsymmetric on the same (symmetric)
 // pattern are refused, and the pivoting still answers.
 TEST(DantzigBlock, NonsymmetricValuesOnASymmetricPatternSkipTheStage) {
