@@ -187,11 +187,11 @@ bool ConstraintSolver::solveIslandFast(Island& island, bool split) {
       body.internalGetDeltaAngularVelocity() += angular;
     }
   }
-  for (int i = 0; i < n; ++i) {
-    btSolverConstraint& c = *island.rows[i];
-    (split ? c.m_appliedPushImpulse : c.m_appliedImpulse) = static_cast<btScalar>(x_[i]);
+  if (split) {
+    for (int i = 0; i < n; ++i) island.rows[i]->m_appliedPushImpulse = static_cast<btScalar>(x_[i]);
+  } else {
+    builder_.remember(island, x_, true);
   }
-  if (!split) builder_.remember(island, x_);
   return true;
 }
 

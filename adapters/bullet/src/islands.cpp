@@ -152,16 +152,15 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     const Remembered* last = nullptr;
     if (i >= nj && i < nj + nc + nf) {  // a contact or friction row
       const bool contact = i < nj + nc;
-      point = static_cast<const btManifoldPoint*>(
-          contact ? c.m_originalContactPoint
-                  : (*in.contacts)[c.m_frictionIndex].m_originalContactPoint);
       // Last step's answer at this manifold point, if it is the same point (see remember());
-      // a friction row's point is its contact row's.
+      // a friction row's point is its contact row's (listed already: contacts come first).
       if (!contact) {
+        point = isl.point[rowLocal_[findex_[i]]];
         last = static_cast<const Remembered*>(isl.last[rowLocal_[findex_[i]]]);
-      } else if (point) {
-        ++isl.points;
-        if (start == Start::CachedImpulse) {
+      } else {
+        point = static_cast<const btManifoldPoint*>(c.m_originalContactPoint);
+        if (point) ++isl.points;
+        if (point && start == Start::CachedImpulse) {
           last = lookup(point);
           if (last && (point->m_localPointA - last->localA).length() >= gContactBreakingThreshold)
             last = nullptr;
@@ -289,10 +288,11 @@ void IslandBuilder::newStep() {
   indexed_ = false;
 }
 
-void IslandBuilder::remember(const Island& island, const Vector& x) {
+void IslandBuilder::remember(const Island& island, const Vector& x, bool store) {
   const int n = static_cast<int>(island.point.size());
   entry_.assign(n, -1);
   for (int r = 0; r < n; ++r) {
+    if (store) island.rows[r]->m_appliedImpulse = static_cast<btScalar>(x[r]);
     const btManifoldPoint* point = island.point[r];
     if (!point) continue;
     // A friction row's point is its contact row's (earlier in the island): the same entry.

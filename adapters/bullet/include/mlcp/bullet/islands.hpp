@@ -101,7 +101,8 @@ class IslandBuilder {
   // point to a cached one (a removed point's slot refilled by another point is farther away).
   // Call newStep() once per simulation step, before its build() calls.
   void newStep();
-  void remember(const Island& island, const Vector& x);
+  // store: also set each row's m_appliedImpulse to x (one pass over Bullet's rows for both).
+  void remember(const Island& island, const Vector& x, bool store = false);
 
   int count() const { return count_; }
   Island& island(int k) { return islands_[k]; }
