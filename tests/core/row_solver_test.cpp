@@ -235,6 +235,50 @@ TEST(RowSolver, KeepsTheLdltAnalysisPerIsland) {
   EXPECT_NE(solver.cachedSolver(8, "ldlt"), ldlt);
 }
 
+// Islands solved in turn each find their own workspace (RowSolver remembers the last island's
+// slot): two patterns alternating keep one sparse analysis each; a mix-up would redo them.
+TEST(RowSolver, AlternatingIslandsKeepTheirOwnWorkspaces) {
+  RowSolverSettings settings;
+  settings.denseMaxRows = 0;
+  RowSolver solver(settings);
+  const RowSystem three = ballJoint();
+  RowSystem two = ballJoint();
+  two.rows.pop_back();
+  two.b.conservativeResize(2);
+  two.lo.conservativeResize(2);
+  two.hi.conservativeResize(2);
+  two.cfm.conservativeResize(2);
+  two.findex.pop_back();
+  Vector x;
+  for (int step = 0; step < 6; ++step) {
+    const bool first = step % 2 == 0;
+    const RowSystem& rows = first ? three : two;
+    ASSERT_EQ(solver.solve(rows, Vector::Zero(rows.size()), x, first ? 7 : 8).choice, "ldlt");
+    EXPECT_LE(rowResidual(rows, x), 1e-12);
+  }
+  for (std::uint64_t key : {7, 8}) {
+    const auto* ldlt = dynamic_cast<const LdltSolver*>(solver.cachedSolver(key, "ldlt"));
+    ASSERT_NE(ldlt, nullptr);
+    EXPECT_EQ(ldlt->analyses(), 1) << "island " << key;
+  }
+}
+
+// timeAssembly = false (the ODE stepper) leaves assembleSeconds at 0 and changes no answer.
+TEST(RowSolver, AssemblyTimingIsOptional) {
+  RowSolverSettings untimed;
+  untimed.timeAssembly = false;
+  RowSolver a, b(untimed);
+  const RowSystem rows = boxOnGround(false);
+  Vector xa, xb;
+  const IslandSolve sa = a.solve(rows, Vector::Zero(rows.size()), xa);
+  const IslandSolve sb = b.solve(rows, Vector::Zero(rows.size()), xb);
+  EXPECT_GE(sa.assembleSeconds, 0.0);
+  EXPECT_EQ(sb.assembleSeconds, 0.0);
+  EXPECT_TRUE((xa.array() == xb.array()).all());
+  EXPECT_LE(rowResidual(rows, xb), 1e-10);
+  EXPECT_GT(sb.result.seconds, 0.0);  // the island is still timed as a whole
+}
+
 TEST(RowSolver, CaptureWritesEachIslandsProblem) {
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / ("row_solver_capture_" + std::to_string(::getpid()));
