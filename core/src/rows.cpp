@@ -386,12 +386,15 @@ bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& row
         vb[k] += mB[k] * xi;
       }
     }
-    if (withBase && r.base != 0) {
+    // base_ holds M^-1 J^T (base - start) here; the start's velocities are added after the
+    // pass (an engine's base is mostly its start: no second 12-wide update per row).
+    if (withBase && r.base != xi) {
+      const double extra = r.base - xi;
       double* ba = base_[runA].v.data();
       double* bb = base_[runB].v.data();
       for (int k = 0; k < 6; ++k) {
-        ba[k] += mA[k] * r.base;
-        bb[k] += mB[k] * r.base;
+        ba[k] += mA[k] * extra;
+        bb[k] += mB[k] * extra;
       }
     }
   }
@@ -400,6 +403,8 @@ bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& row
       return stop(i, std::nan(""));
   // The world never moves (its blocks are zero anyway).
   for (int k = 0; k < kWorldSlots; ++k) velocity_[world + k].v.setZero();
+  if (withBase)
+    for (int k = 0; k < world; ++k) base_[k].v += velocity_[k].v;
   return true;
 }
 
@@ -512,11 +517,8 @@ Result RowPgs::solve(const std::vector<BodyInverseMass>& bodies, int n, const Ro
       },
       opt.warmStart, x.data(), true);
   if (!packed) return slow();
-  if (!x.allFinite()) {
-    // A non-finite start: a cold start, as solve(RowSystem) does.
-    x.setZero();
-    for (BodyVelocity& v : velocity_) v.v.setZero();
-  }
+  // A non-finite start: solve(RowSystem) starts cold (velocity_ and base_ hold NaN here).
+  if (!x.allFinite()) return slow();
   baseValid_ = true;
   return iterate(x, lo_, hi_, findex_, bNorm, t0);
 }

@@ -358,6 +358,21 @@ TEST(RowPgs, EngineRowsWithFaultsGetTheRowSystemsAnswer) {
   s = stackRows(3, 4);
   s.rows[2].jA[0] = std::nan("");
   EXPECT_EQ(both(s).status, Status::InvalidInput);
+  // A non-finite start: both start cold.
+  s = stackRows(30, 4);
+  Vector start = Vector::Constant(s.size(), 0.2);
+  start[5] = std::nan("");
+  RowPgs a, b;
+  a.options().warmStart = b.options().warmStart = true;
+  Vector xa = start, xb;
+  const Result ra = a.solve(s, xa);
+  const Result rb = solveFromRows(b, s, start, start, xb);
+  EXPECT_FALSE(b.velocityChanges());
+  EXPECT_EQ(ra.residual, rb.residual);
+  EXPECT_EQ(xa, xb);
+  RowPgs cold;
+  Vector xc;
+  EXPECT_EQ(cold.solve(s, xc).residual, ra.residual);
 }
 
 TEST(RowPgs, ZeroRowIsAFailureNotAConvergence) {
