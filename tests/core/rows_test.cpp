@@ -326,11 +326,11 @@ TEST(RowPgs, PackingFromAnEnginesRowsEqualsPackingFromTheRowSystem) {
   }
 }
 
-// Bad rows and a zero diagonal through the engine entry point: the slow path says what
-// solve(RowSystem) says, and velocityChange is not offered.
+// Bad rows, a zero diagonal and a non-finite start through the engine entry point: the slow
+// path gives what solve(RowSystem) gives, and velocityChange is not offered.
 TEST(RowPgs, EngineRowsWithFaultsGetTheRowSystemsAnswer) {
-  auto both = [](const RowSystem& s) {
-    const Vector start = Vector::Constant(s.size(), 0.2);
+  auto both = [](const RowSystem& s, Vector start = Vector()) {
+    if (start.size() == 0) start = Vector::Constant(s.size(), 0.2);
     RowPgs a, b;
     a.options().warmStart = b.options().warmStart = true;
     Vector xa = start, xb;
@@ -339,6 +339,10 @@ TEST(RowPgs, EngineRowsWithFaultsGetTheRowSystemsAnswer) {
     EXPECT_FALSE(b.velocityChanges());
     EXPECT_EQ(ra.status, rb.status);
     EXPECT_EQ(ra.message, rb.message);
+    if (ra.status != Status::InvalidInput) {
+      EXPECT_EQ(ra.residual, rb.residual) << toString(ra.status);
+      EXPECT_EQ(xa, xb);
+    }
     return rb;
   };
   RowSystem s = stackRows(30, 4);
@@ -362,17 +366,10 @@ TEST(RowPgs, EngineRowsWithFaultsGetTheRowSystemsAnswer) {
   s = stackRows(30, 4);
   Vector start = Vector::Constant(s.size(), 0.2);
   start[5] = std::nan("");
-  RowPgs a, b;
-  a.options().warmStart = b.options().warmStart = true;
-  Vector xa = start, xb;
-  const Result ra = a.solve(s, xa);
-  const Result rb = solveFromRows(b, s, start, start, xb);
-  EXPECT_FALSE(b.velocityChanges());
-  EXPECT_EQ(ra.residual, rb.residual);
-  EXPECT_EQ(xa, xb);
+  const Result r = both(s, start);
   RowPgs cold;
   Vector xc;
-  EXPECT_EQ(cold.solve(s, xc).residual, ra.residual);
+  EXPECT_EQ(cold.solve(s, xc).residual, r.residual);
 }
 
 TEST(RowPgs, ZeroRowIsAFailureNotAConvergence) {
