@@ -126,6 +126,21 @@
 // 1728, same answers. Synthetic box pyramids: a warm start settles in 1-2 full steps (55 boxes, n =
 // 1200: about 8 ms per step including assembly); from a cold start the trial does not settle and
 // the incremental pivoting runs from zero.
+// Bullet's pyramid at rest (bullet_bench --settle 60; the adapter's guess is our own last answer
+// per manifold point, residual 2e-5..1e-4): the cold trial never settled there (residual 0.14
+// after its factorization of all 1160 rows, 6-12 ms, more than the rest of the solve), hence no
+// trial for a guess within 1e-2 (ODE's stepper guesses have residuals 1.6-13 and keep it). From
+// the guess the stage takes 2 full steps (~2.5 ms each, one with a sliding row in the LU): 2-4
+// rows of the guessed sets are wrong (a normal at 0 whose w0 is slightly negative, ~1e-5, is
+// guessed clamped and its friction row sliding; the answer holds it at 0), so the first step is
+// not the answer. Symmetry is checked on a mirror map of A's pattern (isSymmetric's transposed
+// copy cost ~2 ms per solve at n = 1160); AMD is computed once (A's pattern is kept at rest).
+// Whole steps, CPU ms, stock in the same run, two runs: 55 boxes 5.5-6.2 ms against stock's
+// 275-362 ms (44-65x; before: 13.9-24 ms, 14-19x); 15 boxes 0.43-0.74 ms against 4.0-7.9 ms
+// (9-11x; before 2.2x). After the switch the trial runs once in autoColdRetry solves (it never
+// settles on the moving pyramid either). Tried after the switch without gain: returning to full
+// steps from the damped phase once the residual is below 1e-2 (up to 3 times; the full steps
+// diverge again: residual after 40 steps 1.8-5.9e-3 against 0.9-1.3e-3, 128 against 83 ms).
 //
 // Result::iterations counts pivots (direction computations: each row added or exchanged)
 // summed over all passes; Options::maxPivots (0: 50 n + 100) limits them per pass
