@@ -140,7 +140,9 @@
 // (9-11x; before 2.2x). After the switch the trial runs once in autoColdRetry solves (it never
 // settles on the moving pyramid either). Tried after the switch without gain: returning to full
 // steps from the damped phase once the residual is below 1e-2 (up to 3 times; the full steps
-// diverge again: residual after 40 steps 1.8-5.9e-3 against 0.9-1.3e-3, 128 against 83 ms).
+// diverge again: residual after 40 steps 1.8-5.9e-3 against 0.9-1.3e-3, 128 against 83 ms), and
+// other step budgets before the hand-over (CPU ms per step: 20 steps 123-137, 40 steps 85-88, 70
+// steps 92-98: the damped steps' linear rate does not beat the pivoting's finish).
 //
 // Result::iterations counts pivots (direction computations: each row added or exchanged)
 // summed over all passes; Options::maxPivots (0: 50 n + 100) limits them per pass
