@@ -84,27 +84,33 @@ class RowSystem {
 // sweeps, and one residual check per Options::checkEvery. The packing pass is also the
 // validation: each row is checked by the one-pass rule of RowSystem::validate as it is packed
 // (the bodies and array sizes before), and only a row that fails calls validate() itself to
-// say what is wrong; the caller's x is untouched until every row has passed. The check is the
-// natural-map residual of residual.hpp at the current x, with w = J v + cfm x + b taken from
-// the body velocities the sweeps maintain: v changes by M^-1 J_i^T dx_i with every change dx_i
-// of x, so v = M^-1 J^T x up to round-off and w = A x + b is exact up to round-off as well. The
-// check thus costs about a tenth of a sweep instead of a second pass over the rows to rebuild v
-// (tests compare it with accuracy() on the assembled problem).
+// say what is wrong; the caller's x is untouched until every row has passed. Engines that hold
+// their rows in their own form pack them straight from there (solve with a RowFill: no
+// RowSystem copy in between; same packing, same validation). The check is the natural-map
+// residual of residual.hpp at the current x, with w = J v + cfm x + b taken from the body
+// velocities the sweeps maintain: v changes by M^-1 J_i^T dx_i with every change dx_i of x, so
+// v = M^-1 J^T x up to round-off and w = A x + b is exact up to round-off as well. It reads the
+// packed rows only: step_i w_i = (1 - keep) x_i + shift + sA v (the sweep's own terms, scaled
+// back by 1 / step). The check thus costs about a tenth of a sweep instead of a second pass over
+// the rows to rebuild v (tests compare it with accuracy() on the assembled problem).
 // The sweep is bound by the latency chain through the velocities of bodies shared by
-// consecutive rows (load v, dot, clamp, update v, store), not by memory. Three things keep the
+// consecutive rows (load v, dot, clamp, update v, store), not by memory. Four things keep the
 // chain short: ground rows take 8 zero-velocity world slots in turn (one shared slot chained
-// every ground row through its store and load), a run of consecutive rows on the same two
-// bodies (a contact's normal and friction rows in ODE's order) keeps their velocities in
-// registers, and the velocity change is clamped on its own (below).
+// every ground row through its store and load); a run of up to kMaxRun consecutive rows on the
+// same two bodies (a manifold's normals, its friction rows; a contact's rows in ODE's order) is
+// swept through its couplings: row i's step J_i v is step J_i v_start + sum over the run's
+// earlier rows k of c_ik dx_k, c_ik = step_i J_i M^-1 J_k^T computed when packing, so one row
+// waits for the last only through a multiply-add (not a 12-wide velocity update and dot), and
+// v takes the run's changes at its end; the run's loop is unrolled per length so its changes
+// stay in registers; and the velocity change is clamped on its own (below).
 // Measured through the Bullet drop-in (bullet_bench --pgs-vs-si, 210-box pyramid, 4720 rows,
-// 10 sweeps): before this session's changes packing 0.20 ms, a sweep 0.053 ms (~11 ns a row),
-// the check 0.055 ms. Packing then lost a quarter of its time to store-forwarding stalls
-// (Eigen's M^-1 J^T temporary read back from the stack; now computed in scalars): perf samples
-// against the unchanged collision work say packing is ~30% cheaper since (~0.14 ms); of
-// RowPgs' samples the sweeps are now ~68%, packing ~18%, the check (slackFromVelocities and
-// accuracy) ~9%. The Bullet sweeps did not get measurably faster from the runs (perf share, noisy;
-// Bullet orders a manifold's normals, then its friction rows), ODE's did (ode_pgs_bench, 108 rows:
-// solve 46-48 us -> 31-42 us on a loaded machine).
+// 10 sweeps, perf shares of our stages at the end of session 4): sweeps 44%, packing 21% (~0.18
+// ms: ~40 ns a row, the couplings included), the check (slackFromVelocities and accuracy) 5%;
+// the rest is the adapter's (islands.hpp). The couplings and the unrolling took the Bullet
+// sweeps from ~51 us to ~37 us (~8 ns a row); without the unrolling the coupling sums read the
+// changes back from a stack array in pairs and stalled store forwarding, and the runs gained
+// nothing. Packing once lost a quarter of its time to such stalls too (Eigen's M^-1 J^T
+// temporary read back from the stack; now computed in scalars).
 class RowPgs {
  public:
   Options& options() { return options_; }

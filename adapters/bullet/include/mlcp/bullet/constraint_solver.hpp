@@ -57,15 +57,22 @@
 //  problem with the same A and b = -m_rhsPenetration / m_jacDiagABInv gives push impulses.
 //
 // Cost against SI, "pgs" at SI's sweep count (bulletIterations, bullet_bench --pgs-vs-si; CPU
-// time per step, 210-box pyramid, ~4250 rows, 10 sweeps): Bullet's row setup and finish are the
-// same code in both (~0.33 ms). SI's iterations take ~0.68 ms; our stages 2-7 ~1.0 ms: the
-// sweeps 0.53 (RowPgs' sweep is ~20% cheaper than SI's), and ~100 ns a row of work SI does not
-// have, because SI sweeps Bullet's rows in place: packing RowPgs' rows 0.20 ms (rows.hpp), stage
-// 2-3 (IslandBuilder: union-find and the conversion into a RowSystem) 0.165 ms, storing impulses
-// 0.065 ms, the residual check 0.055 ms. At 50 sweeps the sweeps' edge pays for it (1.0x); at 10
-// it does not (1.3-1.4x). What would remove most of it: one representation written once per
-// step that both the verification (RowSystem) and the sweep read, i.e. RowSystem holding the
-// packed rows, instead of a RowSystem copy of Bullet's rows followed by RowPgs' packed copy.
+// time per step, median of 300 steps, 10 sweeps, two runs): Bullet's row setup and finish are
+// the same code in both. "pgs" islands take a path of their own (solveIslandFast): RowPgs packs
+// straight from Bullet's rows (IslandBuilder::fill; no RowSystem copy), the answer goes to the
+// bodies per body (RowPgs::velocityChange: M^-1 J^T (x - applied), what the per-row
+// internalApplyImpulse calls sum to) and the applied impulses are stored in remember()'s pass.
+// Its answer passes the same acceptable() rule; a rejected one (or keepIslands, or a caller
+// holding rowSolver()) goes through RowSolver on a RowSystem copy like every other solver. The
+// iterates are the same as RowSolver's pgs bit for bit (one packing code); the write-back differs
+// by round-off (the bodies' velocities, 1e-9 apart after ~17 steps of a settling pyramid).
+// Session 4: 15 / 55 / 210 boxes 1.29-1.31x / 1.34-1.36x / 1.34-1.37x SI -> 1.15-1.17x /
+// 1.21-1.23x / 1.21-1.23x; at 50 sweeps 0.96-0.97x -> 0.77-0.79x. At 210 boxes our stages take
+// ~0.87 ms against SI's iterations ~0.67 ms: the sweeps ~0.37 ms (~8 ns a row; SI's ~14 ns),
+// then ~100 ns a row of work SI does not have, because SI sweeps Bullet's rows in place:
+// packing ~0.18 ms (rows.hpp), the island split and numbering ~0.10 ms, the conversion of
+// Bullet's rows ~0.07 ms, storing impulses and remembering the points' answers ~0.08 ms (first
+// touches of Bullet's rows after the sweeps), the check ~0.05 ms (perf shares).
 //
 // "si" runs Bullet's own SI iterations instead (for side-by-side runs with the same statistics).
 #pragma once
