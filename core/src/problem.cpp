@@ -148,8 +148,7 @@ class LazyMessage {
 namespace {
 
 // The usual case, checked in one pass with no branch per row: true when nothing is wrong. False
-// sends validate() through its search for the first thing that is (friction rows always: their
-// rules need that search).
+// sends validate() through its search for the first thing that is.
 bool certainlyValid(const Problem& p) {
   const Eigen::Index n = p.b.size();
   const bool sparse = p.isSparse();
@@ -160,7 +159,14 @@ bool certainlyValid(const Problem& p) {
   bool ok = true;
   for (Eigen::Index i = 0; i < n; ++i)  // lo <= hi is false for a NaN bound
     ok &= std::isfinite(p.b[i]) & (p.lo[i] <= p.hi[i]) & (p.lo[i] < kInf) & (p.hi[i] > -kInf);
-  for (int f : p.findex) ok &= f == -1;
+  const std::vector<int>& fx = p.findex;
+  for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(fx.size()); ++i) {
+    const int f = fx[i];
+    if (f == -1) continue;
+    // A friction row: coupled to an uncoupled other row, bounds -mu..mu with finite mu >= 0.
+    ok &= f >= 0 && f < n && f != i && fx[f] < 0 && p.hi[i] >= 0 && p.hi[i] < kInf &&
+          p.lo[i] == -p.hi[i];
+  }
   return ok && (sparse ? firstNonFiniteSparse(p.sparseA()) : firstNonFinite(p.denseA())).empty();
 }
 
