@@ -173,6 +173,11 @@ bool ConstraintSolver::solveIslandFast(Island& island, bool split) {
   r.seconds = nowSeconds() - t0;
   record(r, n, "pgs");
   current_.packedIslands += 1;
+  if (island.perRowWriteBack) {
+    applyPerRow(island, x_, split);
+    if (!split) builder_.remember(island, x_);
+    return true;
+  }
   // Store impulses: the bodies take M^-1 J^T (x - applied) at once (RowPgs::velocityChange),
   // what the per-row internalApplyImpulse calls sum to.
   for (int k = 0; k < static_cast<int>(island.solverBody.size()); ++k) {
@@ -193,6 +198,31 @@ bool ConstraintSolver::solveIslandFast(Island& island, bool split) {
     builder_.remember(island, x_, true);
   }
   return true;
+}
+
+void ConstraintSolver::applyPerRow(Island& island, const Vector& x, bool split) {
+  const int n = static_cast<int>(island.rows.size());
+  for (int i = 0; i < n; ++i) {
+    btSolverConstraint& c = *island.rows[i];
+    btSolverBody& a = m_tmpSolverBodyPool[c.m_solverBodyIdA];
+    btSolverBody& b = m_tmpSolverBodyPool[c.m_solverBodyIdB];
+    const btScalar xi = static_cast<btScalar>(x[i]);
+    if (split) {
+      const btScalar delta = xi - c.m_appliedPushImpulse;
+      a.internalApplyPushImpulse(c.m_contactNormal1 * a.internalGetInvMass(), c.m_angularComponentA,
+                                 delta);
+      b.internalApplyPushImpulse(c.m_contactNormal2 * b.internalGetInvMass(), c.m_angularComponentB,
+                                 delta);
+      c.m_appliedPushImpulse = xi;
+    } else {
+      const btScalar delta = xi - c.m_appliedImpulse;
+      a.internalApplyImpulse(c.m_contactNormal1 * a.internalGetInvMass(), c.m_angularComponentA,
+                             delta);
+      b.internalApplyImpulse(c.m_contactNormal2 * b.internalGetInvMass(), c.m_angularComponentB,
+                             delta);
+      c.m_appliedImpulse = xi;
+    }
+  }
 }
 
 void ConstraintSolver::solveIsland(Island& island, std::uint64_t key, bool split) {
@@ -216,27 +246,7 @@ void ConstraintSolver::solveIsland(Island& island, std::uint64_t key, bool split
 
   // Store impulses: the change from the start goes through Bullet's own body update.
   const Vector& x = x_;
-  for (int i = 0; i < n; ++i) {
-    btSolverConstraint& c = *island.rows[i];
-    btSolverBody& a = m_tmpSolverBodyPool[c.m_solverBodyIdA];
-    btSolverBody& b = m_tmpSolverBodyPool[c.m_solverBodyIdB];
-    const btScalar xi = static_cast<btScalar>(x[i]);
-    if (split) {
-      const btScalar delta = xi - c.m_appliedPushImpulse;
-      a.internalApplyPushImpulse(c.m_contactNormal1 * a.internalGetInvMass(), c.m_angularComponentA,
-                                 delta);
-      b.internalApplyPushImpulse(c.m_contactNormal2 * b.internalGetInvMass(), c.m_angularComponentB,
-                                 delta);
-      c.m_appliedPushImpulse = xi;
-    } else {
-      const btScalar delta = xi - c.m_appliedImpulse;
-      a.internalApplyImpulse(c.m_contactNormal1 * a.internalGetInvMass(), c.m_angularComponentA,
-                             delta);
-      b.internalApplyImpulse(c.m_contactNormal2 * b.internalGetInvMass(), c.m_angularComponentB,
-                             delta);
-      c.m_appliedImpulse = xi;
-    }
-  }
+  applyPerRow(island, x, split);
   if (!split) builder_.remember(island, x);
   if (settings_.keepIslands)
     records_.push_back({s, start, x, result, solved.choice, split, solved.fellBack});

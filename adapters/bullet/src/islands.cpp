@@ -28,6 +28,17 @@ btVector3 frictionDirection(const btSolverConstraint& c) {
   return c.m_contactNormal1.isZero() ? -c.m_contactNormal2 : c.m_contactNormal1;
 }
 
+// Whether Bullet's body update (internalApplyImpulse) is M^-1 J^T for our mass model: the linear
+// factor l enters Bullet's update squared (m_invMass = invMass l, times l again) and ours once
+// (J's n l, invMass); the angular factor f as diag(f)^2 I^-1 and diag(f) I^-1 diag(f).
+bool sameUpdate(const btSolverBody& b) {
+  const btVector3& l = b.m_linearFactor;
+  const btVector3& f = b.m_angularFactor;
+  for (int k = 0; k < 3; ++k)
+    if (l[k] != 0 && l[k] != 1) return false;
+  return f[0] == f[1] && f[1] == f[2];
+}
+
 }  // namespace
 
 int IslandBuilder::find(int k) {
@@ -108,6 +119,7 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
       const btMatrix3x3& I = rb->getInvInertiaTensorWorld();
       for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 3; ++c) m.invInertia(r, c) = af[r] * I[r][c] * af[c];
+      if (!sameUpdate(sb)) isl.perRowWriteBack = true;
       bodyLocal_[d] = static_cast<int>(isl.system.bodies.size());
       isl.system.bodies.push_back(m);
       isl.solverBody.push_back(d);
@@ -136,6 +148,7 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
       isl.points = 0;
       isl.hasSplit = false;
       isl.filled = false;
+      isl.perRowWriteBack = false;
     }
     const int k = islandOfRoot_[root];
     Island& isl = islands_[k];

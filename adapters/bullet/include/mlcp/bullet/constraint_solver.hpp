@@ -62,6 +62,13 @@
 // straight from Bullet's rows (IslandBuilder::fill; no RowSystem copy), the answer goes to the
 // bodies per body (RowPgs::velocityChange: M^-1 J^T (x - applied), what the per-row
 // internalApplyImpulse calls sum to) and the applied impulses are stored in remember()'s pass.
+// The two are the same only where our mass model is Bullet's body update. Bullet's solver body
+// holds invMass l (l the linear factor) and internalApplyImpulse multiplies by l again: v +=
+// invMass l^2 n x, ours invMass l n x (J's linear part n l); the angular factor f enters as
+// w += diag(f)^2 I^-1 (r x n) x, ours diag(f) I^-1 diag(f) (r x n) x. They agree when l's
+// components are 0 or 1 and f's are equal (any rotation); an island with another body
+// (Island::perRowWriteBack) is written back row by row as the
+// RowSolver path does (tested with factors (0.3, 1, 0.5) and linear factors (1, 0.5, 1)).
 // Its answer passes the same acceptable() rule; a rejected one (or keepIslands, or a caller
 // holding rowSolver()) goes through RowSolver on a RowSystem copy like every other solver. The
 // iterates are the same as RowSolver's pgs bit for bit (one packing code); the write-back differs
@@ -200,6 +207,9 @@ class ConstraintSolver : public btSequentialImpulseConstraintSolver {
   // "pgs" packed straight from Bullet's rows and written back per body; false when the answer
   // was not accepted (the island then goes through rows_ like every other solver).
   bool solveIslandFast(Island& island, bool split);
+  // Store impulses row by row through Bullet's own body update (internalApplyImpulse or
+  // internalApplyPushImpulse with x - applied), and set the applied impulses to x.
+  void applyPerRow(Island& island, const Vector& x, bool split);
   void measureSi(int sweeps);
   void record(const Result& r, int rows, const std::string& choice);
   void finishStep();

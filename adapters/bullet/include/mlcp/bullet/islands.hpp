@@ -62,6 +62,10 @@ struct Island {
   // per point by build().
   std::vector<const void*> last;
   int points = 0;  // contact rows with a manifold point
+  // A body's linear factor has a component other than 0 and 1, or its angular factor unequal
+  // components: Bullet's body update is not M^-1 J^T there (constraint_solver.hpp), so a
+  // per-body write-back would differ from Bullet's.
+  bool perRowWriteBack = false;
 };
 
 // The pools of one solveGroup call, as btSequentialImpulseConstraintSolver holds them.
