@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 // GCC vectorizes the loops over the clamped rows (run-time length m <= n) into 2-wide code
 // with peeling, whose stack stores the next scalar loads cannot forward from: the 6-row solve
@@ -15,16 +16,18 @@ namespace mlcp::detail {
 
 namespace {
 
+constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
+
 bool isEquality(double lo, double hi) { return lo == -kInf && hi == kInf; }
 
-// The guessed block's factors A_CC = L D L^T (columns n apart) and the operations of
-// DantzigSolver's general path on them, written the same way (see dantzig_small.hpp). The size
-// n is a template argument: the products over n rows compile to straight-line code.
+// The guessed block's factors A_CC = L D L^T (columns n apart, D kept as its reciprocals) and
+// the operations of DantzigSolver's general path on them (see dantzig_small.hpp). The size n is
+// a template argument: the products over n rows compile to straight-line code.
 template <int n>
 struct Factors {
   int m = 0;
   const double* a = nullptr;  // A in processing order, column-major n x n
-  double L[n * n], D[n];
+  double L[n * n], invD[n];
   int C[n];
 
   int size() const { return m < n ? m : n; }  // m, visibly at most n for the compiler
@@ -35,17 +38,21 @@ struct Factors {
     for (int k = 0; k < n; ++k) s += row[k] * v[k];
     return s;
   }
-  // y <- D^-1 L^-1 y.
-  void forward(double* y) const {
+  // y <- L^-1 y.
+  void substitute(double* y) const {
     const int m = size();
-    if (m == 0) return;
     for (int k = 0; k < m; ++k) {
       const double yk = y[k];
       if (yk == 0) continue;
       const double* col = L + k * n;
       for (int i = k + 1; i < m; ++i) y[i] -= yk * col[i];
     }
-    for (int c = 0; c < m; ++c) y[c] /= D[c];
+  }
+  // y <- D^-1 L^-1 y (multiplied by the reciprocal pivots: a division's latency each was a
+  // dependent link of the chain from the factor to the answer).
+  void forward(double* y) const {
+    substitute(y);
+    for (int c = 0; c < size(); ++c) y[c] *= invD[c];
   }
   // y <- L^-T y.
   void backward(double* y) const {
@@ -64,13 +71,16 @@ struct Factors {
     double u[n];
     const double* col = a + p * n;
     for (int c = 0; c < m; ++c) u[c] = col[C[c]];
-    forward(u);
+    substitute(u);  // u = L^-1 a_Cp; the new row of L is D^-1 u, its pivot a_pp - u^T D^-1 u
     double s = 0;
-    for (int c = 0; c < m; ++c) s += u[c] * u[c] * D[c];
+    for (int c = 0; c < m; ++c) {
+      const double l = u[c] * invD[c];
+      s += l * u[c];
+      L[m + c * n] = l;
+    }
     const double pivot = col[p] - s;
     if (!(std::abs(pivot) > pivTol)) return false;
-    for (int c = 0; c < m; ++c) L[m + c * n] = u[c];
-    D[m] = pivot;
+    invD[m] = 1.0 / pivot;
     C[m++] = p;
     return true;
   }
@@ -148,7 +158,8 @@ bool solveFixed(const Problem& pb, double pivotTolerance, Vector& xInOut) {
     dMax = std::max(dMax, std::abs(f.a[p + p * n]));
   }
   const double pivTol = (dMax > 0 ? dMax : aMax > 0 ? aMax : 1.0) * pivotTolerance;
-  const double epsW = 1e-12 * (1.0 + pb.b.lpNorm<Eigen::Infinity>());
+  const double bMax = pb.b.lpNorm<Eigen::Infinity>();
+  const double epsW = 1e-12 * (1.0 + bMax);
 
   // The guessed block: factor, solve x_C with the others at their start, all inside bounds.
   for (int p = 0; p < n; ++p)
@@ -158,12 +169,14 @@ bool solveFixed(const Problem& pb, double pivotTolerance, Vector& xInOut) {
     for (int c = 0; c < f.m; ++c)
       if (x[f.C[c]] < lo[f.C[c]] || x[f.C[c]] > hi[f.C[c]]) return false;
   }
-  // The other rows, in order, stay at their bound when their w allows it.
+  // The other rows, in order, stay at their bound when their w allows it (their x is there
+  // already: the clamped start), so one w of every row serves all of them.
+  for (int p = 0; p < n; ++p) w[p] = b[p] + f.rowDot(p, x);
   At at[n];
   for (int p = 0; p < n; ++p) {
     at[p] = At::Clamped;
     if (groupAt[p] <= 1) continue;
-    const double wp = b[p] + f.rowDot(p, x);
+    const double wp = w[p];
     if (lo[p] == hi[p]) {
       x[p] = lo[p];
       at[p] = At::Fixed;
@@ -177,11 +190,20 @@ bool solveFixed(const Problem& pb, double pivotTolerance, Vector& xInOut) {
       return false;  // the row would be driven: the general path pivots
     }
   }
-  // One step of iterative refinement, then every row at a bound checked with a fresh w.
-  f.solveClamped(b, x);
-  for (int p = 0; p < n; ++p) w[p] = b[p] + f.rowDot(p, x);
-  for (int p = 0; p < n; ++p)
-    if ((at[p] == At::Lo && w[p] < -epsW) || (at[p] == At::Hi && w[p] > epsW)) return false;
+  // One step of iterative refinement, then every row at a bound checked with a fresh w; not
+  // when the clamped rows' w is within the rounding error of its own evaluation,
+  // (n + 1) eps (|b| + n max|A| |x|): a correction from it would be noise (the general path
+  // refines always; the refinement was a third of this path's time on the ODE hinge).
+  double wC = 0, xMax = 0;
+  for (int c = 0; c < f.m; ++c) wC = std::max(wC, std::abs(w[f.C[c]]));
+  for (int p = 0; p < n; ++p) xMax = std::max(xMax, std::abs(x[p]));
+  const double rounding = (n + 1) * kEpsilon * (bMax + n * aMax * xMax);
+  if (wC > rounding) {
+    f.solveClamped(b, x);
+    for (int p = 0; p < n; ++p) w[p] = b[p] + f.rowDot(p, x);
+    for (int p = 0; p < n; ++p)
+      if ((at[p] == At::Lo && w[p] < -epsW) || (at[p] == At::Hi && w[p] > epsW)) return false;
+  }
   for (int p = 0; p < n; ++p) xInOut[perm[p]] = x[p];
   return true;
 }

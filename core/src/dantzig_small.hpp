@@ -8,8 +8,12 @@
 // costs a few hundred flops, its general workspace (permuted copy of A, index-set bookkeeping,
 // twenty reused vectors) several times that. This path is the same steps on fixed-size arrays:
 // the same processing order (equality rows, guessed clamped rows, the others; each group in
-// the caller's order), the same factor, the same sums in the same order, the same tolerances,
-// so its answer is the general path's to the bit. It gives up (returns false, x untouched)
+// the caller's order), the same factor, the same tolerances, so its answer is the general
+// path's to round-off: it multiplies by reciprocal pivots where the general path divides (the
+// divisions were links of the dependent chain that sets a 6-row island's latency), and it skips
+// the general path's one step of iterative refinement when the clamped rows' w is already at
+// the rounding level of its evaluation (a third of the path's time on the ODE hinge island,
+// whose trajectory moved by under 1e-12). It gives up (returns false, x untouched)
 // wherever the general path would pivot or fall back: a guessed row whose Schur pivot is at
 // most the pivot tolerance, a solved x_C outside its bounds, a row at a bound whose w points
 // the wrong way (before or after the refinement), an A that is not symmetric; DantzigSolver

@@ -392,6 +392,40 @@ TEST(DantzigSmall, AnswersAreTheGeneralPathsOrDeclined) {
   EXPECT_GT(declined, 100);
 }
 
+// The path skips the general path's refinement step only where the clamped rows' w is at its
+// rounding level. Symmetric indefinite blocks with a tiny first pivot (growth up to 1e8 in L)
+// leave a first solve's w far above it: refined, the answers are the general path's and as
+// accurate (without the refinement their residuals reach ~1e-9).
+TEST(DantzigSmall, GrowthInTheFactorsIsRefined) {
+  Generator g(33);
+  for (int trial = 0; trial < 40; ++trial) {
+    const int n = 2 + trial % (detail::kSmallDenseRows - 1);
+    DenseMatrix A = DenseMatrix::Zero(n, n);
+    const double tiny = std::pow(10.0, -4.0 - trial % 5);
+    A(0, 0) = A(1, 1) = tiny;
+    A(0, 1) = A(1, 0) = 1.0 + 0.1 * g.uniform(-1, 1);
+    if (n > 2) {
+      DenseMatrix S = g.spd(n - 2);
+      A.bottomRightCorner(n - 2, n - 2) = 0.5 * (S + S.transpose());
+      for (int i = 2; i < n; ++i) A(0, i) = A(i, 0) = 0.3 * g.uniform(-1, 1);
+    }
+    Vector b(n);
+    for (int i = 0; i < n; ++i) b[i] = g.uniform(-1, 1);
+    Problem p(A, b);
+    p.lo.setConstant(-kInf);  // equality rows: the path takes them from any start
+    Problem sparse = p;
+    sparse.setA(p.toSparse());
+    Vector x = Vector::Constant(n, 0.5);
+    ASSERT_TRUE(detail::solveSmallDense(p, 1e-12, x)) << "trial " << trial;
+    EXPECT_LE(residual(p, x), 1e-12) << "trial " << trial << " tiny " << tiny;
+    DantzigSolver general;
+    Vector y;
+    ASSERT_TRUE(general.solveWithGuess(sparse, Vector::Constant(n, 0.5), y).converged());
+    EXPECT_LE((x - y).lpNorm<Eigen::Infinity>(), 1e-12 * (1 + y.lpNorm<Eigen::Infinity>()))
+        << "trial " << trial;
+  }
+}
+
 // A guess whose index sets are wrong is declined, and DantzigSolver pivots from it instead.
 TEST(DantzigSmall, WrongGuessFallsToPivoting) {
   // x in [0, 1], w = x - 2: the answer is x = 1 (at hi), not the guessed interior 0.5.
@@ -592,7 +626,9 @@ TEST(DantzigBlock, AutoColdTrialAfterAMissIsRetriedEveryAutoColdRetrySolves) {
     ASSERT_TRUE(r.converged()) << r.message;
     EXPECT_LE(accuracy(p, x).residual, autoStage.options().tolerance);
     const bool tried = r.message.find("cold trial") != std::string::npos;
-    if (solve == 0) ASSERT_TRUE(tried) << "the cold trial settled: pick a scene where it misses";
+    if (solve == 0) {
+      ASSERT_TRUE(tried) << "the cold trial settled: pick a scene where it misses";
+    }
     EXPECT_EQ(tried, solve % 3 == 0) << "solve " << solve << ": " << r.message;
   }
 }
