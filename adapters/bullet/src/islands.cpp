@@ -39,6 +39,14 @@ bool sameUpdate(const btSolverBody& b) {
   return f[0] == f[1] && f[1] == f[2];
 }
 
+// How many rows ahead remember() fetches Bullet's rows (288 bytes in double precision; it reads
+// the first lines and writes the fourth) and manifold points.
+constexpr int kAhead = 6;
+void prefetchRow(const btSolverConstraint* c) {
+  const char* p = reinterpret_cast<const char*>(c);
+  for (int line = 0; line < 4; ++line) __builtin_prefetch(p + 64 * line);
+}
+
 }  // namespace
 
 int IslandBuilder::find(int k) {
@@ -201,77 +209,78 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     for (int k = 0; k < count_; ++k) fillSystem(islands_[k]);
 }
 
-void IslandBuilder::convert(int i, RowPgs::Row& out, bool split) {
-  const btAlignedObjectArray<btSolverBody>& bodies = *in_.bodies;
-  const btSolverConstraint& c = *all_[i];
+inline void IslandBuilder::convert(Island& isl, int r, RowPgs::Row& out, bool split) {
+  const int i = isl.rowIndex[r];
+  const btSolverConstraint& c = *isl.rows[r];
   const int a = rowBodies_[i].first, b = rowBodies_[i].second;
-  // One side's Jacobian block: [n * linearFactor; r x n].
-  auto jacobian = [](Vector6& j, const btVector3& normal, const btVector3& linearFactor,
-                     const btVector3& torqueAxis) {
-    for (int k = 0; k < 3; ++k) {
-      j[k] = normal[k] * linearFactor[k];
-      j[3 + k] = torqueAxis[k];
-    }
+  const int findex = isl.system.findex[r];
+  // Bullet's values read into locals first: `out` might alias them as far as the compiler knows.
+  const double jd = c.m_jacDiagABInv, rhs = c.m_rhs, rhsPenetration = c.m_rhsPenetration,
+               rowCfm = c.m_cfm, friction = c.m_friction, lower = c.m_lowerLimit,
+               upper = c.m_upperLimit;
+  const double base = split ? c.m_appliedPushImpulse : c.m_appliedImpulse;
+  // One side's Jacobian block: [n * linearFactor; r x n], written in place (a local copy read
+  // back 16 bytes at a time from its 8-byte stores stalled store forwarding).
+  auto jacobian = [&](Vector6& j, int body, const btVector3& normal, const btVector3& torqueAxis) {
+    const btVector3& linearFactor = (*in_.bodies)[body].m_linearFactor;
+    const double n0 = normal[0], n1 = normal[1], n2 = normal[2];
+    const double t0 = torqueAxis[0], t1 = torqueAxis[1], t2 = torqueAxis[2];
+    j << n0 * linearFactor[0], n1 * linearFactor[1], n2 * linearFactor[2], t0, t1, t2;
   };
-  out.bodyA = a >= 0 ? bodyLocal_[a] : -1;
-  out.bodyB = b >= 0 ? bodyLocal_[b] : -1;
   if (a >= 0)
-    jacobian(out.jA, c.m_contactNormal1, bodies[c.m_solverBodyIdA].m_linearFactor,
-             c.m_relpos1CrossNormal);
+    jacobian(out.jA, c.m_solverBodyIdA, c.m_contactNormal1, c.m_relpos1CrossNormal);
   else
     out.jA.setZero();
   if (b >= 0)
-    jacobian(out.jB, c.m_contactNormal2, bodies[c.m_solverBodyIdB].m_linearFactor,
-             c.m_relpos2CrossNormal);
+    jacobian(out.jB, c.m_solverBodyIdB, c.m_contactNormal2, c.m_relpos2CrossNormal);
   else
     out.jB.setZero();
+  double start = 0;
+  const bool warm = start_ != Start::Zero;
+  const bool contact = i >= nj_ && i < nj_ + nc_;
+  if (split) {
+    start = warm ? base : 0.0;
+  } else if (warm) {
+    start = (i >= nj_ ? unscaleContacts_ : 1.0) * base;
+    const btManifoldPoint* point = isl.point[r];
+    if (point && start_ == Start::CachedImpulse) {
+      if (const auto* last = static_cast<const Remembered*>(isl.last[r])) {
+        start = contact ? last->normal : last->friction.dot(frictionDirection(c));
+      } else if (!contact && lateralCache_) {
+        const bool first = i - nj_ - nc_ == (*in_.contacts)[c.m_frictionIndex].m_frictionIndex;
+        start = first ? point->m_appliedImpulseLateral1 : point->m_appliedImpulseLateral2;
+      }
+    }
+  }
+  out.bodyA = a >= 0 ? bodyLocal_[a] : -1;
+  out.bodyB = b >= 0 ? bodyLocal_[b] : -1;
   // rhs and cfm are stored pre-multiplied by 1 / A_ii; undo it (as btMLCPSolver does).
-  const double jd = c.m_jacDiagABInv;
-  const bool scaled = !btFuzzyZero(c.m_jacDiagABInv);
-  out.b = scaled ? -c.m_rhs / jd : 0.0;
-  const double splitB = scaled ? -c.m_rhsPenetration / jd : 0.0;
+  const bool scaled = !btFuzzyZero(jd);
+  const double splitB = scaled ? -rhsPenetration / jd : 0.0;
+  out.b = split ? splitB : scaled ? -rhs / jd : 0.0;
   if (cfm_ == CfmModel::StockMlcp)
     out.cfm = stockCfm_;
   else
-    out.cfm = scaled ? std::max(0.0, c.m_cfm / jd) : 0.0;
-  if (cfm_ == CfmModel::Regularized && findex_[i] >= 0 && out.cfm == 0) out.cfm = stockCfm_;
-  out.findex = findex_[i] >= 0 ? rowLocal_[findex_[i]] : -1;
-  if (findex_[i] >= 0) {
-    out.lo = -std::abs(static_cast<double>(c.m_friction));
-    out.hi = std::abs(static_cast<double>(c.m_friction));
+    out.cfm = scaled ? std::max(0.0, rowCfm / jd) : 0.0;
+  if (cfm_ == CfmModel::Regularized && findex >= 0 && out.cfm == 0) out.cfm = stockCfm_;
+  out.findex = findex;
+  if (findex >= 0) {
+    out.lo = -std::abs(friction);
+    out.hi = std::abs(friction);
   } else if (i >= nj_) {  // contact
     out.lo = 0;
     out.hi = kInf;
   } else {
-    out.lo = bound(c.m_lowerLimit);
-    out.hi = bound(c.m_upperLimit);
+    out.lo = bound(lower);
+    out.hi = bound(upper);
   }
-  const bool warm = start_ != Start::Zero;
-  if (split) {
-    out.b = splitB;
-    out.base = static_cast<double>(c.m_appliedPushImpulse);
-    out.start = warm ? out.base : 0.0;
-    return;
-  }
-  Island& isl = islands_[rowIsland_[i]];
-  if (splitB != 0) isl.hasSplit = true;
-  out.base = static_cast<double>(c.m_appliedImpulse);
-  const double unscale = i >= nj_ ? unscaleContacts_ : 1.0;
-  out.start = warm ? unscale * out.base : 0.0;
-  const btManifoldPoint* point = isl.point[rowLocal_[i]];
-  if (point && start_ == Start::CachedImpulse) {
-    const bool contact = i < nj_ + nc_;
-    if (const auto* last = static_cast<const Remembered*>(isl.last[rowLocal_[i]])) {
-      out.start = contact ? last->normal : last->friction.dot(frictionDirection(c));
-    } else if (!contact && lateralCache_) {
-      const bool first = i - nj_ - nc_ == (*in_.contacts)[c.m_frictionIndex].m_frictionIndex;
-      out.start = first ? point->m_appliedImpulseLateral1 : point->m_appliedImpulseLateral2;
-    }
-  }
+  out.base = base;
+  out.start = start;
+  if (!split && splitB != 0) isl.hasSplit = true;
 }
 
 void IslandBuilder::fill(Island& island, int first, int count, RowPgs::Row* out, bool split) {
-  for (int j = 0; j < count; ++j) convert(island.rowIndex[first + j], out[j], split);
+  for (int j = 0; j < count; ++j) convert(island, first + j, out[j], split);
 }
 
 void IslandBuilder::fillSystem(Island& isl) {
@@ -288,7 +297,7 @@ void IslandBuilder::fillSystem(Island& isl) {
   isl.splitStart.resize(m);
   RowPgs::Row push;
   for (int r = 0; r < m; ++r) {
-    convert(isl.rowIndex[r], push, true);
+    convert(isl, r, push, true);
     isl.splitB[r] = push.b;
     isl.splitStart[r] = push.start;
   }
@@ -305,6 +314,11 @@ void IslandBuilder::remember(const Island& island, const Vector& x, bool store) 
   const int n = static_cast<int>(island.point.size());
   entry_.assign(n, -1);
   for (int r = 0; r < n; ++r) {
+    // After the sweeps Bullet's rows and the manifold points are out of the near caches.
+    if (r + kAhead < n) {
+      prefetchRow(island.rows[r + kAhead]);
+      if (island.point[r + kAhead]) __builtin_prefetch(island.point[r + kAhead]);
+    }
     if (store) island.rows[r]->m_appliedImpulse = static_cast<btScalar>(x[r]);
     const btManifoldPoint* point = island.point[r];
     if (!point) continue;

@@ -115,8 +115,8 @@ class IslandBuilder {
 
  private:
   int find(int k);
-  // Global row i's values; split: the split-impulse problem's b, start and base.
-  void convert(int i, RowPgs::Row& out, bool split);
+  // The island's row r; split: the split-impulse problem's b, start and base.
+  void convert(Island& island, int r, RowPgs::Row& out, bool split);
 
   std::vector<Island> islands_;
   int count_ = 0, inert_ = 0;
