@@ -728,9 +728,9 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
   blockSettled_ = false;
   const bool warm = !x.isZero(0.0);
   if (!wantsBlockStage(problem)) {
-    // A joint island's warm start: the same steps on fixed-size arrays, else the general path
-    // (from cold it would pivot: its code would only add to the first step's cold fetches).
-    if (warm && detail::smallDenseApplies(problem) &&
+    // A tiny island's guessed index sets (warm, or the cold guess of dantzig_small.hpp): the
+    // same steps on fixed-size arrays, else the general path.
+    if (detail::smallDenseApplies(problem) &&
         detail::solveSmallDense(problem, options().pivotTolerance, x)) {
       ws.passes = 1;
       result.status = Status::Converged;

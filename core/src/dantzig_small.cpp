@@ -108,13 +108,13 @@ namespace {
 template <int n>
 bool solveFixed(const Problem& pb, double pivotTolerance, Vector& xInOut) {
   const DenseMatrix& A = pb.denseA();
-  const bool useGuess = !xInOut.isZero(0.0);
 
-  // Processing order: 0 equality rows, 1 rows guessed clamped, 2 the others (counting sort).
+  // Processing order: 0 equality rows, 1 rows guessed clamped (the start strictly inside the
+  // bounds; a cold start: the rows whose bounds contain 0), 2 the others (counting sort).
   int group[n], perm[n], start[4] = {0, 0, 0, 0};
   for (int i = 0; i < n; ++i) {
     const double lo = pb.lo[i], hi = pb.hi[i], g = xInOut[i];
-    group[i] = isEquality(lo, hi) ? 0 : useGuess && g > lo && g < hi ? 1 : 2;
+    group[i] = isEquality(lo, hi) ? 0 : g > lo && g < hi ? 1 : 2;
     ++start[group[i] + 1];
   }
   start[2] += start[1];
@@ -154,7 +154,7 @@ bool solveFixed(const Problem& pb, double pivotTolerance, Vector& xInOut) {
     b[p] = pb.b[i];
     lo[p] = pb.lo[i];
     hi[p] = pb.hi[i];
-    x[p] = std::clamp(useGuess ? xInOut[i] : 0.0, lo[p], hi[p]);
+    x[p] = std::clamp(xInOut[i], lo[p], hi[p]);
     dMax = std::max(dMax, std::abs(f.a[p + p * n]));
   }
   const double pivTol = (dMax > 0 ? dMax : aMax > 0 ? aMax : 1.0) * pivotTolerance;

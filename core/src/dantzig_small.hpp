@@ -30,7 +30,11 @@ inline constexpr int kSmallDenseRows = 8;
 // Whether the path applies: dense A, 1..kSmallDenseRows rows, no findex.
 bool smallDenseApplies(const Problem& problem);
 
-// Solves the problem from x (the start; all zero = cold) with the guessed index sets.
+// Solves the problem from x (the start) with the guessed index sets: rows whose start lies
+// strictly inside their bounds clamped. From a cold start (all zero) that guesses the rows whose
+// bounds contain 0 clamped, the others at the bound 0: right for a joint island whose limit or
+// contact rows are not pushing, which spares its first step the general path's cold code (an
+// engine that starts every solve from zero, as Bullet does, takes this path on every step).
 // pivotTolerance: Options::pivotTolerance (relative to max |A_ii|). True with the answer in x
 // when every row's complementarity condition holds (to 1e-12 (1 + ||b||_inf) in w); false,
 // x untouched, otherwise.

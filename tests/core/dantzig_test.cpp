@@ -355,7 +355,7 @@ KnownProblem smallProblem(Generator& g, int n, int kind) {
 // Taken, the path's answer solves the problem and is the general path's (the same problem
 // stored sparse, which the path never takes); declined, x is untouched. Guesses: the solution
 // (taken unless a row sits exactly on a bound with w = 0), a perturbed solution (either), zero
-// (taken only for equality-only problems), random.
+// (the cold guess: rows whose bounds contain 0 clamped; either), random.
 TEST(DantzigSmall, AnswersAreTheGeneralPathsOrDeclined) {
   Generator g(31);
   int taken = 0, declined = 0;
