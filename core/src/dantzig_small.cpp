@@ -105,15 +105,29 @@ bool smallDenseApplies(const Problem& problem) {
 
 namespace {
 
+// Tries per solve: the caller's guess and two corrected ones (solveSmallDense).
+constexpr int kTries = 3;
+
+enum class Try : unsigned char { Solved, Declined, Again };
+
+// A value strictly inside [lo, hi] (lo < hi), for a row moved from a bound to the clamped set;
+// NaN when there is none in double (a bound of 1e16 and up: lo + 1 == lo).
+double inside(double lo, double hi) {
+  const double v = lo > -kInf && hi < kInf ? 0.5 * (lo + hi) : lo > -kInf ? lo + 1 : hi - 1;
+  return v > lo && v < hi ? v : std::numeric_limits<double>::quiet_NaN();
+}
+
+// One try from guess (the caller's order): Solved with the answer in xOut; Declined; or Again
+// with guess changed to the index sets one block-pivoting step corrects it to.
 template <int n>
-bool solveFixed(const Problem& pb, double pivotTolerance, Vector& xInOut) {
+Try solveFixed(const Problem& pb, double pivotTolerance, double* guess, Vector& xOut) {
   const DenseMatrix& A = pb.denseA();
 
   // Processing order: 0 equality rows, 1 rows guessed clamped (the start strictly inside the
   // bounds; a cold start: the rows whose bounds contain 0), 2 the others (counting sort).
   int group[n], perm[n], start[4] = {0, 0, 0, 0};
   for (int i = 0; i < n; ++i) {
-    const double lo = pb.lo[i], hi = pb.hi[i], g = xInOut[i];
+    const double lo = pb.lo[i], hi = pb.hi[i], g = guess[i];
     group[i] = isEquality(lo, hi) ? 0 : g > lo && g < hi ? 1 : 2;
     ++start[group[i] + 1];
   }
@@ -136,7 +150,7 @@ bool solveFixed(const Problem& pb, double pivotTolerance, Vector& xInOut) {
   for (int j = 0; j < n; ++j)
     for (int i = j + 1; i < n; ++i)
       asym[i & 1] = std::max(asym[i & 1], std::abs(a[i + j * n] - a[j + i * n]));
-  if (!(std::max(asym[0], asym[1]) <= 1e-14 * aMax)) return false;  // non-symmetric: general
+  if (!(std::max(asym[0], asym[1]) <= 1e-14 * aMax)) return Try::Declined;  // non-symmetric
 
   Factors<n> f;
   double permuted[n * n];
@@ -154,25 +168,33 @@ bool solveFixed(const Problem& pb, double pivotTolerance, Vector& xInOut) {
     b[p] = pb.b[i];
     lo[p] = pb.lo[i];
     hi[p] = pb.hi[i];
-    x[p] = std::clamp(xInOut[i], lo[p], hi[p]);
+    x[p] = std::clamp(guess[i], lo[p], hi[p]);
     dMax = std::max(dMax, std::abs(f.a[p + p * n]));
   }
   const double pivTol = (dMax > 0 ? dMax : aMax > 0 ? aMax : 1.0) * pivotTolerance;
   const double bMax = pb.b.lpNorm<Eigen::Infinity>();
   const double epsW = 1e-12 * (1.0 + bMax);
 
-  // The guessed block: factor, solve x_C with the others at their start, all inside bounds.
+  // The guessed block: factor, solve x_C with the others at their start, all inside bounds
+  // (the next try has the rows outside at the bound they crossed).
   for (int p = 0; p < n; ++p)
-    if (groupAt[p] <= 1 && !f.join(p, pivTol)) return false;
+    if (groupAt[p] <= 1 && !f.join(p, pivTol)) return Try::Declined;
   if (f.m > 0) {
     f.solveClamped(b, x);
-    for (int c = 0; c < f.m; ++c)
-      if (x[f.C[c]] < lo[f.C[c]] || x[f.C[c]] > hi[f.C[c]]) return false;
+    bool outside = false;
+    for (int c = 0; c < f.m; ++c) {
+      const int p = f.C[c];
+      if (x[p] < lo[p]) guess[perm[p]] = lo[p];
+      if (x[p] > hi[p]) guess[perm[p]] = hi[p];
+      outside = outside || x[p] < lo[p] || x[p] > hi[p];
+    }
+    if (outside) return Try::Again;
   }
   // The other rows, in order, stay at their bound when their w allows it (their x is there
   // already: the clamped start), so one w of every row serves all of them.
   for (int p = 0; p < n; ++p) w[p] = b[p] + f.rowDot(p, x);
   At at[n];
+  bool driven = false;  // a row at a bound whose w points inward: the next try clamps it
   for (int p = 0; p < n; ++p) {
     at[p] = At::Clamped;
     if (groupAt[p] <= 1) continue;
@@ -187,9 +209,12 @@ bool solveFixed(const Problem& pb, double pivotTolerance, Vector& xInOut) {
       x[p] = hi[p];
       at[p] = At::Hi;
     } else {
-      return false;  // the row would be driven: the general path pivots
+      guess[perm[p]] = inside(lo[p], hi[p]);
+      if (std::isnan(guess[perm[p]])) return Try::Declined;
+      driven = true;
     }
   }
+  if (driven) return Try::Again;
   // One step of iterative refinement, then every row at a bound checked with a fresh w; not
   // when the clamped rows' w is within the rounding error of its own evaluation,
   // (n + 1) eps (|b| + n max|A| |x|): a correction from it would be noise (the general path
@@ -202,10 +227,22 @@ bool solveFixed(const Problem& pb, double pivotTolerance, Vector& xInOut) {
     f.solveClamped(b, x);
     for (int p = 0; p < n; ++p) w[p] = b[p] + f.rowDot(p, x);
     for (int p = 0; p < n; ++p)
-      if ((at[p] == At::Lo && w[p] < -epsW) || (at[p] == At::Hi && w[p] > epsW)) return false;
+      if ((at[p] == At::Lo && w[p] < -epsW) || (at[p] == At::Hi && w[p] > epsW))
+        return Try::Declined;
   }
-  for (int p = 0; p < n; ++p) xInOut[perm[p]] = x[p];
-  return true;
+  for (int p = 0; p < n; ++p) xOut[perm[p]] = x[p];
+  return Try::Solved;
+}
+
+template <int n>
+bool solveTries(const Problem& pb, double pivotTolerance, Vector& x) {
+  double guess[n];
+  for (int i = 0; i < n; ++i) guess[i] = x[i];
+  for (int t = 0; t < kTries; ++t) {
+    const Try r = solveFixed<n>(pb, pivotTolerance, guess, x);
+    if (r != Try::Again) return r == Try::Solved;
+  }
+  return false;
 }
 
 }  // namespace
@@ -213,14 +250,14 @@ bool solveFixed(const Problem& pb, double pivotTolerance, Vector& xInOut) {
 bool solveSmallDense(const Problem& pb, double pivotTolerance, Vector& x) {
   static_assert(kSmallDenseRows == 8, "one instance per size below");
   switch (pb.size()) {
-    case 1: return solveFixed<1>(pb, pivotTolerance, x);
-    case 2: return solveFixed<2>(pb, pivotTolerance, x);
-    case 3: return solveFixed<3>(pb, pivotTolerance, x);
-    case 4: return solveFixed<4>(pb, pivotTolerance, x);
-    case 5: return solveFixed<5>(pb, pivotTolerance, x);
-    case 6: return solveFixed<6>(pb, pivotTolerance, x);
-    case 7: return solveFixed<7>(pb, pivotTolerance, x);
-    case 8: return solveFixed<8>(pb, pivotTolerance, x);
+    case 1: return solveTries<1>(pb, pivotTolerance, x);
+    case 2: return solveTries<2>(pb, pivotTolerance, x);
+    case 3: return solveTries<3>(pb, pivotTolerance, x);
+    case 4: return solveTries<4>(pb, pivotTolerance, x);
+    case 5: return solveTries<5>(pb, pivotTolerance, x);
+    case 6: return solveTries<6>(pb, pivotTolerance, x);
+    case 7: return solveTries<7>(pb, pivotTolerance, x);
+    case 8: return solveTries<8>(pb, pivotTolerance, x);
     default: return false;
   }
 }

@@ -13,11 +13,18 @@
 // divisions were links of the dependent chain that sets a 6-row island's latency), and it skips
 // the general path's one step of iterative refinement when the clamped rows' w is already at
 // the rounding level of its evaluation (a third of the path's time on the ODE hinge island,
-// whose trajectory moved by under 1e-12). It gives up (returns false, x untouched)
-// wherever the general path would pivot or fall back: a guessed row whose Schur pivot is at
-// most the pivot tolerance, a solved x_C outside its bounds, a row at a bound whose w points
-// the wrong way (before or after the refinement), an A that is not symmetric; DantzigSolver
-// then runs the general path from the same start. Declining costs at most this path's work.
+// whose trajectory moved by under 1e-12).
+//
+// A guess whose sets are off is corrected by block-pivoting steps (at most kTries - 1 = 2, in
+// dantzig_small.cpp): a solved x_C outside its bounds puts those rows at the bound they crossed,
+// a row at a bound whose w points inward (w < 0 at lo, w > 0 at hi) is clamped, and the path
+// starts again from those sets. Any answer it returns passed every check above for its final
+// sets, so it is an answer of the problem (for a positive definite A_CC, the answer: the
+// general path's to round-off). It gives up (returns false, x untouched) on a guessed row whose
+// Schur pivot is at most the pivot tolerance, a row at a bound whose w points inward after the
+// refinement, an A that is not symmetric, or sets still off after the corrections;
+// DantzigSolver then runs the general path from the caller's start. Declining costs at most
+// this path's work three times.
 #pragma once
 
 #include "mlcp/problem.hpp"
@@ -33,8 +40,9 @@ bool smallDenseApplies(const Problem& problem);
 // Solves the problem from x (the start) with the guessed index sets: rows whose start lies
 // strictly inside their bounds clamped. From a cold start (all zero) that guesses the rows whose
 // bounds contain 0 clamped, the others at the bound 0: right for a joint island whose limit or
-// contact rows are not pushing, which spares its first step the general path's cold code (an
-// engine that starts every solve from zero, as Bullet does, takes this path on every step).
+// contact rows are not pushing (else the corrections above find them), which spares its first
+// step the general path's cold code (an engine that starts every solve from zero, as Bullet
+// does, takes this path on every step).
 // pivotTolerance: Options::pivotTolerance (relative to max |A_ii|). True with the answer in x
 // when every row's complementarity condition holds (to 1e-12 (1 + ||b||_inf) in w); false,
 // x untouched, otherwise.
