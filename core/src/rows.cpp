@@ -358,10 +358,15 @@ bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& row
     p.sB = step * *r.jB;
     // Couplings to the run's earlier rows k: step J_i M^-1 J_k^T on the run's two bodies, i.e.
     // sA . mA_k + sB . mB_k (scalars from locals: no reading back of what was just stored).
+    // step J_i in scalars once (the products the sums used, so the same couplings to the bit).
+    double sJ[12];
+    for (int j = 0; j < 6; ++j) {
+      sJ[j] = step * (*r.jA)[j];
+      sJ[6 + j] = step * (*r.jB)[j];
+    }
     for (int k = 0; k + 1 < runLength; ++k) {
       double c = 0;
-      for (int j = 0; j < 6; ++j) c += step * (*r.jA)[j] * runM[k][j];
-      for (int j = 0; j < 6; ++j) c += step * (*r.jB)[j] * runM[k][6 + j];
+      for (int j = 0; j < 12; ++j) c += sJ[j] * runM[k][j];
       coupling_[coupled++] = c;
     }
     for (int j = 0; j < 6; ++j) {

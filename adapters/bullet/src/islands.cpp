@@ -39,13 +39,8 @@ bool sameUpdate(const btSolverBody& b) {
   return f[0] == f[1] && f[1] == f[2];
 }
 
-// How many rows ahead remember() fetches Bullet's rows (288 bytes in double precision; it reads
-// the first lines and writes the fourth) and manifold points.
+// How many rows ahead remember() fetches the line of Bullet's row it writes.
 constexpr int kAhead = 6;
-void prefetchRow(const btSolverConstraint* c) {
-  const char* p = reinterpret_cast<const char*>(c);
-  for (int line = 0; line < 4; ++line) __builtin_prefetch(p + 64 * line);
-}
 
 }  // namespace
 
@@ -134,6 +129,11 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     }
     return bodyLocal_[d];
   };
+  // First each row's island and its place there (a manifold's rows repeat the previous row's
+  // bodies: no find() for them), then each island's arrays at their final sizes, written by
+  // index (no growth checks per row).
+  rowsIn_.clear();
+  int lastPairA = -2, lastPairB = -2, lastIsland = -1;
   for (int i = 0; i < n; ++i) {
     const auto [a, b] = rowBodies_[i];
     if (a < 0 && b < 0) {
@@ -141,55 +141,75 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
       ++inert_;
       continue;
     }
-    const int root = find(a >= 0 ? a : b);
-    if (islandOfRoot_[root] < 0) {
-      islandOfRoot_[root] = count_++;
-      if (static_cast<int>(islands_.size()) < count_) islands_.resize(count_);
-      Island& isl = islands_[count_ - 1];
-      isl.system.bodies.clear();
-      isl.system.findex.clear();
-      isl.solverBody.clear();
-      isl.rows.clear();
-      isl.rowIndex.clear();
-      isl.point.clear();
-      isl.last.clear();
-      isl.points = 0;
-      isl.hasSplit = false;
-      isl.filled = false;
-      isl.perRowWriteBack = false;
+    int k = lastIsland;
+    if (a != lastPairA || b != lastPairB) {
+      const int root = find(a >= 0 ? a : b);
+      if (islandOfRoot_[root] < 0) {
+        islandOfRoot_[root] = count_++;
+        if (static_cast<int>(islands_.size()) < count_) islands_.resize(count_);
+        rowsIn_.push_back(0);
+        Island& isl = islands_[count_ - 1];
+        isl.system.bodies.clear();
+        isl.solverBody.clear();
+        isl.points = 0;
+        isl.hasSplit = false;
+        isl.filled = false;
+        isl.perRowWriteBack = false;
+      }
+      k = islandOfRoot_[root];
+      localBody(islands_[k], a);
+      localBody(islands_[k], b);
+      lastPairA = a;
+      lastPairB = b;
+      lastIsland = k;
     }
-    const int k = islandOfRoot_[root];
-    Island& isl = islands_[k];
-    const int r = static_cast<int>(isl.rows.size());
     rowIsland_[i] = k;
-    rowLocal_[i] = r;
-    localBody(isl, a);
-    localBody(isl, b);
+    rowLocal_[i] = rowsIn_[k]++;
+  }
+  for (int k = 0; k < count_; ++k) {
+    Island& isl = islands_[k];
+    const std::size_t m = static_cast<std::size_t>(rowsIn_[k]);
+    isl.rows.resize(m);
+    isl.rowIndex.resize(m);
+    isl.system.findex.resize(m);
+    isl.point.resize(m);
+    isl.last.resize(m);
+    isl.memo.resize(m);
+  }
+  for (int i = 0; i < n; ++i) {
+    const int k = rowIsland_[i];
+    if (k < 0) continue;
+    Island& isl = islands_[k];
+    const int r = rowLocal_[i];
     btSolverConstraint& c = *all_[i];
-    isl.rows.push_back(&c);
-    isl.rowIndex.push_back(i);
-    isl.system.findex.push_back(findex_[i] >= 0 ? rowLocal_[findex_[i]] : -1);
+    isl.rows[r] = &c;
+    isl.rowIndex[r] = i;
+    const int f = findex_[i] >= 0 ? rowLocal_[findex_[i]] : -1;
+    isl.system.findex[r] = f;
     const btManifoldPoint* point = nullptr;
     const Remembered* last = nullptr;
+    btVector3 memo(0, 0, 0);
     if (i >= nj && i < nj + nc + nf) {  // a contact or friction row
-      const bool contact = i < nj + nc;
       // Last step's answer at this manifold point, if it is the same point (see remember());
       // a friction row's point is its contact row's (listed already: contacts come first).
-      if (!contact) {
-        point = isl.point[rowLocal_[findex_[i]]];
-        last = static_cast<const Remembered*>(isl.last[rowLocal_[findex_[i]]]);
+      if (i >= nj + nc) {
+        point = isl.point[f];
+        last = static_cast<const Remembered*>(isl.last[f]);
       } else {
         point = static_cast<const btManifoldPoint*>(c.m_originalContactPoint);
-        if (point) ++isl.points;
+        if (point) {
+          ++isl.points;
+          memo = point->m_localPointA;
+        }
         if (point && start == Start::CachedImpulse) {
           last = lookup(point);
-          if (last && (point->m_localPointA - last->localA).length() >= gContactBreakingThreshold)
-            last = nullptr;
+          if (last && (memo - last->localA).length() >= gContactBreakingThreshold) last = nullptr;
         }
       }
     }
-    isl.point.push_back(point);
-    isl.last.push_back(last);
+    isl.point[r] = point;
+    isl.last[r] = last;
+    isl.memo[r] = memo;
   }
 
   stockCfm_ = info.m_globalCfm / info.m_timeStep;
@@ -276,7 +296,9 @@ inline void IslandBuilder::convert(Island& isl, int r, RowPgs::Row& out, bool sp
   }
   out.base = base;
   out.start = start;
-  if (!split && splitB != 0) isl.hasSplit = true;
+  if (split) return;
+  if (splitB != 0) isl.hasSplit = true;
+  if (findex >= 0 && isl.point[r]) isl.memo[r] = frictionDirection(c);
 }
 
 void IslandBuilder::fill(Island& island, int first, int count, RowPgs::Row* out, bool split) {
@@ -314,31 +336,19 @@ void IslandBuilder::remember(const Island& island, const Vector& x, bool store) 
   const int n = static_cast<int>(island.point.size());
   entry_.assign(n, -1);
   for (int r = 0; r < n; ++r) {
-    // After the sweeps Bullet's rows and the manifold points are out of the near caches.
-    if (r + kAhead < n) {
-      prefetchRow(island.rows[r + kAhead]);
-      if (island.point[r + kAhead]) __builtin_prefetch(island.point[r + kAhead]);
-    }
+    // After the sweeps Bullet's rows are out of the near caches: fetch the line written.
+    if (store && r + kAhead < n) __builtin_prefetch(&island.rows[r + kAhead]->m_appliedImpulse, 1);
     if (store) island.rows[r]->m_appliedImpulse = static_cast<btScalar>(x[r]);
     const btManifoldPoint* point = island.point[r];
     if (!point) continue;
     // A friction row's point is its contact row's (earlier in the island): the same entry.
     const int f = island.system.findex[r];
-    int e = f >= 0 ? entry_[f] : -1;
-    if (e < 0) {
-      e = static_cast<int>(this_.size());
-      this_.emplace_back();
-      Remembered& m = this_.back();
-      m.point = point;
-      m.friction.setZero();
-      m.localA = point->m_localPointA;
-      entry_[r] = e;
+    if (f < 0) {
+      entry_[r] = static_cast<int>(this_.size());
+      this_.push_back({point, x[r], btVector3(0, 0, 0), island.memo[r]});
+    } else if (entry_[f] >= 0) {
+      this_[entry_[f]].friction += static_cast<btScalar>(x[r]) * island.memo[r];
     }
-    Remembered& m = this_[e];
-    if (f < 0)
-      m.normal = x[r];
-    else
-      m.friction += static_cast<btScalar>(x[r]) * frictionDirection(*island.rows[r]);
   }
 }
 

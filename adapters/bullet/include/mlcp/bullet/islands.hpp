@@ -61,6 +61,10 @@ struct Island {
   // Each contact and friction row's remembered answer from last step (null: none), found once
   // per point by build().
   std::vector<const void*> last;
+  // What remember() needs of each row with a point, kept here so that it reads neither Bullet's
+  // rows nor the points after the sweeps: a contact row's point's m_localPointA (build()), a
+  // friction row's direction (the impulse on body A per unit x; convert()).
+  std::vector<btVector3> memo;
   int points = 0;  // contact rows with a manifold point
   // A body's linear factor has a component other than 0 and 1, or its angular factor unequal
   // components: Bullet's body update is not M^-1 J^T there (constraint_solver.hpp), so a
@@ -122,7 +126,7 @@ class IslandBuilder {
   int count_ = 0, inert_ = 0;
   std::vector<btSolverConstraint*> all_;
   std::vector<int> findex_, dynamic_, parent_, islandOfRoot_, rowIsland_, rowLocal_, bodyLocal_;
-  std::vector<int> bodyCount_;
+  std::vector<int> rowsIn_;                     // build(): rows per island
   std::vector<std::pair<int, int>> rowBodies_;  // each row's dynamic bodies (-1: none)
   // What convert() needs of the last build() call.
   BulletRows in_;
