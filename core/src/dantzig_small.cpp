@@ -20,17 +20,18 @@ constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
 
 bool isEquality(double lo, double hi) { return lo == -kInf && hi == kInf; }
 
-// The guessed block's factors A_CC = L D L^T (columns n apart, D kept as its reciprocals) and
-// the operations of DantzigSolver's general path on them (see dantzig_small.hpp). The size n is
-// a template argument: the products over n rows compile to straight-line code.
+// The guessed block's factors A_CC = L D L^T (D kept as its reciprocals), the clamped rows
+// being the first m positions of the processing order. The block is padded to n x n by
+// identity rows (L's row 0, D 1: the rows at a bound, which come after the clamped ones), so
+// every loop runs over n, a template argument: the factor and the solves compile to
+// straight-line code whose independent products overlap (with the loops over a run-time m and
+// a division per pivot, the dependent chain set a 6-row island's latency).
 template <int n>
 struct Factors {
   int m = 0;
   const double* a = nullptr;  // A in processing order, column-major n x n
-  double L[n * n], invD[n];
-  int C[n];
-
-  int size() const { return m < n ? m : n; }  // m, visibly at most n for the compiler
+  double L[n * n];            // row-major: L[j * n + k] = L_jk, k < j
+  double invD[n];
 
   double rowDot(int i, const double* v) const {
     const double* row = a + i * n;  // A is symmetric: column i is row i
@@ -38,59 +39,48 @@ struct Factors {
     for (int k = 0; k < n; ++k) s += row[k] * v[k];
     return s;
   }
-  // y <- L^-1 y.
-  void substitute(double* y) const {
-    const int m = size();
-    for (int k = 0; k < m; ++k) {
-      const double yk = y[k];
-      if (yk == 0) continue;
-      const double* col = L + k * n;
-      for (int i = k + 1; i < m; ++i) y[i] -= yk * col[i];
+  // L D L^T of the first `clamped` positions (Crout, row by row); false when a pivot is at
+  // most pivTol (the bordered factor's Schur pivots of dantzig.cpp, in the same order).
+  bool factor(int clamped, double pivTol) {
+    m = clamped;
+    for (int j = 0; j < n; ++j) {
+      double* Lj = L + j * n;
+      if (j >= m) {
+        for (int k = 0; k < n; ++k) Lj[k] = 0;
+        invD[j] = 1;
+        continue;
+      }
+      const double* col = a + j * n;
+      double t[n];  // t_k = (L D)_jk = a_jk - sum_{c<k} t_c L_kc
+      double pivot = col[j];
+      for (int k = 0; k < j; ++k) {
+        double s = col[k];
+        for (int c = 0; c < k; ++c) s -= t[c] * L[k * n + c];
+        t[k] = s;
+        Lj[k] = s * invD[k];
+        pivot -= s * Lj[k];
+      }
+      for (int k = j; k < n; ++k) Lj[k] = 0;
+      if (!(std::abs(pivot) > pivTol)) return false;
+      invD[j] = 1.0 / pivot;
     }
-  }
-  // y <- D^-1 L^-1 y (multiplied by the reciprocal pivots: a division's latency each was a
-  // dependent link of the chain from the factor to the answer).
-  void forward(double* y) const {
-    substitute(y);
-    for (int c = 0; c < size(); ++c) y[c] *= invD[c];
-  }
-  // y <- L^-T y.
-  void backward(double* y) const {
-    const int m = size();
-    if (m == 0) return;
-    for (int i = m - 2; i >= 0; --i) {
-      const double* col = L + i * n;
-      double s = 0;
-      for (int k = i + 1; k < m; ++k) s += col[k] * y[k];
-      y[i] -= s;
-    }
-  }
-  // Borders the factors with position p; false when its Schur pivot is at most pivTol.
-  bool join(int p, double pivTol) {
-    if (m >= n) return false;  // (never: each position joins once)
-    double u[n];
-    const double* col = a + p * n;
-    for (int c = 0; c < m; ++c) u[c] = col[C[c]];
-    substitute(u);  // u = L^-1 a_Cp; the new row of L is D^-1 u, its pivot a_pp - u^T D^-1 u
-    double s = 0;
-    for (int c = 0; c < m; ++c) {
-      const double l = u[c] * invD[c];
-      s += l * u[c];
-      L[m + c * n] = l;
-    }
-    const double pivot = col[p] - s;
-    if (!(std::abs(pivot) > pivTol)) return false;
-    invD[m] = 1.0 / pivot;
-    C[m++] = p;
     return true;
   }
-  // x_C -= A_CC^-1 (b + A x)_C.
+  // x_C -= A_CC^-1 (b + A x)_C (the padded rows' entries of the solve are exact zeros).
   void solveClamped(const double* b, double* x) const {
-    double r[n];
-    for (int c = 0; c < m; ++c) r[c] = b[C[c]] + rowDot(C[c], x);
-    forward(r);
-    backward(r);
-    for (int c = 0; c < m; ++c) x[C[c]] -= r[c];
+    double y[n];
+    for (int k = 0; k < n; ++k) {
+      double s = k < m ? b[k] + rowDot(k, x) : 0.0;
+      for (int c = 0; c < k; ++c) s -= L[k * n + c] * y[c];
+      y[k] = s;
+    }
+    for (int k = 0; k < n; ++k) y[k] *= invD[k];
+    for (int k = n - 1; k >= 0; --k) {
+      double s = y[k];
+      for (int j = k + 1; j < n; ++j) s -= L[j * n + k] * y[j];
+      y[k] = s;
+      x[k] -= s;
+    }
   }
 };
 
@@ -133,6 +123,7 @@ Try solveFixed(const Problem& pb, double pivotTolerance, double* guess, Vector& 
   }
   start[2] += start[1];
   start[3] += start[2];
+  const int clamped = start[2];  // groups 0 and 1: positions 0 .. clamped - 1
   bool identity = true;
   int groupAt[n];
   for (int i = 0; i < n; ++i) {
@@ -177,13 +168,11 @@ Try solveFixed(const Problem& pb, double pivotTolerance, double* guess, Vector& 
 
   // The guessed block: factor, solve x_C with the others at their start, all inside bounds
   // (the next try has the rows outside at the bound they crossed).
-  for (int p = 0; p < n; ++p)
-    if (groupAt[p] <= 1 && !f.join(p, pivTol)) return Try::Declined;
-  if (f.m > 0) {
+  if (!f.factor(clamped, pivTol)) return Try::Declined;
+  if (clamped > 0) {
     f.solveClamped(b, x);
     bool outside = false;
-    for (int c = 0; c < f.m; ++c) {
-      const int p = f.C[c];
+    for (int p = 0; p < clamped; ++p) {
       if (x[p] < lo[p]) guess[perm[p]] = lo[p];
       if (x[p] > hi[p]) guess[perm[p]] = hi[p];
       outside = outside || x[p] < lo[p] || x[p] > hi[p];
@@ -220,16 +209,18 @@ Try solveFixed(const Problem& pb, double pivotTolerance, double* guess, Vector& 
   // (n + 1) eps (|b| + n max|A| |x|): a correction from it would be noise (the general path
   // refines always; the refinement was a third of this path's time on the ODE hinge).
   double wC = 0, xMax = 0;
-  for (int c = 0; c < f.m; ++c) wC = std::max(wC, std::abs(w[f.C[c]]));
+  for (int p = 0; p < clamped; ++p) wC = std::max(wC, std::abs(w[p]));
   for (int p = 0; p < n; ++p) xMax = std::max(xMax, std::abs(x[p]));
   const double rounding = (n + 1) * kEpsilon * (bMax + n * aMax * xMax);
-  if (wC > rounding) {
+  if (!(wC <= rounding)) {
     f.solveClamped(b, x);
     for (int p = 0; p < n; ++p) w[p] = b[p] + f.rowDot(p, x);
     for (int p = 0; p < n; ++p)
       if ((at[p] == At::Lo && w[p] < -epsW) || (at[p] == At::Hi && w[p] > epsW))
         return Try::Declined;
   }
+  for (int p = 0; p < n; ++p)
+    if (!std::isfinite(x[p])) return Try::Declined;  // overflow: the general path decides
   for (int p = 0; p < n; ++p) xOut[perm[p]] = x[p];
   return Try::Solved;
 }
