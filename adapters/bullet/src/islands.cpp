@@ -39,7 +39,7 @@ bool sameUpdate(const btSolverBody& b) {
   return f[0] == f[1] && f[1] == f[2];
 }
 
-// How many rows ahead remember() fetches the line of Bullet's row it writes.
+// How many rows ahead the passes over Bullet's rows fetch what they read or write next.
 constexpr int kAhead = 6;
 
 }  // namespace
@@ -189,6 +189,9 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     const btManifoldPoint* point = nullptr;
     const Remembered* last = nullptr;
     btVector3 memo(0, 0, 0);
+    // The manifold points are read here first (their local position): fetched ahead.
+    if (i >= nj && i + kAhead < nj + nc)
+      __builtin_prefetch(all_[i + kAhead]->m_originalContactPoint);
     if (i >= nj && i < nj + nc + nf) {  // a contact or friction row
       // Last step's answer at this manifold point, if it is the same point (see remember());
       // a friction row's point is its contact row's (listed already: contacts come first).
@@ -302,7 +305,15 @@ inline void IslandBuilder::convert(Island& isl, int r, RowPgs::Row& out, bool sp
 }
 
 void IslandBuilder::fill(Island& island, int first, int count, RowPgs::Row* out, bool split) {
-  for (int j = 0; j < count; ++j) convert(island, first + j, out[j], split);
+  const int n = static_cast<int>(island.rows.size());
+  for (int j = 0; j < count; ++j) {
+    // The first read of Bullet's rows' first four lines (build() read the fifth).
+    if (first + j + kAhead < n) {
+      const char* ahead = reinterpret_cast<const char*>(island.rows[first + j + kAhead]);
+      for (int line = 0; line < 4; ++line) __builtin_prefetch(ahead + 64 * line);
+    }
+    convert(island, first + j, out[j], split);
+  }
 }
 
 void IslandBuilder::fillSystem(Island& isl) {
