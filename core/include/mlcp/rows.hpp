@@ -110,7 +110,9 @@ class RowSystem {
 // sweeps from ~51 us to ~37 us (~8 ns a row); without the unrolling the coupling sums read the
 // changes back from a stack array in pairs and stalled store forwarding, and the runs gained
 // nothing. Packing once lost a quarter of its time to such stalls too (Eigen's M^-1 J^T
-// temporary read back from the stack; now computed in scalars).
+// temporary read back from the stack; now computed in scalars). Round 2 of session 4: packing
+// ~23% (~0.2 ms, ~45 ns a row; the largest single cost is waiting for step = omega / A_ii, the
+// rest is spread thin), the couplings' step J_i computed once per row.
 class RowPgs {
  public:
   Options& options() { return options_; }

@@ -80,6 +80,14 @@
 // packing ~0.18 ms (rows.hpp), the island split and numbering ~0.10 ms, the conversion of
 // Bullet's rows ~0.07 ms, storing impulses and remembering the points' answers ~0.08 ms (first
 // touches of Bullet's rows after the sweeps), the check ~0.05 ms (perf shares).
+// Round 2 (numbering in index passes, conversion without a store-forwarding stall, rows and
+// points fetched ahead, remember() without reads of Bullet's rows): 10 sweeps 1.14x / 1.18-1.19x
+// / 1.19x SI (50 sweeps 0.78x / 0.81x / 0.77-0.79x); our stages at 210 boxes ~0.90 ms against
+// SI's iterations ~0.70 ms: sweeps 40%, packing 23%, numbering 15%, conversion 12%, storing and
+// remembering 5.5%, the check ~5% (perf shares of our symbols). The stages around the sweeps
+// still cost ~2x the gap to SI (~0.2 ms); the hot spots left are the first touches of Bullet's
+// rows and points (1.4 MB of rows; with 1.1 MB of packed rows more than a 2 MB L2 holds) and
+// the packing's division, the rest spread thin.
 //
 // "si" runs Bullet's own SI iterations instead (for side-by-side runs with the same statistics).
 #pragma once

@@ -11,13 +11,19 @@
 // islands. Buffers are kept between calls so a steady scene allocates nothing per step.
 //
 // Two passes over Bullet's rows (288 bytes each, in double precision): the first reads only the
-// body indices (union-find; each row's dynamic bodies kept in a compact array for the island
-// numbering, which also lists each island's rows, bodies and manifold points), the second
+// body indices (union-find; each row's dynamic bodies kept in a compact array), then the island
+// numbering runs on the compact arrays in two passes (each row's island and place, with no
+// find() for a row on the previous row's bodies; then each island's arrays, sized once and
+// written by index: rows, bodies, findex, manifold points and last step's entries), the second
 // converts each row: into its island's RowSystem (build with system = true, or fillSystem
 // later), or straight into RowPgs' packing through fill() (the "pgs" path: no RowSystem copy).
-// Both write the same values (one conversion function). The RowSystem copy cost ~40 ns a row
-// (210-box pyramid), mostly first touches of Bullet's rows and the scattered writes of its
-// arrays.
+// Both write the same values (one conversion function). The conversion and the numbering fetch
+// Bullet's rows and the manifold points a few rows ahead; what remember() needs after the
+// solve (points' positions, friction directions) is kept in Island::memo, so after the sweeps
+// only the applied impulses are written back into Bullet's rows. The RowSystem copy cost ~40 ns
+// a row (210-box pyramid), mostly first touches of Bullet's rows and the scattered writes of
+// its arrays; the "pgs" path's numbering ~30 ns and conversion ~23 ns a row (session 4, round 2,
+// perf shares: see constraint_solver.hpp).
 #pragma once
 
 #include <BulletDynamics/ConstraintSolver/btSequentialImpulseConstraintSolver.h>
