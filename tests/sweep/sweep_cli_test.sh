@@ -41,6 +41,16 @@ else
   failed=$((failed + 1)); echo "FAIL sweep-distinct: repeated (value, engine, solver, step) rows"
 fi
 
+# --repeat: the same rows (the runs are deterministic), times the minimum over the passes.
+check sweep-repeat 0 "wrote $tmp/r.csv: $((4 * n_engines)) runs x 3 passes, $((12 * n_engines)) rows" -- \
+  "$mlcp" sweep "$scenes/resting_box.json" --solvers pgs,dantzig --setting iterations \
+  --values 5,10 --steps 3 --repeat 3 --csv "$tmp/r.csv"
+if diff <(cut -d, -f1-7,10- "$tmp/a.csv") <(cut -d, -f1-7,10- "$tmp/r.csv") > /dev/null; then
+  passed=$((passed + 1))
+else
+  failed=$((failed + 1)); echo "FAIL sweep-repeat-rows: --repeat 3 changed columns other than the times"
+fi
+
 if [ "$engines" = "bullet,ode" ]; then
   # Stock solvers ignore the tolerance: one run each, marked; the other engine's are skipped.
   check sweep-stock-skipped 0 'skipped \(not a solver of that engine\): bullet-si in ode, ode-world in bullet' -- \
@@ -71,6 +81,7 @@ bad empty-values "--values: an empty value" --values ""
 bad fractional-iterations "'2.5' is not a whole number of iterations" --values 5,2.5
 bad negative-tolerance "'-1e-6' is not a positive tolerance" --setting tolerance --values -1e-6
 bad missing-values "--values is required" --solvers pgs
+bad repeat-zero "--repeat: Value 0 not in range" --values 5 --repeat 0
 check missing-scene 2 'nope.json' -- "$mlcp" sweep "$tmp/nope.json" --values 5 --csv "$tmp/bad.csv"
 
 # mlcp chart: a clear message without Python; bad CSVs pass through as exit 2; charts drawn.

@@ -49,12 +49,15 @@ const char* const kStepCsvHeader =
 
 void writeStepCsv(std::ostream& out, const scene::World& world, const std::string& solver,
                   int step) {
-  const scene::StepMeasures& m = world.last();
-  out << world.scene().name << ',' << world.engine() << ',' << solver << ',' << step << ','
-      << m.solverMs << ',' << m.stepMs << ',' << m.residual << ',' << m.iterations << ','
-      << m.status << ',' << m.fallbacks << ',' << m.choice << ',' << m.contacts << ','
-      << m.maxPenetration << ',' << m.jointError << ',' << m.energy << ',' << m.momentum << ','
-      << m.maxSpeed << "\n";
+  writeStepCsv(out, world.scene().name, world.engine(), solver, step, world.last());
+}
+
+void writeStepCsv(std::ostream& out, const std::string& scene, const std::string& engine,
+                  const std::string& solver, int step, const scene::StepMeasures& m) {
+  out << scene << ',' << engine << ',' << solver << ',' << step << ',' << m.solverMs << ','
+      << m.stepMs << ',' << m.residual << ',' << m.iterations << ',' << m.status << ','
+      << m.fallbacks << ',' << m.choice << ',' << m.contacts << ',' << m.maxPenetration << ','
+      << m.jointError << ',' << m.energy << ',' << m.momentum << ',' << m.maxSpeed << "\n";
 }
 
 RunSummary runWorld(scene::World& world, int steps,

@@ -27,6 +27,9 @@ extern const char* const kStepCsvHeader;
 // One CSV row for the world's last step; `solver` is the name the run was asked for.
 void writeStepCsv(std::ostream& out, const scene::World& world, const std::string& solver,
                   int step);
+// The same row from kept measures (mlcp sweep --repeat writes its rows after the repeats).
+void writeStepCsv(std::ostream& out, const std::string& scene, const std::string& engine,
+                  const std::string& solver, int step, const scene::StepMeasures& m);
 
 // A run's summary over its steps.
 struct RunSummary {

@@ -15,6 +15,14 @@
 //   Core solvers (through our adapters) take both settings and run at every value.
 // - A run that blows up (non-finite body state) keeps its rows up to and including the step
 //   that blew up; the sweep goes on and exits 1 at the end, listing those runs.
+// - --repeat N runs every combination N times, in N passes over all of them (so that a slow
+//   spell of a shared machine hits different combinations in different passes), and writes
+//   each step's solver_ms and step_ms as the minimum over the passes: the runs are
+//   deterministic (the same trajectory, residuals and choices every pass), so the work per step
+//   is the same and the minimum is the estimate least disturbed by other processes. A pass
+//   whose measures of a step differ from the first pass's (residual, iterations, status,
+//   choice, energy, penetration: some solver depended on time) is not used from that step
+//   on, and the sweep says so on stderr. The rows are written after the last pass.
 #include <unistd.h>
 
 #include <algorithm>
@@ -49,7 +57,16 @@ struct SweepArgs {
   std::string fallback = "pgs";
   std::string csv;
   bool append = false;
+  int repeat = 1;
 };
+
+// Whether two runs' measures of one step describe the same step (all but the times).
+bool sameStep(const scene::StepMeasures& a, const scene::StepMeasures& b) {
+  auto same = [](double x, double y) { return x == y || (std::isnan(x) && std::isnan(y)); };
+  return same(a.residual, b.residual) && a.iterations == b.iterations && a.status == b.status &&
+         a.fallbacks == b.fallbacks && a.choice == b.choice && a.contacts == b.contacts &&
+         same(a.maxPenetration, b.maxPenetration) && same(a.energy, b.energy);
+}
 
 bool isStock(const std::string& solver) {
   return solver.rfind("bullet-", 0) == 0 || solver.rfind("ode-", 0) == 0;
@@ -207,59 +224,93 @@ int runSweep(const SweepArgs& args) {
   csv << std::setprecision(9);
 
   const bool tty = isatty(fileno(stderr)) != 0;
-  // On a terminal the bar redraws in place; elsewhere (CI, logs) one line per combination.
-  Progress bar("sweep", static_cast<int>(combos.size()), !tty);
-  std::vector<std::string> blownUp;
+  // On a terminal the bar redraws in place; elsewhere (CI, logs) one line per run.
+  const int passes = args.repeat;
+  Progress bar("sweep", static_cast<int>(combos.size()) * passes, !tty);
+  struct Kept {  // a combination's steps from the first pass, times lowered by later passes
+    std::string scene, engine;
+    std::vector<scene::StepMeasures> steps;
+  };
+  std::vector<Kept> kept(combos.size());
+  std::vector<std::string> blownUp, differing;
   std::size_t rows = 0;
-  for (std::size_t c = 0; c < combos.size(); ++c) {
-    const Combo& combo = combos[c];
-    const scene::Scene& sc = scenes[combo.scene];
-    scene::RunSettings run = runSettings(args, sc, combo.solver);
-    if (args.setting == "iterations")
-      run.iterations = static_cast<int>(combo.value);
-    else
-      run.tolerance = combo.value;
-    const int steps = args.steps >= 0 ? args.steps : sc.settings.steps;
-    const std::string label = sc.name + " " + combo.engine + " " + combo.solver + " " +
-                              args.setting + "=" +
-                              (combo.applies ? fmtValue(combo.value) : "(ignored)");
-    const std::string prefix =
-        args.setting + "," + fmtValue(combo.value) + "," + (combo.applies ? "1" : "0") + ",";
-    bar.start(label);
-    std::unique_ptr<scene::World> world;
-    try {
-      world = makeWorld(combo.engine, sc, run);  // the pair was checked on the smallest scene
-    } catch (const std::exception& e) {
-      std::cerr << me << label << ": " << e.what() << "\n";
-      return kInvalidInput;
-    }
-    auto lastDraw = std::chrono::steady_clock::now();
-    const RunSummary sum = runWorld(*world, steps, [&](const scene::World& w, int i) {
-      csv << prefix;
-      writeStepCsv(csv, w, combo.solver, i);
-      const auto now = std::chrono::steady_clock::now();
-      if (tty && now - lastDraw > std::chrono::milliseconds(200)) {
-        bar.start(label + " step " + std::to_string(i + 1) + "/" + std::to_string(steps));
-        lastDraw = now;
+  for (int pass = 0; pass < passes; ++pass)
+    for (std::size_t c = 0; c < combos.size(); ++c) {
+      const Combo& combo = combos[c];
+      const scene::Scene& sc = scenes[combo.scene];
+      scene::RunSettings run = runSettings(args, sc, combo.solver);
+      if (args.setting == "iterations")
+        run.iterations = static_cast<int>(combo.value);
+      else
+        run.tolerance = combo.value;
+      const int steps = args.steps >= 0 ? args.steps : sc.settings.steps;
+      const std::string label = sc.name + " " + combo.engine + " " + combo.solver + " " +
+                                args.setting + "=" +
+                                (combo.applies ? fmtValue(combo.value) : "(ignored)") +
+                                (passes > 1 ? " pass " + std::to_string(pass + 1) : "");
+      const std::string prefix =
+          args.setting + "," + fmtValue(combo.value) + "," + (combo.applies ? "1" : "0") + ",";
+      bar.start(label);
+      std::unique_ptr<scene::World> world;
+      try {
+        world = makeWorld(combo.engine, sc, run);  // the pair was checked on the smallest scene
+      } catch (const std::exception& e) {
+        std::cerr << me << label << ": " << e.what() << "\n";
+        return kInvalidInput;
       }
-    });
-    csv.flush();
-    rows += sum.steps;
-    if (!sum.finite) blownUp.push_back(label + " at step " + std::to_string(sum.steps - 1));
-    bar.done();
-    if (!tty) {
-      const double s = bar.seconds();
-      const double eta = s / double(c + 1) * double(combos.size() - c - 1);
-      std::cerr << "sweep " << c + 1 << "/" << combos.size() << " " << label << ": " << sum.steps
-                << " steps, solver " << std::setprecision(3) << sum.meanSolverMs
-                << " ms/step, worst residual " << sum.worstResidual
-                << (sum.finite ? "" : ", BLEW UP") << " (" << minutes(s) << " elapsed, ETA "
-                << minutes(eta) << ")\n";
+      Kept& k = kept[c];
+      const bool last = pass + 1 == passes;
+      bool matching = true;  // this pass's steps still match the first pass's
+      auto lastDraw = std::chrono::steady_clock::now();
+      const RunSummary sum = runWorld(*world, steps, [&](const scene::World& w, int i) {
+        const scene::StepMeasures& m = w.last();
+        if (pass == 0) {
+          if (i == 0) k.scene = w.scene().name, k.engine = w.engine();
+          k.steps.push_back(m);
+        } else if (matching && i < static_cast<int>(k.steps.size()) && sameStep(k.steps[i], m)) {
+          k.steps[i].solverMs = std::min(k.steps[i].solverMs, m.solverMs);
+          k.steps[i].stepMs = std::min(k.steps[i].stepMs, m.stepMs);
+        } else if (matching) {
+          matching = false;
+          differing.push_back(label + " from step " + std::to_string(i));
+        }
+        if (last) {  // streamed as before when there is one pass
+          csv << prefix;
+          writeStepCsv(csv, k.scene, k.engine, combo.solver, i,
+                       i < static_cast<int>(k.steps.size()) ? k.steps[i] : m);
+        }
+        const auto now = std::chrono::steady_clock::now();
+        if (tty && now - lastDraw > std::chrono::milliseconds(200)) {
+          bar.start(label + " step " + std::to_string(i + 1) + "/" + std::to_string(steps));
+          lastDraw = now;
+        }
+      });
+      if (last) {
+        csv.flush();
+        rows += sum.steps;
+        if (!sum.finite) blownUp.push_back(label + " at step " + std::to_string(sum.steps - 1));
+      }
+      bar.done();
+      if (!tty) {
+        const double s = bar.seconds();
+        const std::size_t done = pass * combos.size() + c + 1;
+        const double eta = s / double(done) * double(combos.size() * passes - done);
+        std::cerr << "sweep " << done << "/" << combos.size() * passes << " " << label << ": "
+                  << sum.steps << " steps, solver " << std::setprecision(3) << sum.meanSolverMs
+                  << " ms/step, worst residual " << sum.worstResidual
+                  << (sum.finite ? "" : ", BLEW UP") << " (" << minutes(s) << " elapsed, ETA "
+                  << minutes(eta) << ")\n";
+      }
     }
-  }
   bar.finish();
-  std::cout << (fresh ? "wrote " : "appended to ") << args.csv << ": " << combos.size() << " runs, "
-            << rows << " rows in " << std::fixed << std::setprecision(1) << bar.seconds() << " s\n";
+  std::cout << (fresh ? "wrote " : "appended to ") << args.csv << ": " << combos.size() << " runs"
+            << (passes > 1 ? " x " + std::to_string(passes) + " passes" : "") << ", " << rows
+            << " rows in " << std::fixed << std::setprecision(1) << bar.seconds() << " s\n";
+  if (!differing.empty()) {
+    std::cerr << me << differing.size()
+              << " repeated run(s) differed from their first pass (times not used from there):\n";
+    for (const std::string& d : differing) std::cerr << "  " << d << "\n";
+  }
   if (!blownUp.empty()) {
     std::cerr << me << blownUp.size() << " run(s) blew up (rows kept up to the blow-up):\n";
     for (const std::string& b : blownUp) std::cerr << "  " << b << "\n";
@@ -304,6 +355,10 @@ Runner addSweepCommand(CLI::App& app) {
   cmd->add_option("--fallback", args->fallback,
                   "core solver run when an answer is rejected, or none (default pgs)");
   cmd->add_option("--csv", args->csv, "CSV file to write")->required();
+  cmd->add_option("--repeat", args->repeat,
+                  "run every combination this many times (in passes over all of them) and keep "
+                  "each step's minimum solver and step time (default 1)")
+      ->check(CLI::Range(1, 100));
   cmd->add_flag("--append", args->append,
                 "add the rows to an existing sweep CSV (e.g. a second sweep with other solvers "
                 "or values) instead of replacing it");
