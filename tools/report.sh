@@ -27,13 +27,16 @@ export MLCP_PYTHON=$py  # `mlcp chart` uses the same interpreter
 # budget of a few minutes). Iterative solvers run at several iteration counts (a curve per
 # solver on the charts), pivoting ones at one (a point): their iteration limit only caps
 # friction passes. No fallback: each solver alone. summary.md says per scene whether auto is on
-# the Pareto front of these points (tools/report.py).
+# the Pareto front of these points (tools/report.py). Each run is repeated in 3 passes and each
+# step keeps its shortest time (`mlcp sweep --repeat`): single runs of a few ms moved by 30%
+# between runs on a shared 2-core machine, enough to flip the front between identical solvers.
 scenes=(stack_10 pyramid_15 pendulum_chain hinge_motor_limits mass_ratio_stack sphere_pit)
 iterative=pgs,bullet-si,ode-quick
 iterative_values=5,10,20,50,100
 pivoting=dantzig,auto,bullet-mlcp-dantzig,ode-world
 pivoting_values=50
 steps=300
+repeat=3
 stability_args=()
 if [ "${MLCP_REPORT_QUICK:-0}" = 1 ]; then
   scenes=(stack_10 pendulum_chain)
@@ -41,6 +44,7 @@ if [ "${MLCP_REPORT_QUICK:-0}" = 1 ]; then
   iterative_values=5,20
   pivoting=dantzig,auto  # auto: the Pareto table has its row
   steps=5
+  repeat=1
   stability_args=(--quick)
 fi
 scene_files=()
@@ -70,7 +74,7 @@ step() {  # step TITLE command...: runs the command, its stderr into the log; ex
 
 sweep() {  # sweep SOLVERS VALUES [--append]
   step "sweep: $1 at iterations $2" "$mlcp" sweep "${scene_files[@]}" --solvers "$1" \
-    --setting iterations --values "$2" --steps "$steps" --fallback none \
+    --setting iterations --values "$2" --steps "$steps" --repeat "$repeat" --fallback none \
     --csv "$out/sweep.csv" "${@:3}"
 }
 echo "report: ${#scenes[@]} scenes (${scenes[*]}), $steps steps per run, both engines"

@@ -29,7 +29,7 @@ grep -q "^| scene | engine | auto ms/step | auto residual | most accurate other 
   "$out/summary.md" || fail "summary.md lacks the Pareto table"
 for s in stack_10 pendulum_chain; do
   for e in bullet ode; do
-    grep -qE "^\| $s \| $e \| [0-9][^|]* \| [0-9][^|]* \|.* \| (yes|no, dominated by .*) \|\$" \
+    grep -qE "^\| $s \| $e \| [0-9][^|]* \| [0-9][^|]* \|.* \| (yes|yes, as .*|no, dominated by .*) \|\$" \
       "$out/summary.md" || fail "the Pareto table has no row with auto's numbers for $s / $e"
   done
 done
@@ -43,4 +43,29 @@ if grep -qE '^ +stability' <<< "$("$mlcp" --help)"; then
   ls "$out"/stability/*.png > /dev/null 2>&1 || fail "no stability heat map"
   grep -q "src='stability/" "$out/index.html" || fail "index.html does not show the stability map"
 fi
+# The verdict on synthetic sweeps: auto dominated only by its sole choice at the same residual is
+# "yes, as" it; dominated by another solver, or by its choice when it also chose another, "no".
+verdicts=$(cd "$repo/tools" && "$repo/.venv/bin/python" - "$out/v.csv" <<'PY'
+import sys
+from chart import SWEEP_COLUMNS, read_rows
+from report import fronts, verdict
+head = ("setting,value,setting_applies,scene,engine,solver,step,solver_ms,step_ms,residual,"
+        "iterations,status,fallbacks,choice,contacts,max_penetration,joint_error,energy,"
+        "momentum,max_speed")
+def row(scene, solver, ms, choice, step=0):
+    return (f"iterations,50,1,{scene},ode,{solver},{step},{ms},{ms},1e-16,1,converged,0,"
+            f"{choice},0,0,0,0,0,0")
+lines = [head,
+         row("a", "dantzig", 1.00, "dantzig:1"), row("a", "auto", 1.02, "dantzig:1 none:2"),
+         row("b", "ode-world", 1.00, ""), row("b", "auto", 1.02, "dantzig:1"),
+         row("c", "dantzig", 1.00, "dantzig:1"), row("c", "auto", 1.02, "dantzig:1"),
+         row("c", "auto", 1.02, "ldlt:1", step=1)]
+open(sys.argv[1], "w").write("\n".join(lines) + "\n")
+for e in fronts(sys.argv[1], read_rows(sys.argv[1], SWEEP_COLUMNS)):
+    print(e["scene"], verdict(e))
+PY
+)
+grep -q "^a yes, as dantzig" <<< "$verdicts" || fail "auto behind its sole choice is not 'yes, as': $verdicts"
+grep -q "^b no, dominated by ode-world" <<< "$verdicts" || fail "auto behind another solver is not 'no': $verdicts"
+grep -q "^c no, dominated by dantzig" <<< "$verdicts" || fail "auto with two choices is 'yes, as': $verdicts"
 echo "report_test: ok"
