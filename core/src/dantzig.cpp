@@ -735,7 +735,7 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
       ws.passes = 1;
       result.status = Status::Converged;
       result.iterations = 0;
-      result.message = "no pivot needed";
+      result.message = "tiny-island path: guessed index sets (at most two block corrections)";
       return;
     }
     runPivoting(problem, x, result, false);
@@ -761,7 +761,7 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
   const bool autoStage = params_.blockStage == DantzigParams::BlockStage::Auto;
   const bool trusted = warm && autoStage && residual(problem, x) <= kTrustedGuess;
   bool coldTrial = autoStage && !trusted;
-  if (coldTrial && warm && coldMissed_ > 0) {
+  if (coldTrial && warm && coldMissed_ > 0 && coldMissedRows_ == problem.size()) {
     coldTrial = coldMissed_ % std::max(1, params_.autoColdRetry) == 0;
     ++coldMissed_;
   }
@@ -773,6 +773,7 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
     symmetric = rep.symmetric;
     blockSteps_ += rep.steps;
     coldMissed_ = rep.settled ? 0 : 1;
+    coldMissedRows_ = problem.size();
     if (rep.settled) {
       x = trial;
       settle(rep);

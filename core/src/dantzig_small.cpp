@@ -218,6 +218,8 @@ Try solveFixed(const Problem& pb, double pivotTolerance, double* guess, Vector& 
     for (int p = 0; p < n; ++p)
       if ((at[p] == At::Lo && w[p] < -epsW) || (at[p] == At::Hi && w[p] > epsW))
         return Try::Declined;
+    for (int p = 0; p < clamped; ++p)  // the refined x_C must still be within its bounds
+      if (!(x[p] >= lo[p] && x[p] <= hi[p])) return Try::Declined;
   }
   for (int p = 0; p < n; ++p)
     if (!std::isfinite(x[p])) return Try::Declined;  // overflow: the general path decides

@@ -524,6 +524,10 @@ Result RowPgs::solve(const std::vector<BodyInverseMass>& bodies, int n, const Ro
   if (!packed) return slow();
   // A non-finite start: solve(RowSystem) starts cold (velocity_ and base_ hold NaN here).
   if (!x.allFinite()) return slow();
+  // A non-finite base would make every velocityChange NaN: no per-body changes then (the
+  // caller applies x row by row, as after the slow path).
+  for (int k = 0; k < static_cast<int>(bodies.size()); ++k)
+    if (!base_[k].v.allFinite()) return iterate(x, lo_, hi_, findex_, bNorm, t0);
   baseValid_ = true;
   return iterate(x, lo_, hi_, findex_, bNorm, t0);
 }

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "mlcp/pgs.hpp"
@@ -370,6 +371,25 @@ TEST(RowPgs, EngineRowsWithFaultsGetTheRowSystemsAnswer) {
   RowPgs cold;
   Vector xc;
   EXPECT_EQ(cold.solve(s, xc).residual, r.residual);
+}
+
+// A non-finite base (what the engine's bodies carry already): the same answer, but no per-body
+// velocity changes on offer (they would all be NaN).
+TEST(RowPgs, NonFiniteBaseOffersNoVelocityChanges) {
+  const RowSystem s = stackRows(30, 4);
+  const Vector start = Vector::Constant(s.size(), 0.2);
+  Vector base = start;
+  base[7] = std::numeric_limits<double>::infinity();
+  RowPgs a, b;
+  a.options().warmStart = b.options().warmStart = true;
+  Vector xa, xb;
+  const Result ra = solveFromRows(a, s, start, start, xa);
+  const Result rb = solveFromRows(b, s, start, base, xb);
+  EXPECT_TRUE(a.velocityChanges());
+  EXPECT_FALSE(b.velocityChanges());
+  EXPECT_EQ(ra.status, rb.status);
+  EXPECT_EQ(ra.residual, rb.residual);
+  EXPECT_EQ(xa, xb);
 }
 
 TEST(RowPgs, ZeroRowIsAFailureNotAConvergence) {

@@ -228,7 +228,7 @@ int runSweep(const SweepArgs& args) {
   const int passes = args.repeat;
   Progress bar("sweep", static_cast<int>(combos.size()) * passes, !tty);
   struct Kept {  // a combination's steps from the first pass, times lowered by later passes
-    std::string scene, engine;
+    std::string scene, engine, prefix;
     std::vector<scene::StepMeasures> steps;
   };
   std::vector<Kept> kept(combos.size());
@@ -259,7 +259,7 @@ int runSweep(const SweepArgs& args) {
         return kInvalidInput;
       }
       Kept& k = kept[c];
-      const bool last = pass + 1 == passes;
+      k.prefix = prefix;
       bool matching = true;  // this pass's steps still match the first pass's
       auto lastDraw = std::chrono::steady_clock::now();
       const RunSummary sum = runWorld(*world, steps, [&](const scene::World& w, int i) {
@@ -274,10 +274,9 @@ int runSweep(const SweepArgs& args) {
           matching = false;
           differing.push_back(label + " from step " + std::to_string(i));
         }
-        if (last) {  // streamed as before when there is one pass
+        if (passes == 1) {  // streamed; with repeats the first pass's rows are written last
           csv << prefix;
-          writeStepCsv(csv, k.scene, k.engine, combo.solver, i,
-                       i < static_cast<int>(k.steps.size()) ? k.steps[i] : m);
+          writeStepCsv(csv, w, combo.solver, i);
         }
         const auto now = std::chrono::steady_clock::now();
         if (tty && now - lastDraw > std::chrono::milliseconds(200)) {
@@ -285,7 +284,7 @@ int runSweep(const SweepArgs& args) {
           lastDraw = now;
         }
       });
-      if (last) {
+      if (pass == 0) {  // the rows and the blow-ups are the first pass's
         csv.flush();
         rows += sum.steps;
         if (!sum.finite) blownUp.push_back(label + " at step " + std::to_string(sum.steps - 1));
@@ -302,6 +301,14 @@ int runSweep(const SweepArgs& args) {
                   << minutes(eta) << ")\n";
       }
     }
+  if (passes > 1)
+    for (std::size_t c = 0; c < combos.size(); ++c)
+      for (std::size_t i = 0; i < kept[c].steps.size(); ++i) {
+        csv << kept[c].prefix;
+        writeStepCsv(csv, kept[c].scene, kept[c].engine, combos[c].solver, static_cast<int>(i),
+                     kept[c].steps[i]);
+      }
+  csv.flush();
   bar.finish();
   std::cout << (fresh ? "wrote " : "appended to ") << args.csv << ": " << combos.size() << " runs"
             << (passes > 1 ? " x " + std::to_string(passes) + " passes" : "") << ", " << rows

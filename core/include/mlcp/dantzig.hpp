@@ -189,8 +189,9 @@ struct DantzigParams {
   // Auto: most factorizations of the trial from the cold guess (it ends at its first full step
   // that brings no new lowest merit). Default 3.
   int autoColdSteps = 3;
-  // Auto: after a cold trial that did not settle, warm solves of this solver skip the trial
-  // except every autoColdRetry-th one (a trial that settles resets this). Default 8.
+  // Auto: after a cold trial that did not settle, warm solves of this solver on problems of the
+  // same size skip the trial except every autoColdRetry-th one (a trial that settles, or a
+  // problem of another size, resets this). Default 8.
   int autoColdRetry = 8;
   // Auto: the smallest problem (rows) whose warm start gets the block stage after an unsettled
   // cold trial; smaller ones go to the incremental pivoting from their guess, which is cheaper
@@ -232,7 +233,8 @@ class DantzigSolver : public Solver {
   DantzigParams params_;
   int blockSteps_ = 0;
   bool blockSettled_ = false;
-  int coldMissed_ = 0;  // solves since the last cold trial, which did not settle (0: it did)
+  int coldMissed_ = 0;      // solves since the last cold trial, which did not settle (0: it did)
+  int coldMissedRows_ = 0;  // that trial's problem size: another size tries again
 };
 
 }  // namespace mlcp

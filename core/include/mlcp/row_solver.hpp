@@ -117,15 +117,13 @@ ProblemClass classify(const RowSystem& rows);
 //   pendulum_chain (33 rows, ldlt)     auto 5.0-5.2 us, 55k | ode-world 5.8-6.2 us, 77k
 //     (ldlt's dense envelope LDL^T (ldlt.hpp) ~25k, assembly 15k, validation and check ~8k;
 //     before it: sparse LDL^T, 9.7 us and 99.8k)
-//   hinge_motor_limits (6 rows, dantzig) auto 0.74 us, 6.5k | ode-world 0.69 us, 6.7k
-//     (steps after the first, medians of 11 runs; dantzig's small dense path, dantzig_small.hpp,
-//     2.3k; assembly 1.4k; validation and the residual check ~1k; ODE's dxSolveLCP alone 2.8k.
-//     Before that path: 1.22 us, 10.4k.) The first step is cold: dantzig's general path, ~35 us
-//     against ode-world's ~14 us, mostly code fetched from memory (callgrind: 524 against 344
-//     instruction-cache misses to memory), so the report's 300-step means are 0.87 against
-//     0.74 us.
-// Bullet, the same scenes against bullet-mlcp-dantzig: pendulum 8.2 vs 20 us, hinge 2.1 vs
-// 2.5 us (Bullet hands the hinge's rows over with a zero start: the general path pivots).
+//   hinge_motor_limits (6 rows, dantzig) auto 0.61 us, 5.8k | ode-world 0.68 us, 6.7k
+//     (means of 300 steps, report; dantzig's tiny-island path, dantzig_small.hpp, ~1.7k;
+//     assembly 1.4k; validation and the residual check ~1k; ODE's dxSolveLCP alone 2.8k.
+//     Before that path: 1.22 us, 10.4k.) The first step is cold and takes the same path from
+//     the cold guess (~19 us against ode-world's 13-17 us, mostly code fetched from memory).
+// Bullet, the same scenes against bullet-mlcp-dantzig (report means): pendulum 8.9 vs 20 us,
+// hinge 1.4 vs 2.3 us (Bullet hands the hinge's rows over with a zero start: the cold guess).
 // The memory rule dates from Bullet's zero-CFM friction rows (bullet::CfmModel::Engine), on which
 // dantzig failed 29 of 30 steps of pyramid_15 (70 ms, residual 0.12): with the rule auto went
 // from 47 ms to 8.6 ms there. With the default Regularized model dantzig's answers are accepted

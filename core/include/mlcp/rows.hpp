@@ -17,6 +17,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <cassert>
 #include <functional>
 #include <string>
 #include <vector>
@@ -142,13 +143,17 @@ class RowPgs {
   // After solve(bodies, rows, fill, x) took the fast path: body k's M^-1 J^T (x - base),
   // [linear; angular], from the velocities the sweeps maintain (what an engine adds to its
   // body's velocity to apply the answer, instead of one impulse per row). velocityChanges()
-  // is false after the slow path or solve(RowSystem).
+  // is false after the slow path, after solve(RowSystem), and when a row's base is not finite
+  // (then apply x row by row).
   bool velocityChanges() const { return baseValid_; }
   // The rows fill gives, as a RowSystem with these bodies, and their starts: the slow path's
   // copy, for callers that need a RowSystem after all.
   static void toSystem(const std::vector<BodyInverseMass>& bodies, int rows, const RowFill& fill,
                        RowSystem& system, Vector& start);
-  Vector6 velocityChange(int body) const { return velocity_[body].v - base_[body].v; }
+  Vector6 velocityChange(int body) const {
+    assert(baseValid_ && body >= 0 && body < static_cast<int>(base_.size()));
+    return velocity_[body].v - base_[body].v;
+  }
 
  private:
   // Everything the sweep reads per row, in one stream: bodies remapped so that "the world" is
