@@ -72,14 +72,18 @@ inline bool rowValid(const RowRef& r, int i, int n, unsigned slots) {
   return hi >= 0 && std::isfinite(hi) && lo == -hi;
 }
 
+// A finite, non-negative inverse mass and a finite inverse inertia.
+bool bodyValid(const BodyInverseMass& body) {
+  return std::isfinite(body.invMass) && body.invMass >= 0 && body.invInertia.allFinite();
+}
+
 // The rules rowValid assumes: the per-row arrays' sizes and finite, non-negative body masses.
 bool arraysAndBodiesValid(const RowSystem& s) {
   const int n = s.size();
   if (s.b.size() != n || s.lo.size() != n || s.hi.size() != n || s.cfm.size() != n) return false;
   if (!s.findex.empty() && static_cast<int>(s.findex.size()) != n) return false;
   for (const BodyInverseMass& body : s.bodies)
-    if (!std::isfinite(body.invMass) || body.invMass < 0 || !body.invInertia.allFinite())
-      return false;
+    if (!bodyValid(body)) return false;
   return true;
 }
 
@@ -128,7 +132,7 @@ std::string RowSystem::validate() const {
   const int nb = static_cast<int>(bodies.size());
   for (int k = 0; k < nb; ++k) {
     const BodyInverseMass& body = bodies[k];
-    if (!std::isfinite(body.invMass) || body.invMass < 0 || !body.invInertia.allFinite()) {
+    if (!bodyValid(body)) {
       os << "body " << k << " has an invalid inverse mass or inertia";
       return os.str();
     }
@@ -495,8 +499,7 @@ Result RowPgs::solve(const std::vector<BodyInverseMass>& bodies, int n, const Ro
   }
   if (!(opt.relaxation > 0 && opt.relaxation < 2)) return slow();
   for (const BodyInverseMass& body : bodies)
-    if (!std::isfinite(body.invMass) || body.invMass < 0 || !body.invInertia.allFinite())
-      return slow();
+    if (!bodyValid(body)) return slow();
   x.resize(n);
   lo_.resize(n);
   hi_.resize(n);

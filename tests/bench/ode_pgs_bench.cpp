@@ -169,14 +169,8 @@ int main(int argc, char** argv) {
     tight.solver.relaxation = 1.0;
     tight.fallback = "";
     Stepper reference("pgs", tight);
-    StepperOptions fixed;
-    fixed.solver.maxIterations = sweeps;
-    fixed.solver.relaxation = 1.3;
-    fixed.solver.checkEvery = sweeps;
-    fixed.solver.tolerance = 0;
-    fixed.fallback = "";
-    fixed.keepProblems = true;  // swapped out, not copied: no measurable cost (stepper.hpp)
-    Stepper pgs("pgs", fixed);
+    // keepProblems: swapped out, not copied: no measurable cost (stepper.hpp).
+    Stepper pgs("pgs", fixedSweepPgs(sweeps, true));
 
     auto stepRef = [&](dWorldID w, dReal dt) { reference.step(w, dt); };
     for (int k = 0; k < warmup; ++k) {

@@ -17,17 +17,8 @@ namespace {
 
 constexpr double kUnset = std::numeric_limits<double>::quiet_NaN();
 
-// The bench's pgs: a fixed sweep count, no convergence test, no fallback.
-StepperOptions fixedPgs(bool keep) {
-  StepperOptions o;
-  o.solver.maxIterations = 20;
-  o.solver.checkEvery = 20;
-  o.solver.tolerance = 0;
-  o.solver.relaxation = 1.3;
-  o.fallback = "";
-  o.keepProblems = keep;
-  return o;
-}
+// The bench's pgs (ode_pgs_bench): 20 sweeps, no convergence test, no fallback.
+StepperOptions fixedPgs(bool keep) { return fixedSweepPgs(20, keep); }
 
 std::unique_ptr<Scene> pileWithContactFeedback() {
   auto s = boxPyramid(3);

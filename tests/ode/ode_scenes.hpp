@@ -12,7 +12,22 @@
 #include <memory>
 #include <vector>
 
+#include "mlcp/ode/stepper.hpp"
+
 namespace mlcp::ode::test {
+
+// Our pgs as QuickStep runs: a fixed number of sweeps with SOR factor 1.3 (QuickStep's
+// default), no convergence test, no fallback.
+inline StepperOptions fixedSweepPgs(int sweeps, bool keepProblems = false) {
+  StepperOptions o;
+  o.solver.maxIterations = sweeps;
+  o.solver.checkEvery = sweeps;
+  o.solver.tolerance = 0;
+  o.solver.relaxation = 1.3;
+  o.fallback = "";
+  o.keepProblems = keepProblems;
+  return o;
+}
 
 inline void ensureOdeInitialized() {
   static const bool done = [] {

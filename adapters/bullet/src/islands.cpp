@@ -151,7 +151,6 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
         Island& isl = islands_[count_ - 1];
         isl.system.bodies.clear();
         isl.solverBody.clear();
-        isl.points = 0;
         isl.hasSplit = false;
         isl.filled = false;
         isl.perRowWriteBack = false;
@@ -200,10 +199,7 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
         last = static_cast<const Remembered*>(isl.last[f]);
       } else {
         point = static_cast<const btManifoldPoint*>(c.m_originalContactPoint);
-        if (point) {
-          ++isl.points;
-          memo = point->m_localPointA;
-        }
+        if (point) memo = point->m_localPointA;
         if (point && start == Start::CachedImpulse) {
           last = lookup(point);
           if (last && (memo - last->localA).length() >= gContactBreakingThreshold) last = nullptr;

@@ -71,7 +71,6 @@ struct Island {
   // rows nor the points after the sweeps: a contact row's point's m_localPointA (build()), a
   // friction row's direction (the impulse on body A per unit x; convert()).
   std::vector<btVector3> memo;
-  int points = 0;  // contact rows with a manifold point
   // A body's linear factor has a component other than 0 and 1, or its angular factor unequal
   // components: Bullet's body update is not M^-1 J^T there (constraint_solver.hpp), so a
   // per-body write-back would differ from Bullet's.
