@@ -31,24 +31,71 @@ Problem boundsOnly(const RowSystem& s) {
   return p;
 }
 
-// One row's values wherever they are stored (a RowSystem or an engine's rows via RowPgs::Row):
+// One row's values wherever they are stored (a RowSystem, RowPgs::Row, an engine's own rows):
 // what validation and RowPgs' packing read.
-struct RowRef {
-  int bodyA, bodyB;
-  const Vector6* jA;
-  const Vector6* jB;
-  double b, cfm, lo, hi;
-  int findex;
-  double start, base;
-};
+using RowRef = RowPgs::RowView;
+
+RowRef viewOf(int bodyA, int bodyB, const Vector6& jA, const Vector6& jB) {
+  RowRef r;
+  r.bodyA = bodyA;
+  r.bodyB = bodyB;
+  r.linA = jA.data();
+  r.angA = jA.data() + 3;
+  r.linB = jB.data();
+  r.angB = jB.data() + 3;
+  return r;
+}
 
 inline RowRef systemRow(const RowSystem& s, int i, const double* x) {
-  const ConstraintRow& r = s.rows[i];
-  return {r.bodyA,        r.bodyB, &r.jA,
-          &r.jB,          s.b[i],  s.cfm[i],
-          s.lo[i],        s.hi[i], s.findex.empty() ? -1 : s.findex[i],
-          x ? x[i] : 0.0, 0.0};
+  const ConstraintRow& c = s.rows[i];
+  RowRef r = viewOf(c.bodyA, c.bodyB, c.jA, c.jB);
+  r.b = s.b[i];
+  r.cfm = s.cfm[i];
+  r.lo = s.lo[i];
+  r.hi = s.hi[i];
+  r.findex = s.findex.empty() ? -1 : s.findex[i];
+  r.start = x ? x[i] : 0.0;
+  return r;
 }
+
+RowRef rowView(const RowPgs::Row& row) {
+  RowRef r = viewOf(row.bodyA, row.bodyB, row.jA, row.jB);
+  r.b = row.b;
+  r.cfm = row.cfm;
+  r.lo = row.lo;
+  r.hi = row.hi;
+  r.findex = row.findex;
+  r.start = row.start;
+  r.base = row.base;
+  return r;
+}
+
+// A view's Jacobian block as [linear; angular] (a missing part reads as zeros).
+inline void jacobianOf(const double* lin, const double* ang, double* j) {
+  for (int k = 0; k < 3; ++k) {
+    j[k] = lin ? lin[k] : 0.0;
+    j[3 + k] = ang ? ang[k] : 0.0;
+  }
+}
+
+// The rows of a RowFill, fetched in batches of 64 (a few kB, stays in L1).
+class FillSource final : public RowPgs::RowSource {
+ public:
+  FillSource(const RowPgs::RowFill& fill, int n) : fill_(fill), n_(n) {}
+  RowRef row(int i) override {
+    if (i >= fetched_ || i < fetched_ - kBatch) {  // the next batch, or the slow path's re-read
+      fill_(i, std::min(kBatch, n_ - i), batch_.data());
+      fetched_ = i + kBatch;
+    }
+    return rowView(batch_[i - (fetched_ - kBatch)]);
+  }
+
+ private:
+  static constexpr int kBatch = 64;
+  const RowPgs::RowFill& fill_;
+  int n_, fetched_ = 0;
+  std::vector<RowPgs::Row> batch_ = std::vector<RowPgs::Row>(kBatch);
+};
 
 // Every per-row rule of RowSystem::validate and Problem::validate (b, bounds, findex) for row i of
 // n as one predicate without copies, except that row findex's own findex must be -1 (the callers
@@ -57,11 +104,14 @@ inline RowRef systemRow(const RowSystem& s, int i, const double* x) {
 // in RowSystem::validate find the row and say what is wrong (Problem::validate stays the one
 // statement of the bound rules' wording). A false alarm (a sum of finite Jacobian entries
 // overflowing) only costs the slow path. slots = bodies + 1; the array sizes are checked.
-inline bool rowValid(const RowRef& r, int i, int n, unsigned slots) {
+inline bool rowValid(const RowRef& r, const double* jA, const double* jB, int i, int n,
+                     unsigned slots) {
   if (static_cast<unsigned>(r.bodyA + 1) >= slots || static_cast<unsigned>(r.bodyB + 1) >= slots)
     return false;
   // Any NaN or Inf entry makes the sum NaN or Inf.
-  if (!std::isfinite(r.jA->sum() + r.jB->sum())) return false;
+  double sum = 0;
+  for (int k = 0; k < 6; ++k) sum += jA[k] + jB[k];
+  if (!std::isfinite(sum)) return false;
   if (!(r.cfm >= 0 && r.cfm < kInf)) return false;
   const double lo = r.lo, hi = r.hi;
   // !(lo <= hi) also catches NaN bounds.
@@ -87,19 +137,21 @@ bool arraysAndBodiesValid(const RowSystem& s) {
   return true;
 }
 
-// M^-1 j for one body written to out[0..5], returning j . M^-1 j. Scalar code on purpose: the
-// Vector6 that applyInverseMass returns passes through a stack temporary written in 8- and
-// 16-byte pieces, and reading it back in pairs stalled store forwarding on every row of the
-// packing pass (a quarter of its time, measured with perf).
-inline double inverseMassInto(const BodyInverseMass& body, const Vector6& j, double* out) {
+// M^-1 j for one body written to out[0..5], returning j . M^-1 j; the angular part is the
+// engine's own invAng when given (RowPgs::RowView: the same products, computed by the engine).
+// Scalar code on purpose: the Vector6 that applyInverseMass returns passes through a stack
+// temporary written in 8- and 16-byte pieces, and reading it back in pairs stalled store
+// forwarding on every row of the packing pass (a quarter of its time, measured with perf).
+inline double inverseMassInto(const BodyInverseMass& body, const double* j, const double* invAng,
+                              double* out) {
   const double im = body.invMass;
   const Eigen::Matrix3d& I = body.invInertia;
-  const double m[6] = {im * j[0],
-                       im * j[1],
-                       im * j[2],
-                       I(0, 0) * j[3] + I(0, 1) * j[4] + I(0, 2) * j[5],
-                       I(1, 0) * j[3] + I(1, 1) * j[4] + I(1, 2) * j[5],
-                       I(2, 0) * j[3] + I(2, 1) * j[4] + I(2, 2) * j[5]};
+  double m[6] = {im * j[0], im * j[1], im * j[2]};
+  if (invAng) {
+    for (int k = 0; k < 3; ++k) m[3 + k] = invAng[k];
+  } else {
+    for (int k = 0; k < 3; ++k) m[3 + k] = I(k, 0) * j[3] + I(k, 1) * j[4] + I(k, 2) * j[5];
+  }
   double d = 0;
   for (int k = 0; k < 6; ++k) {
     out[k] = m[k];
@@ -113,7 +165,8 @@ bool rowsValid(const RowSystem& s) {
   if (!s.findex.empty() && static_cast<int>(s.findex.size()) != s.size()) return false;
   for (int i = 0; i < s.size(); ++i) {
     const RowRef r = systemRow(s, i, nullptr);
-    if (!rowValid(r, i, s.size(), slots) || (r.findex >= 0 && s.findex[r.findex] >= 0))
+    if (!rowValid(r, s.rows[i].jA.data(), s.rows[i].jB.data(), i, s.size(), slots) ||
+        (r.findex >= 0 && s.findex[r.findex] >= 0))
       return false;
   }
   return true;
@@ -313,6 +366,7 @@ bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& row
     for (BodyVelocity& v : base_) v.v.setZero();
   }
   bad_ = -1;
+  const bool unitRelaxation = options_.relaxation == 1;
   auto stop = [&](int i, double d) {
     bad_ = i;
     badDiagonal_ = d;
@@ -321,7 +375,10 @@ bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& row
   int later = -1;  // the first row whose findex points forward (checked after the pass)
   for (int i = 0; i < n; ++i) {
     const RowRef r = rowAt(i);
-    if (!rowValid(r, i, n, slots)) return stop(i, std::nan(""));
+    double jA[6], jB[6];
+    jacobianOf(r.linA, r.angA, jA);
+    jacobianOf(r.linB, r.angB, jB);
+    if (!rowValid(r, jA, jB, i, n, slots)) return stop(i, std::nan(""));
     PackedRow& p = packed_[i];
     p.findex = r.findex;
     if (r.findex >= 0) {
@@ -348,25 +405,27 @@ bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& row
     p.a = runA;
     p.b = runB;
     double mA[6] = {}, mB[6] = {};
-    const double dA = r.bodyA >= 0 ? inverseMassInto(bodies[r.bodyA], *r.jA, mA) : 0.0;
-    const double dB = r.bodyB >= 0 ? inverseMassInto(bodies[r.bodyB], *r.jB, mB) : 0.0;
+    const double dA = r.bodyA >= 0 ? inverseMassInto(bodies[r.bodyA], jA, r.invAngA, mA) : 0.0;
+    const double dB = r.bodyB >= 0 ? inverseMassInto(bodies[r.bodyB], jB, r.invAngB, mB) : 0.0;
     p.lo = r.lo;
     p.hi = r.hi;
     double d = dA + dB + r.cfm;
     // A row joining a body to itself: A_ii = (jA + jB) M^-1 (jA + jB) has the cross terms too.
     if (r.bodyA == r.bodyB && r.bodyA >= 0)
-      for (int k = 0; k < 6; ++k) d += (*r.jA)[k] * mB[k] + (*r.jB)[k] * mA[k];
+      for (int k = 0; k < 6; ++k) d += jA[k] * mB[k] + jB[k] * mA[k];
     if (!(d > 0)) return stop(i, d);
     const double step = options_.relaxation / d;
-    p.sA = step * *r.jA;
-    p.sB = step * *r.jB;
+    for (int k = 0; k < 6; ++k) {
+      p.sA[k] = step * jA[k];
+      p.sB[k] = step * jB[k];
+    }
     // Couplings to the run's earlier rows k: step J_i M^-1 J_k^T on the run's two bodies, i.e.
     // sA . mA_k + sB . mB_k (scalars from locals: no reading back of what was just stored).
     // step J_i in scalars once (the products the sums used, so the same couplings to the bit).
     double sJ[12];
     for (int j = 0; j < 6; ++j) {
-      sJ[j] = step * (*r.jA)[j];
-      sJ[6 + j] = step * (*r.jB)[j];
+      sJ[j] = step * jA[j];
+      sJ[6 + j] = step * jB[j];
     }
     for (int k = 0; k + 1 < runLength; ++k) {
       double c = 0;
@@ -379,7 +438,7 @@ bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& row
     }
     p.keep = 1 - step * r.cfm;
     p.shift = step * r.b;
-    scale_[i] = d / options_.relaxation;
+    scale_[i] = unitRelaxation ? d : d / options_.relaxation;  // d / 1 = d: no second division
     // v = M^-1 J^T x of the start (from mA, mB, not from p.mA, p.mB just stored: see above).
     const double xi = warm ? r.start : 0.0;
     if (xOut) xOut[i] = xi;
@@ -456,8 +515,9 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
   return iterate(x, s.lo, s.hi, s.findex, n ? s.b.lpNorm<Eigen::Infinity>() : 0.0, t0);
 }
 
-void RowPgs::toSystem(const std::vector<BodyInverseMass>& bodies, int n, const RowFill& fill,
-                      RowSystem& s, Vector& start) {
+namespace {
+
+void resizeSystem(const std::vector<BodyInverseMass>& bodies, int n, RowSystem& s, Vector& start) {
   s.bodies = bodies;
   s.rows.resize(n);
   s.b.resize(n);
@@ -466,28 +526,52 @@ void RowPgs::toSystem(const std::vector<BodyInverseMass>& bodies, int n, const R
   s.cfm.resize(n);
   s.findex.resize(n);
   start.resize(n);
+}
+
+void setRow(RowSystem& s, Vector& start, int i, const RowRef& r) {
+  ConstraintRow& c = s.rows[i];
+  c.bodyA = r.bodyA;
+  c.bodyB = r.bodyB;
+  jacobianOf(r.linA, r.angA, c.jA.data());
+  jacobianOf(r.linB, r.angB, c.jB.data());
+  s.b[i] = r.b;
+  s.lo[i] = r.lo;
+  s.hi[i] = r.hi;
+  s.cfm[i] = r.cfm;
+  s.findex[i] = r.findex;
+  start[i] = r.start;
+}
+
+}  // namespace
+
+void RowPgs::toSystem(const std::vector<BodyInverseMass>& bodies, int n, const RowFill& fill,
+                      RowSystem& s, Vector& start) {
+  resizeSystem(bodies, n, s, start);
   std::vector<Row> all(n);
   if (n > 0) fill(0, n, all.data());
-  for (int i = 0; i < n; ++i) {
-    const Row& r = all[i];
-    s.rows[i] = {r.bodyA, r.bodyB, r.jA, r.jB};
-    s.b[i] = r.b;
-    s.lo[i] = r.lo;
-    s.hi[i] = r.hi;
-    s.cfm[i] = r.cfm;
-    s.findex[i] = r.findex;
-    start[i] = r.start;
-  }
+  for (int i = 0; i < n; ++i) setRow(s, start, i, rowView(all[i]));
+}
+
+void RowPgs::toSystem(const std::vector<BodyInverseMass>& bodies, int n, RowSource& source,
+                      RowSystem& s, Vector& start) {
+  resizeSystem(bodies, n, s, start);
+  for (int i = 0; i < n; ++i) setRow(s, start, i, source.row(i));
 }
 
 Result RowPgs::solve(const std::vector<BodyInverseMass>& bodies, int n, const RowFill& fill,
+                     Vector& x) {
+  FillSource source(fill, std::max(n, 0));
+  return solve(bodies, n, source, x);
+}
+
+Result RowPgs::solve(const std::vector<BodyInverseMass>& bodies, int n, RowSource& source,
                      Vector& x) {
   const double t0 = nowSeconds();
   baseValid_ = false;
   // The slow path: the same rows as a RowSystem, solved (or refused) by solve(RowSystem).
   auto slow = [&] {
     RowSystem s;
-    toSystem(bodies, n, fill, s, x);
+    toSystem(bodies, n, source, s, x);
     return solve(s, x);
   };
   const Options& opt = options_;
@@ -504,24 +588,16 @@ Result RowPgs::solve(const std::vector<BodyInverseMass>& bodies, int n, const Ro
   lo_.resize(n);
   hi_.resize(n);
   findex_.resize(n);
-  constexpr int kBatch = 64;  // rows fetched per call of fill (a few kB, stays in L1)
-  batch_.resize(kBatch);
   double bNorm = 0;
-  int fetched = 0;  // rows in batch_ start at fetched - kBatch
   const bool packed = pack(
       bodies, n,
       [&](int i) {
-        if (i == fetched) {
-          fill(i, std::min(kBatch, n - i), batch_.data());
-          fetched = i + kBatch;
-        }
-        const Row& r = batch_[i - (fetched - kBatch)];
+        const RowRef r = source.row(i);
         lo_[i] = r.lo;
         hi_[i] = r.hi;
         findex_[i] = r.findex;
         bNorm = std::max(bNorm, std::abs(r.b));
-        return RowRef{r.bodyA, r.bodyB, &r.jA,    &r.jB,   r.b,   r.cfm,
-                      r.lo,    r.hi,    r.findex, r.start, r.base};
+        return r;
       },
       opt.warmStart, x.data(), true);
   if (!packed) return slow();

@@ -162,12 +162,8 @@ bool ConstraintSolver::solveIslandFast(Island& island, bool split) {
   pgs_.options() = rows_->options();
   pgs_.options().warmStart = true;  // as RowSolver runs it: from the start given
   const int n = static_cast<int>(island.rows.size());
-  Result r = pgs_.solve(
-      island.system.bodies, n,
-      [&](int first, int count, RowPgs::Row* out) {
-        builder_.fill(island, first, count, out, split);
-      },
-      x_);
+  IslandBuilder::Source rows(builder_, island, split);
+  Result r = pgs_.solve(island.system.bodies, n, rows, x_);
   if (!pgs_.velocityChanges() || !acceptable(r, settings_.acceptResidual)) return false;
   r.solver = "pgs";
   r.seconds = nowSeconds() - t0;

@@ -42,6 +42,14 @@ bool sameUpdate(const btSolverBody& b) {
 // How many rows ahead the passes over Bullet's rows fetch what they read or write next.
 constexpr int kAhead = 6;
 
+constexpr unsigned char kUnitLinear = 1, kUnitAngular = 2;
+bool allOnes(const btVector3& v) { return v[0] == 1 && v[1] == 1 && v[2] == 1; }
+
+// J of a side without a dynamic body (ignored by the solver; zeros as a RowSystem would hold).
+constexpr double kZeros[3] = {0, 0, 0};
+
+static_assert(sizeof(btScalar) == sizeof(double), "rows are read in place as doubles");
+
 }  // namespace
 
 int IslandBuilder::find(int k) {
@@ -68,10 +76,15 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
 
   dynamic_.resize(nb);
   parent_.resize(nb);
+  unit_.resize(nb);
   for (int k = 0; k < nb; ++k) {
-    const btRigidBody* rb = bodies[k].m_originalBody;
+    const btSolverBody& sb = bodies[k];
+    const btRigidBody* rb = sb.m_originalBody;
     dynamic_[k] = (rb && rb->getInvMass() != 0) ? k : -1;
     parent_[k] = k;
+    if (dynamic_[k] >= 0)
+      unit_[k] = (allOnes(sb.m_linearFactor) ? kUnitLinear : 0) |
+                 (allOnes(sb.m_angularFactor) ? kUnitAngular : 0);
   }
 
   // One pass over Bullet's rows for the graph: rows in the stock order, friction rows pointing at
@@ -171,10 +184,13 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     isl.rows.resize(m);
     isl.rowIndex.resize(m);
     isl.system.findex.resize(m);
-    isl.point.resize(m);
-    isl.last.resize(m);
-    isl.memo.resize(m);
+    // Only the cached-impulse start reads the points (and remember() keeps answers for it).
+    const std::size_t withPoints = start == Start::CachedImpulse ? m : 0;
+    isl.point.resize(withPoints);
+    isl.last.resize(withPoints);
+    isl.memo.resize(withPoints);
   }
+  points_ = start == Start::CachedImpulse;
   for (int i = 0; i < n; ++i) {
     const int k = rowIsland_[i];
     if (k < 0) continue;
@@ -185,6 +201,7 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     isl.rowIndex[r] = i;
     const int f = findex_[i] >= 0 ? rowLocal_[findex_[i]] : -1;
     isl.system.findex[r] = f;
+    if (!points_) continue;
     const btManifoldPoint* point = nullptr;
     const Remembered* last = nullptr;
     btVector3 memo(0, 0, 0);
@@ -200,7 +217,7 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
       } else {
         point = static_cast<const btManifoldPoint*>(c.m_originalContactPoint);
         if (point) memo = point->m_localPointA;
-        if (point && start == Start::CachedImpulse) {
+        if (point) {
           last = lookup(point);
           if (last && (memo - last->localA).length() >= gContactBreakingThreshold) last = nullptr;
         }
@@ -228,32 +245,42 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     for (int k = 0; k < count_; ++k) fillSystem(islands_[k]);
 }
 
-inline void IslandBuilder::convert(Island& isl, int r, RowPgs::Row& out, bool split) {
+inline RowPgs::RowView IslandBuilder::view(Island& isl, int r, bool split, double* scratch) {
   const int i = isl.rowIndex[r];
   const btSolverConstraint& c = *isl.rows[r];
   const int a = rowBodies_[i].first, b = rowBodies_[i].second;
   const int findex = isl.system.findex[r];
-  // Bullet's values read into locals first: `out` might alias them as far as the compiler knows.
-  const double jd = c.m_jacDiagABInv, rhs = c.m_rhs, rhsPenetration = c.m_rhsPenetration,
-               rowCfm = c.m_cfm, friction = c.m_friction, lower = c.m_lowerLimit,
-               upper = c.m_upperLimit;
-  const double base = split ? c.m_appliedPushImpulse : c.m_appliedImpulse;
-  // One side's Jacobian block: [n * linearFactor; r x n], written in place (a local copy read
-  // back 16 bytes at a time from its 8-byte stores stalled store forwarding).
-  auto jacobian = [&](Vector6& j, int body, const btVector3& normal, const btVector3& torqueAxis) {
-    const btVector3& linearFactor = (*in_.bodies)[body].m_linearFactor;
-    const double n0 = normal[0], n1 = normal[1], n2 = normal[2];
-    const double t0 = torqueAxis[0], t1 = torqueAxis[1], t2 = torqueAxis[2];
-    j << n0 * linearFactor[0], n1 * linearFactor[1], n2 * linearFactor[2], t0, t1, t2;
+  RowPgs::RowView out;
+  // One side's J = [n * linearFactor; r x n] and M^-1's angular part, read in place (see
+  // islands.hpp).
+  auto side = [&](int body, const btVector3& normal, const btVector3& torqueAxis,
+                  const btVector3& invAngular, const double*& lin, const double*& ang,
+                  const double*& invAng, double* own) {
+    const unsigned char unit = unit_[body];
+    if (unit & kUnitLinear) {
+      lin = normal;
+    } else {
+      const btVector3& linearFactor = (*in_.bodies)[body].m_linearFactor;
+      for (int k = 0; k < 3; ++k) own[k] = normal[k] * linearFactor[k];
+      lin = own;
+    }
+    ang = torqueAxis;
+    invAng = (unit & kUnitAngular) ? static_cast<const double*>(invAngular) : nullptr;
   };
-  if (a >= 0)
-    jacobian(out.jA, c.m_solverBodyIdA, c.m_contactNormal1, c.m_relpos1CrossNormal);
-  else
-    out.jA.setZero();
-  if (b >= 0)
-    jacobian(out.jB, c.m_solverBodyIdB, c.m_contactNormal2, c.m_relpos2CrossNormal);
-  else
-    out.jB.setZero();
+  if (a >= 0) {
+    side(a, c.m_contactNormal1, c.m_relpos1CrossNormal, c.m_angularComponentA, out.linA, out.angA,
+         out.invAngA, scratch);
+  } else {
+    out.linA = out.angA = kZeros;
+  }
+  if (b >= 0) {
+    side(b, c.m_contactNormal2, c.m_relpos2CrossNormal, c.m_angularComponentB, out.linB, out.angB,
+         out.invAngB, scratch + 3);
+  } else {
+    out.linB = out.angB = kZeros;
+  }
+  const double jd = c.m_jacDiagABInv;
+  const double base = split ? c.m_appliedPushImpulse : c.m_appliedImpulse;
   double start = 0;
   const bool warm = start_ != Start::Zero;
   const bool contact = i >= nj_ && i < nj_ + nc_;
@@ -261,8 +288,8 @@ inline void IslandBuilder::convert(Island& isl, int r, RowPgs::Row& out, bool sp
     start = warm ? base : 0.0;
   } else if (warm) {
     start = (i >= nj_ ? unscaleContacts_ : 1.0) * base;
-    const btManifoldPoint* point = isl.point[r];
-    if (point && start_ == Start::CachedImpulse) {
+    const btManifoldPoint* point = points_ ? isl.point[r] : nullptr;
+    if (point) {
       if (const auto* last = static_cast<const Remembered*>(isl.last[r])) {
         start = contact ? last->normal : last->friction.dot(frictionDirection(c));
       } else if (!contact && lateralCache_) {
@@ -275,41 +302,41 @@ inline void IslandBuilder::convert(Island& isl, int r, RowPgs::Row& out, bool sp
   out.bodyB = b >= 0 ? bodyLocal_[b] : -1;
   // rhs and cfm are stored pre-multiplied by 1 / A_ii; undo it (as btMLCPSolver does).
   const bool scaled = !btFuzzyZero(jd);
-  const double splitB = scaled ? -rhsPenetration / jd : 0.0;
-  out.b = split ? splitB : scaled ? -rhs / jd : 0.0;
+  // Most rows have no penetration rhs: no division for them (-0 / jd would be 0 as well).
+  const double rhsPenetration = c.m_rhsPenetration;
+  const double splitB = scaled && rhsPenetration != 0 ? -rhsPenetration / jd : 0.0;
+  out.b = split ? splitB : scaled ? -c.m_rhs / jd : 0.0;
   if (cfm_ == CfmModel::StockMlcp)
     out.cfm = stockCfm_;
   else
-    out.cfm = scaled ? std::max(0.0, rowCfm / jd) : 0.0;
+    out.cfm = scaled ? std::max(0.0, c.m_cfm / jd) : 0.0;
   if (cfm_ == CfmModel::Regularized && findex >= 0 && out.cfm == 0) out.cfm = stockCfm_;
   out.findex = findex;
   if (findex >= 0) {
-    out.lo = -std::abs(friction);
-    out.hi = std::abs(friction);
+    out.lo = -std::abs(c.m_friction);
+    out.hi = std::abs(c.m_friction);
   } else if (i >= nj_) {  // contact
     out.lo = 0;
     out.hi = kInf;
   } else {
-    out.lo = bound(lower);
-    out.hi = bound(upper);
+    out.lo = bound(c.m_lowerLimit);
+    out.hi = bound(c.m_upperLimit);
   }
   out.base = base;
   out.start = start;
-  if (split) return;
+  if (split) return out;
   if (splitB != 0) isl.hasSplit = true;
-  if (findex >= 0 && isl.point[r]) isl.memo[r] = frictionDirection(c);
+  if (points_ && findex >= 0 && isl.point[r]) isl.memo[r] = frictionDirection(c);
+  return out;
 }
 
-void IslandBuilder::fill(Island& island, int first, int count, RowPgs::Row* out, bool split) {
-  const int n = static_cast<int>(island.rows.size());
-  for (int j = 0; j < count; ++j) {
-    // The first read of Bullet's rows' first four lines (build() read the fifth).
-    if (first + j + kAhead < n) {
-      const char* ahead = reinterpret_cast<const char*>(island.rows[first + j + kAhead]);
-      for (int line = 0; line < 4; ++line) __builtin_prefetch(ahead + 64 * line);
-    }
-    convert(island, first + j, out[j], split);
+RowPgs::RowView IslandBuilder::Source::row(int r) {
+  // The first read of Bullet's row r + kAhead's first four lines (build() read the fifth).
+  if (r + kAhead < static_cast<int>(island_.rows.size())) {
+    const char* ahead = reinterpret_cast<const char*>(island_.rows[r + kAhead]);
+    for (int line = 0; line < 4; ++line) __builtin_prefetch(ahead + 64 * line);
   }
+  return builder_.view(island_, r, split_, scratch_);
 }
 
 void IslandBuilder::fillSystem(Island& isl) {
@@ -318,15 +345,13 @@ void IslandBuilder::fillSystem(Island& isl) {
   const int m = static_cast<int>(isl.rows.size());
   // toSystem replaces bodies and findex with the same values.
   const std::vector<BodyInverseMass> bodies = isl.system.bodies;
-  RowPgs::toSystem(
-      bodies, m,
-      [&](int first, int count, RowPgs::Row* out) { fill(isl, first, count, out, false); },
-      isl.system, isl.start);
+  Source rows(*this, isl, false);
+  RowPgs::toSystem(bodies, m, rows, isl.system, isl.start);
   isl.splitB.resize(m);
   isl.splitStart.resize(m);
-  RowPgs::Row push;
+  double scratch[6];
   for (int r = 0; r < m; ++r) {
-    convert(isl, r, push, true);
+    const RowPgs::RowView push = view(isl, r, true, scratch);
     isl.splitB[r] = push.b;
     isl.splitStart[r] = push.start;
   }
@@ -340,12 +365,14 @@ void IslandBuilder::newStep() {
 }
 
 void IslandBuilder::remember(const Island& island, const Vector& x, bool store) {
-  const int n = static_cast<int>(island.point.size());
-  entry_.assign(n, -1);
+  const int n = static_cast<int>(island.rows.size());
+  const bool points = !island.point.empty();  // build() kept them (the cached-impulse start)
+  if (points) entry_.assign(n, -1);
   for (int r = 0; r < n; ++r) {
     // After the sweeps Bullet's rows are out of the near caches: fetch the line written.
     if (store && r + kAhead < n) __builtin_prefetch(&island.rows[r + kAhead]->m_appliedImpulse, 1);
     if (store) island.rows[r]->m_appliedImpulse = static_cast<btScalar>(x[r]);
+    if (!points) continue;
     const btManifoldPoint* point = island.point[r];
     if (!point) continue;
     // A friction row's point is its contact row's (earlier in the island): the same entry.

@@ -140,6 +140,40 @@ class RowPgs {
   using RowFill = std::function<void(int first, int count, Row* out)>;
   Result solve(const std::vector<BodyInverseMass>& bodies, int rows, const RowFill& fill,
                Vector& x);
+
+  // The same without any copy of a row: one row as the engine holds it, read in place by the
+  // packing pass (pointers into the engine's own rows; the values must stay put until solve
+  // returns). Each 3-vector is 3 contiguous doubles: J_A = [linA; angA], J_B = [linB; angB].
+  // invAngA / invAngB, when not null, are the engine's own I^-1 angA / I^-1 angB for the row's
+  // body (I = BodyInverseMass::invInertia): packing takes them instead of the 3x3 products. The
+  // caller promises they are what those products give bit for bit (invInertia(k, 0) * ang[0] +
+  // invInertia(k, 1) * ang[1] + invInertia(k, 2) * ang[2], left to right, no fused
+  // multiply-add), so the iterates stay those of solve(RowSystem) on the same values.
+  struct RowView {
+    int bodyA = -1, bodyB = -1;  // indices into bodies, -1 = world
+    const double* linA = nullptr;
+    const double* angA = nullptr;
+    const double* linB = nullptr;
+    const double* angB = nullptr;
+    const double* invAngA = nullptr;
+    const double* invAngB = nullptr;
+    // As in Row. lo and hi are kept apart: the packing copies them to neighbouring places, and
+    // a 16-byte load of two neighbours just written as 8-byte values by the source stalled
+    // store forwarding (a fifth of the packing's time, measured with perf).
+    double lo = 0, b = 0, hi = 0, cfm = 0;
+    int findex = -1;
+    double start = 0, base = 0;
+  };
+  // Rows fetched one at a time, in order 0 .. rows-1 by the fast path (and once more, in order,
+  // by the slow path's copy); the view of row i may be overwritten by the call for row i + 1.
+  class RowSource {
+   public:
+    virtual RowView row(int i) = 0;
+
+   protected:
+    ~RowSource() = default;
+  };
+  Result solve(const std::vector<BodyInverseMass>& bodies, int rows, RowSource& source, Vector& x);
   // After solve(bodies, rows, fill, x) took the fast path: body k's M^-1 J^T (x - base),
   // [linear; angular], from the velocities the sweeps maintain (what an engine adds to its
   // body's velocity to apply the answer, instead of one impulse per row). velocityChanges()
@@ -149,6 +183,8 @@ class RowPgs {
   // The rows fill gives, as a RowSystem with these bodies, and their starts: the slow path's
   // copy, for callers that need a RowSystem after all.
   static void toSystem(const std::vector<BodyInverseMass>& bodies, int rows, const RowFill& fill,
+                       RowSystem& system, Vector& start);
+  static void toSystem(const std::vector<BodyInverseMass>& bodies, int rows, RowSource& source,
                        RowSystem& system, Vector& start);
   Vector6 velocityChange(int body) const {
     assert(baseValid_ && body >= 0 && body < static_cast<int>(base_.size()));
@@ -207,7 +243,6 @@ class RowPgs {
   // The engine path's copies of what the check reads (the RowSystem path reads the system's).
   Vector lo_, hi_;
   std::vector<int> findex_;
-  std::vector<Row> batch_;
   bool baseValid_ = false;
   int bad_ = -1;            // the row that stopped pack()
   double badDiagonal_ = 0;  // its A_ii, or NaN when the row was invalid

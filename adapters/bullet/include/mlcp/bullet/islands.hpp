@@ -16,7 +16,7 @@
 // find() for a row on the previous row's bodies; then each island's arrays, sized once and
 // written by index: rows, bodies, findex, manifold points and last step's entries), the second
 // converts each row: into its island's RowSystem (build with system = true, or fillSystem
-// later), or straight into RowPgs' packing through fill() (the "pgs" path: no RowSystem copy).
+// later), or straight into RowPgs' packing through Source (the "pgs" path: no RowSystem copy).
 // Both write the same values (one conversion function). The conversion and the numbering fetch
 // Bullet's rows and the manifold points a few rows ahead; what remember() needs after the
 // solve (points' positions, friction directions) is kept in Island::memo, so after the sweeps
@@ -55,12 +55,15 @@ struct Island {
   RowSystem system;
   bool filled = false;
   std::vector<btSolverConstraint*> rows;  // Bullet's row for each system row
-  std::vector<int> rowIndex;              // the builder's index of each row (for fill())
+  std::vector<int> rowIndex;              // the builder's index of each row (for view())
   std::vector<int> solverBody;            // Bullet's solver body of each system body
   Vector start;                           // applied impulses (warm start)
   Vector splitB;                          // b of the split-impulse problem (m_rhsPenetration)
   Vector splitStart;                      // applied push impulses
   bool hasSplit = false;                  // splitB has a non-zero entry
+  // point, last and memo: only with the cached-impulse start (Start::CachedImpulse), the only
+  // start that reads them (remember() keeps answers for it); empty otherwise (no reads of the
+  // manifold points, no answers kept: SI's start and a cold start need neither).
   // Each contact and friction row's manifold point (null for other rows), for
   // IslandBuilder::remember.
   std::vector<const btManifoldPoint*> point;
@@ -69,7 +72,7 @@ struct Island {
   std::vector<const void*> last;
   // What remember() needs of each row with a point, kept here so that it reads neither Bullet's
   // rows nor the points after the sweeps: a contact row's point's m_localPointA (build()), a
-  // friction row's direction (the impulse on body A per unit x; convert()).
+  // friction row's direction (the impulse on body A per unit x; view()).
   std::vector<btVector3> memo;
   // A body's linear factor has a component other than 0 and 1, or its angular factor unequal
   // components: Bullet's body update is not M^-1 J^T there (constraint_solver.hpp), so a
@@ -90,14 +93,37 @@ class IslandBuilder {
  public:
   // Splits the rows into islands. globalCfm and timeStep feed CfmModel::StockMlcp and Regularized.
   // With system = false only each island's bodies, findex, rows and points are written; the
-  // rows reach a solver through fill() or fillSystem().
+  // rows reach a solver through Source or fillSystem().
   void build(const BulletRows& rows, const btContactSolverInfo& info, CfmModel cfm, Start start,
              bool system = true);
-  // Rows first .. first+count-1 of the island as RowPgs takes them (the same values fillSystem
-  // writes; split: b from m_rhsPenetration, the applied push impulse as start and base); base is
-  // the impulse Bullet's bodies already carry (m_appliedImpulse / m_appliedPushImpulse). The
-  // primary problem's fill sets island.hasSplit.
-  void fill(Island& island, int first, int count, RowPgs::Row* out, bool split);
+  // The island's rows as RowPgs reads them, in place in Bullet's rows (RowPgs::RowView; the
+  // same values fillSystem writes; split: b from m_rhsPenetration, the applied push impulse as
+  // start and base); base is the impulse Bullet's bodies already carry (m_appliedImpulse /
+  // m_appliedPushImpulse). Reading the primary problem's rows sets island.hasSplit.
+  // J's linear part is m_contactNormal1/2 itself where the body's linear factor is (1, 1, 1)
+  // (else n times the factor, computed), the angular part m_relpos1/2CrossNormal; M^-1 J^T's
+  // angular part is Bullet's m_angularComponentA/B where the body's angular factor is (1, 1, 1).
+  // Bullet 3.24's setup (setupContactConstraint, setupFrictionConstraint,
+  // setupTorsionalFrictionConstraint, convertJoint) computes it as
+  // getInvInertiaTensorWorld() * m_relposNCrossNormal * getAngularFactor(): with the factor 1
+  // that is bit for bit our invInertia (diag(f) I^-1 diag(f) = I^-1) times the same vector, row
+  // by row left to right (double precision Bullet has no SIMD dot; neither side is built with
+  // fused multiply-adds). So the packing skips two 3x3 products per row and the iterates stay
+  // those of the RowSystem copy (tested bit for bit on a pyramid). Bullet's m_jacDiagABInv is
+  // not used: it is 1 / (invMass + n . (I^-1 (r x n)) x r + Bullet's own cfm), a different
+  // rounding of A_ii, and friction rows lack the cfm our CfmModel gives them.
+  class Source final : public RowPgs::RowSource {
+   public:
+    Source(IslandBuilder& builder, Island& island, bool split)
+        : builder_(builder), island_(island), split_(split) {}
+    RowPgs::RowView row(int r) override;
+
+   private:
+    IslandBuilder& builder_;
+    Island& island_;
+    bool split_;
+    double scratch_[6];  // J's linear parts for bodies with other linear factors
+  };
   // The island's RowSystem, start, splitB and splitStart (once per build).
   void fillSystem(Island& island);
 
@@ -115,6 +141,7 @@ class IslandBuilder {
   // Call newStep() once per simulation step, before its build() calls.
   void newStep();
   // store: also set each row's m_appliedImpulse to x (one pass over Bullet's rows for both).
+  // Keeps nothing when the island has no points (build() with another start than CachedImpulse).
   void remember(const Island& island, const Vector& x, bool store = false);
 
   int count() const { return count_; }
@@ -124,22 +151,26 @@ class IslandBuilder {
 
  private:
   int find(int k);
-  // The island's row r; split: the split-impulse problem's b, start and base.
-  void convert(Island& island, int r, RowPgs::Row& out, bool split);
+  // The island's row r; split: the split-impulse problem's b, start and base. scratch: 6
+  // doubles for J's linear parts when they are not Bullet's normals themselves.
+  RowPgs::RowView view(Island& island, int r, bool split, double* scratch);
 
   std::vector<Island> islands_;
   int count_ = 0, inert_ = 0;
   std::vector<btSolverConstraint*> all_;
   std::vector<int> findex_, dynamic_, parent_, islandOfRoot_, rowIsland_, rowLocal_, bodyLocal_;
-  std::vector<int> rowsIn_;                     // build(): rows per island
+  std::vector<int> rowsIn_;  // build(): rows per island
+  // Per solver body: kUnitLinear / kUnitAngular when its linear / angular factor is (1, 1, 1).
+  std::vector<unsigned char> unit_;
   std::vector<std::pair<int, int>> rowBodies_;  // each row's dynamic bodies (-1: none)
-  // What convert() needs of the last build() call.
+  // What view() needs of the last build() call.
   BulletRows in_;
   CfmModel cfm_{};
   Start start_ = Start::Zero;
   int nj_ = 0, nc_ = 0, nf_ = 0;
   double stockCfm_ = 0, unscaleContacts_ = 1;
   bool lateralCache_ = false;
+  bool points_ = false;  // the islands keep their points (Start::CachedImpulse)
   struct Remembered {
     const btManifoldPoint* point = nullptr;
     double normal = 0;   // the contact row's impulse
