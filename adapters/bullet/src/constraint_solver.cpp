@@ -162,8 +162,7 @@ bool ConstraintSolver::solveIslandFast(Island& island, bool split) {
   pgs_.options() = rows_->options();
   pgs_.options().warmStart = true;  // as RowSolver runs it: from the start given
   const int n = static_cast<int>(island.rows.size());
-  IslandBuilder::Source rows(builder_, island, split);
-  Result r = pgs_.solve(island.system.bodies, n, rows, x_);
+  Result r = builder_.solvePgs(pgs_, island, split, x_);
   if (!pgs_.velocityChanges() || !acceptable(r, settings_.acceptResidual)) return false;
   r.solver = "pgs";
   r.seconds = nowSeconds() - t0;

@@ -7,6 +7,7 @@
 #include <cstdint>
 
 #include "mlcp/bullet/constraint_solver.hpp"
+#include "mlcp/detail/row_pack.hpp"
 
 namespace mlcp::bullet {
 
@@ -330,13 +331,18 @@ inline RowPgs::RowView IslandBuilder::view(Island& isl, int r, bool split, doubl
   return out;
 }
 
-RowPgs::RowView IslandBuilder::Source::row(int r) {
+inline RowPgs::RowView IslandBuilder::Source::row(int r) {
   // The first read of Bullet's row r + kAhead's first four lines (build() read the fifth).
   if (r + kAhead < static_cast<int>(island_.rows.size())) {
     const char* ahead = reinterpret_cast<const char*>(island_.rows[r + kAhead]);
     for (int line = 0; line < 4; ++line) __builtin_prefetch(ahead + 64 * line);
   }
   return builder_.view(island_, r, split_, scratch_);
+}
+
+Result IslandBuilder::solvePgs(RowPgs& pgs, Island& island, bool split, Vector& x) {
+  Source rows(*this, island, split);
+  return pgs.solveFrom(island.system.bodies, static_cast<int>(island.rows.size()), rows, x);
 }
 
 void IslandBuilder::fillSystem(Island& isl) {

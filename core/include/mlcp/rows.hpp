@@ -174,6 +174,10 @@ class RowPgs {
     ~RowSource() = default;
   };
   Result solve(const std::vector<BodyInverseMass>& bodies, int rows, RowSource& source, Vector& x);
+  // The same for any class with RowView row(int) (a final RowSource, or none): defined in
+  // mlcp/detail/row_pack.hpp, where the source's row() can be inlined into the packing loop.
+  template <class Source>
+  Result solveFrom(const std::vector<BodyInverseMass>& bodies, int rows, Source& source, Vector& x);
   // After solve(bodies, rows, fill, x) took the fast path: body k's M^-1 J^T (x - base),
   // [linear; angular], from the velocities the sweeps maintain (what an engine adds to its
   // body's velocity to apply the answer, instead of one impulse per row). velocityChanges()
@@ -221,11 +225,15 @@ class RowPgs {
   static constexpr int kMaxRun = 8;
   // w = J v + cfm x + b for every row, from the maintained velocities (see above).
   void slackFromVelocities(const Vector& x);
-  // Fills packed_ and velocity_ from rowAt(i) (rows.cpp); false at the first invalid row or
-  // non-positive A_ii (bad_, badDiagonal_ say which).
+  // Fills packed_ and velocity_ from rowAt(i) (detail/row_pack.hpp); false at the first invalid row
+  // or non-positive A_ii (bad_, badDiagonal_ say which).
   template <class RowAt>
   bool pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& rowAt, bool warm, double* x,
             bool withBase);
+  static Result negativeRows();
+  // After the engine path's packing: per-body changes offered when the bases are finite, then
+  // iterate() on lo_, hi_, findex_.
+  Result iteratePacked(int bodies, Vector& x, double bNorm, double t0);
   // The sweeps and checks on packed_ from x; lo, hi, findex and bNorm for the check.
   Result iterate(Vector& x, const Vector& lo, const Vector& hi, const std::vector<int>& findex,
                  double bNorm, double t0);

@@ -124,6 +124,8 @@ class IslandBuilder {
     bool split_;
     double scratch_[6];  // J's linear parts for bodies with other linear factors
   };
+  // RowPgs' engine path on the island's rows read in place (Source, inlined into the packing).
+  Result solvePgs(RowPgs& pgs, Island& island, bool split, Vector& x);
   // The island's RowSystem, start, splitB and splitStart (once per build).
   void fillSystem(Island& island);
 

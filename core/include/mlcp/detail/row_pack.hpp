@@ -1,0 +1,283 @@
+// mlcp/detail/row_pack.hpp: RowPgs' packing pass and its engine entry point as templates
+// (rows.hpp), for engines whose row source the compiler should see: RowPgs::solveFrom with a
+// final source class inlines the source's row() into the packing loop (no view written to
+// memory and read back, no call per row). Include it only where solveFrom is instantiated.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+
+#include "mlcp/rows.hpp"
+#include "mlcp/solver.hpp"
+
+namespace mlcp {
+namespace detail {
+
+// A view's Jacobian block as [linear; angular] (a missing part reads as zeros).
+inline void jacobianOf(const double* lin, const double* ang, double* j) {
+  for (int k = 0; k < 3; ++k) {
+    j[k] = lin ? lin[k] : 0.0;
+    j[3 + k] = ang ? ang[k] : 0.0;
+  }
+}
+
+// Every per-row rule of RowSystem::validate and Problem::validate (b, bounds, findex) for row i of
+// n as one predicate without copies, except that row findex's own findex must be -1 (the callers
+// check that against the other row): the fast path of RowSystem::validate, which the adapters
+// call every step, and the check RowPgs folds into its packing pass. When it says no, the checks
+// in RowSystem::validate find the row and say what is wrong (Problem::validate stays the one
+// statement of the bound rules' wording). A false alarm (a sum of finite Jacobian entries
+// overflowing) only costs the slow path. slots = bodies + 1; the array sizes are checked.
+inline bool rowValid(const RowPgs::RowView& r, const double* jA, const double* jB, int i, int n,
+                     unsigned slots) {
+  if (static_cast<unsigned>(r.bodyA + 1) >= slots || static_cast<unsigned>(r.bodyB + 1) >= slots)
+    return false;
+  // Any NaN or Inf entry makes the sum NaN or Inf.
+  double sum = 0;
+  for (int k = 0; k < 6; ++k) sum += jA[k] + jB[k];
+  if (!std::isfinite(sum)) return false;
+  if (!(r.cfm >= 0 && r.cfm < kInf)) return false;
+  const double lo = r.lo, hi = r.hi;
+  // !(lo <= hi) also catches NaN bounds.
+  if (!std::isfinite(r.b) || !(lo <= hi) || lo == kInf || hi == -kInf) return false;
+  const int f = r.findex;
+  if (f < 0) return f == -1;
+  if (f >= n || f == i) return false;
+  return hi >= 0 && std::isfinite(hi) && lo == -hi;
+}
+
+// A finite, non-negative inverse mass and a finite inverse inertia.
+inline bool bodyValid(const BodyInverseMass& body) {
+  return std::isfinite(body.invMass) && body.invMass >= 0 && body.invInertia.allFinite();
+}
+
+// M^-1 j for one body written to out[0..5], returning j . M^-1 j; the angular part is the
+// engine's own invAng when given (RowPgs::RowView: the same products, computed by the engine).
+// Scalar code on purpose: the Vector6 that applyInverseMass returns passes through a stack
+// temporary written in 8- and 16-byte pieces, and reading it back in pairs stalled store
+// forwarding on every row of the packing pass (a quarter of its time, measured with perf).
+inline double inverseMassInto(const BodyInverseMass& body, const double* j, const double* invAng,
+                              double* out) {
+  const double im = body.invMass;
+  const Eigen::Matrix3d& I = body.invInertia;
+  double m[6] = {im * j[0], im * j[1], im * j[2]};
+  if (invAng) {
+    for (int k = 0; k < 3; ++k) m[3 + k] = invAng[k];
+  } else {
+    for (int k = 0; k < 3; ++k) m[3 + k] = I(k, 0) * j[3] + I(k, 1) * j[4] + I(k, 2) * j[5];
+  }
+  double d = 0;
+  for (int k = 0; k < 6; ++k) {
+    out[k] = m[k];
+    d += j[k] * m[k];
+  }
+  return d;
+}
+
+inline void resizeSystem(const std::vector<BodyInverseMass>& bodies, int n, RowSystem& s,
+                         Vector& start) {
+  s.bodies = bodies;
+  s.rows.resize(n);
+  s.b.resize(n);
+  s.lo.resize(n);
+  s.hi.resize(n);
+  s.cfm.resize(n);
+  s.findex.resize(n);
+  start.resize(n);
+}
+
+inline void setRow(RowSystem& s, Vector& start, int i, const RowPgs::RowView& r) {
+  ConstraintRow& c = s.rows[i];
+  c.bodyA = r.bodyA;
+  c.bodyB = r.bodyB;
+  jacobianOf(r.linA, r.angA, c.jA.data());
+  jacobianOf(r.linB, r.angB, c.jB.data());
+  s.b[i] = r.b;
+  s.lo[i] = r.lo;
+  s.hi[i] = r.hi;
+  s.cfm[i] = r.cfm;
+  s.findex[i] = r.findex;
+  start[i] = r.start;
+}
+
+}  // namespace detail
+
+template <class RowAt>
+bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& rowAt, bool warm,
+                  double* xOut, bool withBase) {
+  const int world = static_cast<int>(bodies.size());  // the first zero-velocity slot
+  const unsigned slots = static_cast<unsigned>(world) + 1;
+  // Ground rows take the world slots in turn (per run of rows on the same bodies): one shared
+  // slot would chain them all through its store and load (see rows.hpp).
+  unsigned nextWorld = 0;
+  int runStart = 0;            // first row of the current run
+  int runA = 0, runB = 0;      // its slots (kept here: reading them back from packed_ right after
+                               // their 4-byte stores stalled store forwarding)
+  int lastA = -2, lastB = -2;  // the previous row's bodies
+  int runLength = 0;
+  double runM[kMaxRun][12];  // the run's M^-1 J^T so far (for its couplings)
+  std::size_t coupled = 0;   // couplings written
+  if (coupling_.size() < static_cast<std::size_t>(n) * (kMaxRun - 1))
+    coupling_.resize(static_cast<std::size_t>(n) * (kMaxRun - 1));
+  auto worldSlot = [&] { return world + static_cast<int>(nextWorld++ % kWorldSlots); };
+  packed_.resize(n);
+  scale_.resize(n);
+  velocity_.resize(world + kWorldSlots);
+  for (BodyVelocity& v : velocity_) v.v.setZero();
+  if (withBase) {
+    base_.resize(world + kWorldSlots);
+    for (BodyVelocity& v : base_) v.v.setZero();
+  }
+  bad_ = -1;
+  const bool unitRelaxation = options_.relaxation == 1;
+  auto stop = [&](int i, double d) {
+    bad_ = i;
+    badDiagonal_ = d;
+    return false;
+  };
+  int later = -1;  // the first row whose findex points forward (checked after the pass)
+  for (int i = 0; i < n; ++i) {
+    const RowView r = rowAt(i);
+    double jA[6], jB[6];
+    detail::jacobianOf(r.linA, r.angA, jA);
+    detail::jacobianOf(r.linB, r.angB, jB);
+    if (!detail::rowValid(r, jA, jB, i, n, slots)) return stop(i, std::nan(""));
+    PackedRow& p = packed_[i];
+    p.findex = r.findex;
+    if (r.findex >= 0) {
+      if (r.findex > i) {
+        if (later < 0) later = i;
+      } else if (packed_[r.findex].findex >= 0) {
+        return stop(i, std::nan(""));
+      }
+    }
+    // "The world" (-1) becomes the zero-velocity slot (its J meets v = 0, its M^-1 J^T is 0).
+    if (i > 0 && r.bodyA == lastA && r.bodyB == lastB && r.bodyA != r.bodyB &&
+        runLength < kMaxRun) {
+      ++packed_[runStart].run;
+      ++runLength;
+    } else {
+      runStart = i;
+      runLength = 1;
+      p.run = 1;
+      runA = r.bodyA >= 0 ? r.bodyA : worldSlot();
+      runB = r.bodyB >= 0 ? r.bodyB : worldSlot();
+    }
+    lastA = r.bodyA;
+    lastB = r.bodyB;
+    p.a = runA;
+    p.b = runB;
+    double mA[6] = {}, mB[6] = {};
+    const double dA =
+        r.bodyA >= 0 ? detail::inverseMassInto(bodies[r.bodyA], jA, r.invAngA, mA) : 0.0;
+    const double dB =
+        r.bodyB >= 0 ? detail::inverseMassInto(bodies[r.bodyB], jB, r.invAngB, mB) : 0.0;
+    p.lo = r.lo;
+    p.hi = r.hi;
+    double d = dA + dB + r.cfm;
+    // A row joining a body to itself: A_ii = (jA + jB) M^-1 (jA + jB) has the cross terms too.
+    if (r.bodyA == r.bodyB && r.bodyA >= 0)
+      for (int k = 0; k < 6; ++k) d += jA[k] * mB[k] + jB[k] * mA[k];
+    if (!(d > 0)) return stop(i, d);
+    const double step = options_.relaxation / d;
+    for (int k = 0; k < 6; ++k) {
+      p.sA[k] = step * jA[k];
+      p.sB[k] = step * jB[k];
+    }
+    // Couplings to the run's earlier rows k: step J_i M^-1 J_k^T on the run's two bodies, i.e.
+    // sA . mA_k + sB . mB_k (scalars from locals: no reading back of what was just stored).
+    // step J_i in scalars once (the products the sums used, so the same couplings to the bit).
+    double sJ[12];
+    for (int j = 0; j < 6; ++j) {
+      sJ[j] = step * jA[j];
+      sJ[6 + j] = step * jB[j];
+    }
+    for (int k = 0; k + 1 < runLength; ++k) {
+      double c = 0;
+      for (int j = 0; j < 12; ++j) c += sJ[j] * runM[k][j];
+      coupling_[coupled++] = c;
+    }
+    for (int j = 0; j < 6; ++j) {
+      runM[runLength - 1][j] = mA[j];
+      runM[runLength - 1][6 + j] = mB[j];
+    }
+    p.keep = 1 - step * r.cfm;
+    p.shift = step * r.b;
+    scale_[i] = unitRelaxation ? d : d / options_.relaxation;  // d / 1 = d: no second division
+    // v = M^-1 J^T x of the start (from mA, mB, not from p.mA, p.mB just stored: see above).
+    const double xi = warm ? r.start : 0.0;
+    if (xOut) xOut[i] = xi;
+    double* va = velocity_[runA].v.data();
+    double* vb = velocity_[runB].v.data();
+    for (int k = 0; k < 6; ++k) {
+      p.mA[k] = mA[k];
+      p.mB[k] = mB[k];
+    }
+    if (xi != 0) {
+      for (int k = 0; k < 6; ++k) {
+        va[k] += mA[k] * xi;
+        vb[k] += mB[k] * xi;
+      }
+    }
+    // base_ holds M^-1 J^T (base - start) here; the start's velocities are added after the
+    // pass (an engine's base is mostly its start: no second 12-wide update per row).
+    if (withBase && r.base != xi) {
+      const double extra = r.base - xi;
+      double* ba = base_[runA].v.data();
+      double* bb = base_[runB].v.data();
+      for (int k = 0; k < 6; ++k) {
+        ba[k] += mA[k] * extra;
+        bb[k] += mB[k] * extra;
+      }
+    }
+  }
+  for (int i = std::max(later, 0); later >= 0 && i < n; ++i)
+    if (packed_[i].findex > i && packed_[packed_[i].findex].findex >= 0)
+      return stop(i, std::nan(""));
+  // The world never moves (its blocks are zero anyway).
+  for (int k = 0; k < kWorldSlots; ++k) velocity_[world + k].v.setZero();
+  if (withBase)
+    for (int k = 0; k < world; ++k) base_[k].v += velocity_[k].v;
+  return true;
+}
+
+template <class Source>
+Result RowPgs::solveFrom(const std::vector<BodyInverseMass>& bodies, int n, Source& source,
+                         Vector& x) {
+  const double t0 = nowSeconds();
+  baseValid_ = false;
+  // The slow path: the same rows as a RowSystem, solved (or refused) by solve(RowSystem).
+  auto slow = [&] {
+    RowSystem s;
+    detail::resizeSystem(bodies, n, s, x);
+    for (int i = 0; i < n; ++i) detail::setRow(s, x, i, source.row(i));
+    return solve(s, x);
+  };
+  const Options& opt = options_;
+  if (n < 0) return negativeRows();
+  if (!(opt.relaxation > 0 && opt.relaxation < 2)) return slow();
+  for (const BodyInverseMass& body : bodies)
+    if (!detail::bodyValid(body)) return slow();
+  x.resize(n);
+  lo_.resize(n);
+  hi_.resize(n);
+  findex_.resize(n);
+  double bNorm = 0;
+  const bool packed = pack(
+      bodies, n,
+      [&](int i) {
+        const RowView r = source.row(i);
+        lo_[i] = r.lo;
+        hi_[i] = r.hi;
+        findex_[i] = r.findex;
+        bNorm = std::max(bNorm, std::abs(r.b));
+        return r;
+      },
+      opt.warmStart, x.data(), true);
+  if (!packed) return slow();
+  // A non-finite start: solve(RowSystem) starts cold (velocity_ and base_ hold NaN here).
+  if (!x.allFinite()) return slow();
+  return iteratePacked(static_cast<int>(bodies.size()), x, bNorm, t0);
+}
+
+}  // namespace mlcp
