@@ -725,6 +725,7 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
     return;
   }
   blockSteps_ = 0;
+  blockFactorizations_ = 0;
   blockSettled_ = false;
   const bool warm = !x.isZero(0.0);
   if (!wantsBlockStage(problem)) {
@@ -750,6 +751,7 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
     result.message = blockMessage.empty() ? rep.message : blockMessage + "; " + rep.message;
   };
   bool symmetric = false;  // known after a first run of the block stage
+  block_->setLimits({params_.blockWoodburyRows, params_.blockUpdateRows});
   // Auto first tries a few full steps from the cold guess (every row clamped): resting piles
   // (ODE) settle in one step there, often sooner than from a warm guess whose sets are off by
   // a few rows; when they do not settle the trial is dropped (its iterate is a worse start than
@@ -772,6 +774,7 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
                     std::max(1, std::min(params_.autoColdSteps, params_.maxBlockSteps)), true);
     symmetric = rep.symmetric;
     blockSteps_ += rep.steps;
+    blockFactorizations_ += rep.factorizations;
     coldMissed_ = rep.settled ? 0 : 1;
     coldMissedRows_ = problem.size();
     if (rep.settled) {
@@ -787,6 +790,7 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
     const detail::BlockPivoting::Report rep =
         block_->run(problem, x, options(), std::max(1, params_.maxBlockSteps), false, symmetric);
     blockSteps_ += rep.steps;
+    blockFactorizations_ += rep.factorizations;
     if (rep.settled) {
       settle(rep);
       return;

@@ -25,6 +25,19 @@ double heldValue(double lo, double hi, bool atHi) { return atHi ? hi : lo; }
 bool SymmetricPatternLu::factor(int m, const std::vector<int>& outer, const std::vector<int>& inner,
                                 const std::vector<double>& k, const std::vector<double>& kt,
                                 double pivotTolerance) {
+  return run(m, outer, inner, k, &kt, pivotTolerance);
+}
+
+bool SymmetricPatternLu::factorSymmetric(int m, const std::vector<int>& outer,
+                                         const std::vector<int>& inner,
+                                         const std::vector<double>& k, double pivotTolerance) {
+  return run(m, outer, inner, k, nullptr, pivotTolerance);
+}
+
+bool SymmetricPatternLu::run(int m, const std::vector<int>& outer, const std::vector<int>& inner,
+                             const std::vector<double>& k, const std::vector<double>* kt,
+                             double pivotTolerance) {
+  symmetric_ = kt == nullptr;
   // Symbolic: the elimination tree and the column counts of L (as SimplicialLDLT's analysis).
   parent_.assign(m, -1);
   tag_.assign(m, -1);
@@ -42,7 +55,7 @@ bool SymmetricPatternLu::factor(int m, const std::vector<int>& outer, const std:
   for (int c = 0; c < m; ++c) start_[c + 1] = start_[c] + fill_[c];
   rows_.resize(start_[m]);
   l_.resize(start_[m]);
-  u_.resize(start_[m]);
+  if (!symmetric_) u_.resize(start_[m]);
   std::copy(start_.begin(), start_.end() - 1, fill_.begin());
   d_.assign(m, 0.0);
   y_.assign(m, 0.0);
@@ -61,13 +74,26 @@ bool SymmetricPatternLu::factor(int m, const std::vector<int>& outer, const std:
       if (i == col) dk = k[e];
       if (i >= col) continue;
       y_[i] = k[e];
-      z_[i] = kt[e];
+      if (!symmetric_) z_[i] = (*kt)[e];
       int len = 0;
       for (; tag_[i] != col; i = parent_[i]) {
         stack_[len++] = i;
         tag_[i] = col;
       }
       while (len > 0) stack_[--top] = stack_[--len];
+    }
+    if (symmetric_) {
+      for (; top < m; ++top) {
+        const int i = stack_[top];
+        const double yi = y_[i];
+        y_[i] = 0;
+        for (int p = start_[i]; p < fill_[i]; ++p) y_[rows_[p]] -= l_[p] * yi;
+        const double li = yi / d_[i];
+        dk -= li * yi;
+        const int p = fill_[i]++;
+        rows_[p] = col;
+        l_[p] = li;
+      }
     }
     for (; top < m; ++top) {
       const int i = stack_[top];
@@ -94,10 +120,29 @@ void SymmetricPatternLu::solve(Vector& y) const {
   for (int i = 0; i < m; ++i)
     for (int p = start_[i]; p < start_[i + 1]; ++p) y[rows_[p]] -= l_[p] * y[i];
   for (int i = 0; i < m; ++i) y[i] /= d_[i];
+  const std::vector<double>& u = symmetric_ ? l_ : u_;
   for (int i = m - 1; i >= 0; --i) {
     double s = y[i];
-    for (int p = start_[i]; p < start_[i + 1]; ++p) s -= u_[p] * y[rows_[p]];
+    for (int p = start_[i]; p < start_[i + 1]; ++p) s -= u[p] * y[rows_[p]];
     y[i] = s;
+  }
+}
+
+void SymmetricPatternLu::forward(std::vector<int>& idx, Vector& y) {
+  reached_.resize(d_.size(), 0);
+  const size_t given = idx.size();
+  for (size_t a = 0; a < given; ++a)
+    for (int i = idx[a]; i >= 0 && !reached_[i]; i = parent_[i]) {
+      reached_[i] = 1;
+      idx.push_back(i);
+    }
+  idx.erase(idx.begin(), idx.begin() + static_cast<std::ptrdiff_t>(given));
+  std::sort(idx.begin(), idx.end());
+  for (int i : idx) {
+    reached_[i] = 0;
+    const double yi = y[i];
+    if (yi != 0)
+      for (int p = start_[i]; p < start_[i + 1]; ++p) y[rows_[p]] -= l_[p] * yi;
   }
 }
 
@@ -153,8 +198,9 @@ void BlockPivoting::guess(const Problem& pb, const Vector& x0, const Vector& w0,
 //   friction at a bound:  x_t = mu_t s_j x_j (s_j = sign of the normal, mu_t = lo_t or hi_t)
 // with a proximal term: clamped rows solve w_i + rho (x_i - prev_i) = 0 (rho = 0: the exact
 // equations). Substituting the sliding rows (normal clamped) gives K y = r with K = A_CC + rho I
-// plus the sliding columns scaled by their coefficients added to their normals' columns: sparse
-// LDL^T without sliding rows, sparse LU with them (factorClamped / factorCoupled).
+// plus the sliding columns scaled by their coefficients added to their normals' columns: the
+// sparse LDL^T of A_CC + rho I with the sliding rows bordered (Woodbury), reused by the next
+// steps while their sets stay close (buildCapacitance); many sliding rows: the LU of K.
 bool BlockPivoting::solveClamped(const Problem& pb, Vector& x, const Vector& prev, double rho,
                                  std::string& why) {
   const int n = pb.size();
@@ -191,11 +237,26 @@ bool BlockPivoting::solveClamped(const Problem& pb, Vector& x, const Vector& pre
   for (int c = 0; c < m; ++c)
     r[c] = -(pb.b[order_[c]] + A.row(order_[c]).dot(x)) + rho * prev[order_[c]];
   const int s = static_cast<int>(sliding_.size());
-  useLu_ = s > 0 && m > 0;
-  if (useLu_) {
-    if (!factorCoupled(rho, why)) return false;
-  } else if (m > 0) {
-    if (!factorClamped(rho, why)) return false;
+  useLu_ = s > limits_.woodburyRows && m > 0;
+  if (m > 0) {
+    if (useLu_) {
+      haveBase_ = false;
+      ++factorizations_;
+      if (!factorCoupled(rho, true, why)) return false;
+    } else if (!(haveBase_ && rho == baseRho_ && buildCapacitance(pb, rho, limits_.updateRows))) {
+      // A new base: B = A_CC + rho I for the current set, the sliding rows by Woodbury.
+      ++factorizations_;
+      haveBase_ = false;
+      if (!factorCoupled(rho, false, why)) return false;
+      haveBase_ = true;
+      baseRho_ = rho;
+      basePos_ = pos_;
+      baseOrder_ = order_;
+      if (!buildCapacitance(pb, rho, m + s)) {
+        why = "the clamped system with its sliding rows is singular";
+        return false;
+      }
+    }
   }
   auto place = [&](const Vector& y, bool add) {
     for (int c = 0; c < m; ++c) x[order_[c]] = (add ? x[order_[c]] : 0.0) + y[c];
@@ -217,68 +278,159 @@ bool BlockPivoting::solveClamped(const Problem& pb, Vector& x, const Vector& pre
   return true;
 }
 
-void BlockPivoting::applySolve(Vector& y) const {
-  if (useLu_ && useSymLu_)
-    symLu_.solve(y);
-  else if (useLu_)
-    y = lu_.solve(y);
-  else
-    y = ldlt_.solve(y);
+void BlockPivoting::applySolve(Vector& y) {
+  if (useLu_) {
+    if (useSymLu_)
+      symLu_.solve(y);
+    else
+      y = lu_.solve(y);
+    return;
+  }
+  // [B G; H^T F] [x0; xi] = [r0; s] (see the header): x0 = B^-1 (r0 - G xi) with
+  // S xi = s - H^T B^-1 r0, S = F - H^T B^-1 G.
+  const int m0 = static_cast<int>(baseOrder_.size()), p = static_cast<int>(extraRow_.size());
+  Vector& r0 = work_;
+  r0.setZero(m0);
+  Vector rhs = Vector::Zero(p);
+  for (size_t c = 0; c < order_.size(); ++c) {
+    const int i = order_[c];
+    if (basePos_[i] >= 0)
+      r0[basePos_[i]] = y[c];
+    else
+      rhs[extraOf_[i]] = y[c];
+  }
+  Vector t = r0;
+  symLu_.solve(t);
+  for (int a = 0; a < p; ++a)
+    for (int q = hStart_[a]; q < hStart_[a + 1]; ++q) rhs[a] -= hVal_[q] * t[hIdx_[q]];
+  const Vector xi = p > 0 ? Vector(capacitance_.solve(rhs)) : rhs;
+  for (int a = 0; a < p; ++a)
+    for (int q = gStart_[a]; q < gStart_[a + 1]; ++q) r0[gIdx_[q]] -= xi[a] * gVal_[q];
+  symLu_.solve(r0);
+  for (size_t c = 0; c < order_.size(); ++c) {
+    const int i = order_[c];
+    y[c] = basePos_[i] >= 0 ? r0[basePos_[i]] : xi[extraOf_[i]];
+  }
 }
 
-// Factors the symmetric A_CC + rho I (no sliding rows): sparse LDL^T of its upper triangle,
-// column by column in the order of byRank_; the symbolic analysis only when the pattern changed.
-bool BlockPivoting::factorClamped(double rho, std::string& why) {
+// The bordered system of the current sets on the base factor B = A_{C0,C0} + rho I (C0: the
+// set of the last factorization). Unknowns beyond C0 (the xi of applySolve), each a column of G
+// (its coefficients in C0's equations), of H (its equation's coefficients on x0) and of F:
+//   a row d that joined C:   G = H = A_{C0,d}, F(d, d') = A_dd' (+ rho on the diagonal);
+//   a row r that left C:     G = H = e_r (a multiplier frees r's equation, x_r = 0);
+//   a sliding row t:         z_t = x_j for its normal j; G = c_t A_{C0,t}, F(d, t) = c_t A_dt
+//                            for joined rows d, and z_t - x_j = 0: H = -e_j when j is in C0,
+//                            else F(t, j) = -1; F(t, t) = 1.
+// S = F - H^T B^-1 G = F - (L^-1 H)^T D^-1 (L^-1 G) from sparse forward solves (G and H are
+// local to a few bodies, so their reach in the elimination tree is short). False when there
+// are more than maxExtra unknowns beyond C0 or S is singular.
+bool BlockPivoting::buildCapacitance(const Problem& pb, double rho, int maxExtra) {
   const SparseMatrix& A = *a_;
-  const int m = static_cast<int>(order_.size());
-  K_.resize(m, m);
-  std::vector<std::pair<int, double>> column;
-  std::vector<int> outer(m + 1, 0), inner;
-  std::vector<double> values;
-  for (int c = 0; c < m; ++c) {
-    column.clear();
-    bool diagonal = false;
-    for (SparseMatrix::InnerIterator it(A, order_[c]); it; ++it) {
-      const int q = pos_[it.index()];
-      if (q < 0 || q > c) continue;
-      diagonal |= q == c;
-      column.emplace_back(q, it.value() + (q == c ? rho : 0.0));
+  const int n = pb.size(), m0 = static_cast<int>(baseOrder_.size());
+  extraRow_.clear();
+  extraOf_.assign(n, -1);
+  for (int i : order_)
+    if (basePos_[i] < 0) extraRow_.push_back(i);  // joined
+  const int joined = static_cast<int>(extraRow_.size());
+  for (int i : baseOrder_)
+    if (pos_[i] < 0) extraRow_.push_back(i);  // left
+  const int left = static_cast<int>(extraRow_.size());
+  for (int t : sliding_) extraRow_.push_back(t);
+  const int p = static_cast<int>(extraRow_.size());
+  if (p > maxExtra) return false;
+  for (int a = 0; a < left; ++a) extraOf_[extraRow_[a]] = a;
+  DenseMatrix S = DenseMatrix::Zero(p, p);
+  gStart_.assign(1, 0);
+  hStart_.assign(1, 0);
+  gIdx_.clear();
+  gVal_.clear();
+  hIdx_.clear();
+  hVal_.clear();
+  work_.setZero(m0);
+  // Column a of G (and of H when given) as sparse lists; F's entries in S.
+  auto pushColumn = [&](std::vector<int>& idx, std::vector<double>& val, std::vector<int>& start,
+                        int row, double scale) {
+    for (SparseMatrix::InnerIterator it(A, row); it; ++it)
+      if (basePos_[it.index()] >= 0) {
+        idx.push_back(basePos_[it.index()]);
+        val.push_back(scale * it.value());
+      }
+    start.push_back(static_cast<int>(idx.size()));
+  };
+  auto pushUnit = [](std::vector<int>& idx, std::vector<double>& val, std::vector<int>& start,
+                     int at, double v) {
+    if (at >= 0) {
+      idx.push_back(at);
+      val.push_back(v);
     }
-    if (rho > 0 && !diagonal) column.emplace_back(c, rho);
-    std::sort(column.begin(), column.end());
-    for (const auto& [q, v] : column) {
-      inner.push_back(q);
-      values.push_back(v);
+    start.push_back(static_cast<int>(idx.size()));
+  };
+  for (int a = 0; a < p; ++a) {
+    const int i = extraRow_[a];
+    if (a < joined) {
+      pushColumn(gIdx_, gVal_, gStart_, i, 1.0);
+      pushColumn(hIdx_, hVal_, hStart_, i, 1.0);
+      for (SparseMatrix::InnerIterator it(A, i); it; ++it)
+        if (extraOf_[it.index()] >= 0 && extraOf_[it.index()] < joined)
+          S(a, extraOf_[it.index()]) += it.value();
+      S(a, a) += rho;
+    } else if (a < left) {
+      pushUnit(gIdx_, gVal_, gStart_, basePos_[i], 1.0);
+      pushUnit(hIdx_, hVal_, hStart_, basePos_[i], 1.0);
+    } else {
+      const double c = coeff_[a - left];
+      const int j = problemFindex_[i];
+      pushColumn(gIdx_, gVal_, gStart_, i, c);
+      for (SparseMatrix::InnerIterator it(A, i); it; ++it)
+        if (extraOf_[it.index()] >= 0 && extraOf_[it.index()] < joined)
+          S(extraOf_[it.index()], a) += c * it.value();
+      pushUnit(hIdx_, hVal_, hStart_, basePos_[j], -1.0);
+      if (basePos_[j] < 0) S(a, extraOf_[j]) -= 1;
+      S(a, a) += 1;
     }
-    outer[c + 1] = static_cast<int>(inner.size());
   }
-  K_.resizeNonZeros(static_cast<Eigen::Index>(inner.size()));
-  std::copy(outer.begin(), outer.end(), K_.outerIndexPtr());
-  std::copy(inner.begin(), inner.end(), K_.innerIndexPtr());
-  std::copy(values.begin(), values.end(), K_.valuePtr());
-  if (!kPattern_.same(K_)) {
-    ldlt_.analyzePattern(K_);
-    kPattern_.remember(K_);
+  // D^-1 L^-1 H column by column (applySolve uses H itself, on B^-1 r0).
+  std::vector<int> hsStart(1, 0), hsIdx;
+  std::vector<double> hsVal;
+  for (int a = 0; a < p; ++a) {
+    reach_.assign(hIdx_.begin() + hStart_[a], hIdx_.begin() + hStart_[a + 1]);
+    for (int q = hStart_[a]; q < hStart_[a + 1]; ++q) work_[hIdx_[q]] += hVal_[q];
+    symLu_.forward(reach_, work_);
+    for (int i : reach_) {
+      hsIdx.push_back(i);
+      hsVal.push_back(work_[i] / symLu_.pivot(i));
+      work_[i] = 0;
+    }
+    hsStart.push_back(static_cast<int>(hsIdx.size()));
   }
-  ldlt_.factorize(K_);
-  if (ldlt_.info() != Eigen::Success || !(ldlt_.vectorD().cwiseAbs().minCoeff() > pivTol_)) {
-    why = "the clamped block is singular";
-    return false;
+  for (int b = 0; b < p; ++b) {
+    reach_.assign(gIdx_.begin() + gStart_[b], gIdx_.begin() + gStart_[b + 1]);
+    for (int q = gStart_[b]; q < gStart_[b + 1]; ++q) work_[gIdx_[q]] += gVal_[q];
+    symLu_.forward(reach_, work_);
+    for (int a = 0; a < p; ++a) {
+      double sum = 0;
+      for (int q = hsStart[a]; q < hsStart[a + 1]; ++q) sum += hsVal[q] * work_[hsIdx[q]];
+      S(a, b) -= sum;
+    }
+    for (int i : reach_) work_[i] = 0;
   }
-  return true;
+  if (p == 0) return true;
+  capacitance_.setThreshold(pivTolRelative_);
+  capacitance_.compute(S);
+  return S.allFinite() && capacitance_.isInvertible();
 }
 
-// Factors K = A_CC + rho I with each sliding row's column c_t A_{C,t} added to its normal's
-// column. The friction coupling makes K nonsymmetric, but a contact's friction and normal rows
-// touch the same bodies, so K keeps A_CC's pattern and a sparse LU in the inherited
-// fill-reducing order stays cheap.
-bool BlockPivoting::factorCoupled(double rho, std::string& why) {
+// Factors K = A_CC + rho I, when coupled with each sliding row's column c_t A_{C,t} added to its
+// normal's column. The friction coupling makes K nonsymmetric, but a contact's friction and
+// normal rows touch the same bodies, so K keeps A_CC's pattern and a sparse LU in the inherited
+// fill-reducing order stays cheap. Not coupled: the symmetric LDL^T of A_CC + rho I.
+bool BlockPivoting::factorCoupled(double rho, bool coupled, std::string& why) {
   const SparseMatrix& A = *a_;
   const int n = static_cast<int>(pos_.size());
   const int m = static_cast<int>(order_.size());
   slidingHead_.assign(n, -1);
   slidingNext_.resize(sliding_.size());
-  for (size_t k = 0; k < sliding_.size(); ++k) {
+  for (size_t k = 0; coupled && k < sliding_.size(); ++k) {
     const int j = problemFindex_[sliding_[k]];
     slidingNext_[k] = slidingHead_[j];
     slidingHead_[j] = static_cast<int>(k);
@@ -331,7 +483,9 @@ bool BlockPivoting::factorCoupled(double rho, std::string& why) {
     kOuter_[c + 1] = nz;
   }
   useSymLu_ = true;
-  if (symLu_.factor(m, kOuter_, kInner_, kVal_, ktVal_, pivTol_)) return true;
+  if (coupled ? symLu_.factor(m, kOuter_, kInner_, kVal_, ktVal_, pivTol_)
+              : symLu_.factorSymmetric(m, kOuter_, kInner_, kVal_, pivTol_))
+    return true;
   why = "the clamped system with its sliding rows is singular";
   return false;
 }
@@ -471,8 +625,11 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
   double dMax = 0;
   for (int i = 0; i < n; ++i) dMax = std::max(dMax, std::abs(pb.diagonal(i)));
   pivTol_ = opt.pivotTolerance * (dMax > 0 ? dMax : 1.0);
+  pivTolRelative_ = opt.pivotTolerance;
   eps_ = 0.01 * opt.tolerance * (1 + pb.b.lpNorm<Eigen::Infinity>());
   pos_.assign(n, -1);
+  haveBase_ = false;  // A's values are new
+  factorizations_ = 0;
   const bool cold = x.isZero(0.0);
   Vector w = *a_ * x + pb.b, xOld(n), wOld(n), wNew(n);
   guess(pb, x, w, cold);
@@ -597,6 +754,7 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
     merit = trial;
   }
   rep.message = os.str();
+  rep.factorizations = factorizations_;
   return rep;
 }
 

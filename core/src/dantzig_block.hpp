@@ -2,7 +2,6 @@
 // mlcp/dantzig.hpp for the method). Internal to the library.
 #pragma once
 
-#include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
 #include <string>
 #include <vector>
@@ -17,6 +16,7 @@ namespace mlcp::detail {
 // is symmetric, in the given order: up-looking, row k of L and column k of U from two sparse
 // triangular solves over the elimination tree (built as it goes), so L and U^T share one
 // pattern, that of the Cholesky factor of the pattern. Twice an LDL^T's work, no symbolic phase.
+// factorSymmetric is the same for a symmetric K (U = L^T, one triangular solve per row).
 class SymmetricPatternLu {
  public:
   // K (m x m) in compressed columns, rows in any order within a column; kt holds the values of
@@ -24,22 +24,34 @@ class SymmetricPatternLu {
   // is at most pivotTolerance (or not finite).
   bool factor(int m, const std::vector<int>& outer, const std::vector<int>& inner,
               const std::vector<double>& k, const std::vector<double>& kt, double pivotTolerance);
+  bool factorSymmetric(int m, const std::vector<int>& outer, const std::vector<int>& inner,
+                       const std::vector<double>& k, double pivotTolerance);
   void solve(Vector& y) const;  // y <- K^-1 y
+  // y <- L^-1 y for a y that is zero outside idx; idx becomes the rows where the result may be
+  // nonzero (idx's reach in the elimination tree: L(r, i) != 0 only for ancestors r of i), in
+  // increasing order. Costs the entries of L in those columns, not m.
+  void forward(std::vector<int>& idx, Vector& y);
+  double pivot(int c) const { return d_[c]; }  // D's entry c
 
  private:
+  bool run(int m, const std::vector<int>& outer, const std::vector<int>& inner,
+           const std::vector<double>& k, const std::vector<double>* kt, double pivotTolerance);
   // Column c of L (and row c of U) at [start_[c], start_[c + 1]): rows_, l_ = L(row, c),
-  // u_ = U(c, row), sized by a symbolic pass over the elimination tree.
+  // u_ = U(c, row) (unused when symmetric_), sized by a symbolic pass over the elimination tree.
   std::vector<int> start_, fill_, rows_;
   std::vector<double> l_, u_, d_, y_, z_;
   std::vector<int> parent_, tag_, stack_;
+  std::vector<char> reached_;
+  bool symmetric_ = false;
 };
 
 class BlockPivoting {
  public:
   struct Report {
     bool settled = false;    // x solves the problem to Options::tolerance (checked by residual())
-    int steps = 0;           // factorizations (block or single-switch steps)
+    int steps = 0;           // block steps (each one linear solve of the index sets' equations)
     bool symmetric = false;  // A passed the symmetry check (else the stage did not run)
+    int factorizations = 0;  // of the steps, those that factored their clamped block afresh
     std::string message;
   };
 
@@ -52,16 +64,23 @@ class BlockPivoting {
 
   int orderings() const { return aPattern_.analyses(); }
 
+  // Most sliding rows handled by Woodbury on the symmetric factor (more: the LU), and most
+  // unknowns by which a step's sets may differ from the last factored ones (joined, left and
+  // sliding rows) for the step to reuse that factor. DantzigParams documents them.
+  struct Limits {
+    int woodburyRows = 16;
+    int updateRows = 40;
+  };
+  void setLimits(const Limits& limits) { limits_ = limits; }
+
  private:
   enum class Set : unsigned char { Clamped, AtLo, AtHi, Fixed };
   using ColMajor = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
-  using Ldlt = Eigen::SimplicialLDLT<ColMajor, Eigen::Upper, Eigen::NaturalOrdering<int>>;
 
   void guess(const Problem& pb, const Vector& x0, const Vector& w0, bool cold);
   bool solveClamped(const Problem& pb, Vector& x, const Vector& prev, double rho, std::string& why);
-  bool factorClamped(double rho, std::string& why);
-  bool factorCoupled(double rho, std::string& why);
-  void applySolve(Vector& y) const;
+  bool factorCoupled(double rho, bool coupled, std::string& why);
+  void applySolve(Vector& y);
   int setsAt(const Problem& pb, const Vector& x, const Vector& w);
   double meritAt(const Problem& pb, const Vector& x, const Vector& w) const;
   double frictionBound(const Problem& pb, int t, Set s, const Vector& x) const;
@@ -71,7 +90,7 @@ class BlockPivoting {
 
   SparseMatrix A_;  // row-major copy when the problem is stored dense
   const SparseMatrix* a_ = nullptr;
-  PatternCache aPattern_, kPattern_;
+  PatternCache aPattern_;
   // Per entry of A's pattern the index of its mirror entry (j, i), computed with the ordering;
   // empty when the pattern is not symmetric or a row is not sorted (then isSymmetric decides).
   std::vector<int> mirror_;
@@ -80,9 +99,7 @@ class BlockPivoting {
   std::vector<Set> set_;
   std::vector<int> pos_, order_, sliding_;  // pos_: row -> unknown index in K, or -1
   std::vector<double> coeff_;               // sliding row t: x_t = coeff_ * x_normal
-  ColMajor K_;  // upper triangle of the clamped block in the order of byRank_
-  Ldlt ldlt_;
-  bool useLu_ = false;  // sliding rows present: K is nonsymmetric and factored by lu_
+  bool useLu_ = false;  // more than Limits::woodburyRows sliding rows: K is factored as it is
   std::vector<Eigen::Triplet<double>> triplets_;
   // K with its sliding rows substituted: A_CC's pattern (compressed columns) with the values of
   // K and of K^T, factored by symLu_; when a sliding row touches an entry outside that pattern,
@@ -94,6 +111,21 @@ class BlockPivoting {
   ColMajor Kfull_;
   Eigen::SparseLU<ColMajor, Eigen::NaturalOrdering<int>> lu_;
   bool factorGeneral(double rho, std::string& why);
+  bool buildCapacitance(const Problem& pb, double rho, int maxExtra);
+  // Block steps reuse the factor of the last factored clamped set C0 (the base) while the sets
+  // differ from it by at most Limits::updateRows unknowns (joined, left, sliding rows) and rho is
+  // the same: a bordered system with a small dense Schur complement (buildCapacitance). Sliding
+  // rows on the symmetric B = A_CC + rho I (K = B + U E^T, Woodbury) are bordered the same way.
+  Limits limits_;
+  int factorizations_ = 0;
+  bool haveBase_ = false;
+  double baseRho_ = 0;
+  std::vector<int> basePos_, baseOrder_, extraRow_, extraOf_, reach_;
+  std::vector<int> gStart_, gIdx_, hStart_, hIdx_;
+  std::vector<double> gVal_, hVal_;
+  Vector work_;
+  Eigen::FullPivLU<DenseMatrix> capacitance_;
+  double pivTolRelative_ = 0;
   double eps_ = 0, pivTol_ = 0;
 };
 

@@ -497,6 +497,31 @@ DantzigSolver withStage(DantzigParams::BlockStage stage) {
   return s;
 }
 
+// Steps the pyramid `steps` times (1e-4 s each) and solves every step with both solvers, each
+// warm started from its own last answer (both from x0 first); `check` gets the problem, the
+// step number and both answers, after both solves were checked to converge with a residual
+// within 1e-10.
+template <class Check>
+void solveSequence(test::BoxPyramid& pyramid, DantzigSolver& a, DantzigSolver& b, const Vector& x0,
+                   int steps, Check check) {
+  Vector xa = x0, xb = x0;
+  for (int step = 0; step < steps; ++step) {
+    pyramid.nextStep(1e-4);
+    const Problem p = pyramid.rows().assemble(true);
+    Vector ya, yb;
+    const Result ra = a.solveWithGuess(p, xa, ya);
+    const Result rb = b.solveWithGuess(p, xb, yb);
+    ASSERT_TRUE(ra.converged()) << ra.message;
+    ASSERT_TRUE(rb.converged()) << rb.message;
+    EXPECT_LE(accuracy(p, ya).residual, 1e-10);
+    EXPECT_LE((ya - yb).lpNorm<Eigen::Infinity>(), 1e-9 * (1 + yb.lpNorm<Eigen::Infinity>()))
+        << "step " << step;
+    check(p, ya);
+    xa = ya;
+    xb = yb;
+  }
+}
+
 // A time-step sequence on the 15-box pyramid: the block stage (warm) gives the dense path's
 // answer, within the findex bounds, and settles in a few factorizations.
 TEST(DantzigBlock, PyramidSequenceMatchesTheDensePath) {
@@ -506,28 +531,14 @@ TEST(DantzigBlock, PyramidSequenceMatchesTheDensePath) {
   DantzigSolver block = withStage(DantzigParams::BlockStage::Always);
   DantzigSolver dense = withStage(DantzigParams::BlockStage::Never);
   dense.options().tolerance = 1e-13;
-  Vector xb, xd;
-  ASSERT_TRUE(dense.solve(pyramid.rows().assemble(true), xd).converged());
-  xb = xd;
+  Vector x;
+  ASSERT_TRUE(dense.solve(pyramid.rows().assemble(true), x).converged());
   int settled = 0;
-  for (int step = 0; step < 5; ++step) {
-    pyramid.nextStep(1e-4);
-    const Problem p = pyramid.rows().assemble(true);
-    Vector yb, yd;
-    const Result rb = block.solveWithGuess(p, xb, yb);
-    const Result rd = dense.solveWithGuess(p, xd, yd);
-    ASSERT_TRUE(rb.converged()) << rb.message;
-    ASSERT_TRUE(rd.converged()) << rd.message;
-    const Accuracy a = accuracy(p, yb);
-    EXPECT_LE(a.residual, 1e-10);
-    EXPECT_LE(a.boundViolation, 1e-12);
-    EXPECT_LE((yb - yd).lpNorm<Eigen::Infinity>(), 1e-9 * (1 + yd.lpNorm<Eigen::Infinity>()))
-        << "step " << step;
+  solveSequence(pyramid, block, dense, x, 5, [&](const Problem& p, const Vector& y) {
+    EXPECT_LE(accuracy(p, y).boundViolation, 1e-12);
     settled += block.blockSettled();
     EXPECT_GT(block.blockSteps(), 0);
-    xb = yb;
-    xd = yd;
-  }
+  });
   EXPECT_GE(settled, 4) << "the block stage should settle close warm starts by itself";
 }
 
@@ -692,6 +703,33 @@ TEST(DantzigBlock, SlidingPyramidWarmStart) {
   EXPECT_GT(sliding, 0) << "the scene was meant to slide";
 }
 
+// Reusing a factor across block steps (bordered systems) and Woodbury for sliding rows give the
+// answers of factoring every step afresh with the LU, on a sliding pyramid where the sets change
+// between steps; the reuse happens (fewer factorizations than steps).
+TEST(DantzigBlock, BorderedUpdatesMatchFreshFactorizations) {
+  test::PyramidSpec spec;
+  spec.levels = 5;
+  spec.sideVelocity = 0.5;
+  test::BoxPyramid pyramid(spec);
+  DantzigSolver updated = withStage(DantzigParams::BlockStage::Always);
+  updated.params().blockWoodburyRows = 200;  // the scene slides: every friction row by Woodbury
+  updated.params().blockUpdateRows = 200;
+  DantzigSolver fresh = withStage(DantzigParams::BlockStage::Always);
+  fresh.params().blockUpdateRows = 0;
+  fresh.params().blockWoodburyRows = 0;
+  Vector x;
+  ASSERT_TRUE(withStage(DantzigParams::BlockStage::Never)
+                  .solve(pyramid.rows().assemble(true), x)
+                  .converged());
+  int steps = 0, factorizations = 0;
+  solveSequence(pyramid, updated, fresh, x, 6, [&](const Problem&, const Vector&) {
+    EXPECT_EQ(fresh.blockFactorizations(), fresh.blockSteps());
+    steps += updated.blockSteps();
+    factorizations += updated.blockFactorizations();
+  });
+  EXPECT_LT(factorizations, steps) << "no block step reused a factor";
+}
+
 // A random guess is a bad warm start: the answer is right or the status says it is not.
 TEST(DantzigBlock, RandomWarmStartConvergesOrFailsHonestly) {
   test::PyramidSpec spec;
@@ -775,6 +813,46 @@ TEST(DantzigBlock, SymmetricPatternLuSolves) {
     lu.solve(x);
     const Vector expected = K.partialPivLu().solve(b);
     EXPECT_LE((x - expected).lpNorm<Eigen::Infinity>(), 1e-12 * (1 + expected.norm())) << m;
+  }
+  // Symmetric K: factorSymmetric solves, and the sparse forward solve gives
+  // y^T K^-1 z = (L^-1 y)^T D^-1 (L^-1 z) for sparse y, z (what the block stage's bordered
+  // systems are built from).
+  for (int m : {1, 7, 60}) {
+    DenseMatrix K = DenseMatrix::Zero(m, m);
+    for (int i = 0; i < m; ++i) {
+      K(i, i) = 6 + u(rng);
+      for (int j = 0; j < i; ++j)
+        if (rng() % 6 == 0) K(i, j) = K(j, i) = u(rng);
+    }
+    std::vector<int> outer(m + 1, 0), inner;
+    std::vector<double> k;
+    for (int c = 0; c < m; ++c) {
+      for (int r = 0; r < m; ++r)
+        if (K(r, c) != 0) {
+          inner.push_back(r);
+          k.push_back(K(r, c));
+        }
+      outer[c + 1] = static_cast<int>(inner.size());
+    }
+    detail::SymmetricPatternLu ldl;
+    ASSERT_TRUE(ldl.factorSymmetric(m, outer, inner, k, 1e-12));
+    const DenseMatrix inverse = K.inverse();
+    Vector b = Vector::NullaryExpr(m, [&](Eigen::Index) { return u(rng); });
+    Vector x = b;
+    ldl.solve(x);
+    EXPECT_LE((x - inverse * b).lpNorm<Eigen::Infinity>(), 1e-12 * (1 + x.norm())) << m;
+    Vector y = Vector::Zero(m), z = Vector::Zero(m);
+    std::vector<int> yIdx = {m - 1 - m / 3}, zIdx = {m / 2, 0};
+    y[yIdx[0]] = 1;
+    z[zIdx[0]] = 2;
+    z[zIdx[1]] = -1;
+    const double expected = y.dot(inverse * z);
+    ldl.forward(yIdx, y);
+    ldl.forward(zIdx, z);
+    EXPECT_TRUE(std::is_sorted(yIdx.begin(), yIdx.end()));
+    double product = 0;
+    for (int i : yIdx) product += y[i] * z[i] / ldl.pivot(i);
+    EXPECT_NEAR(product, expected, 1e-12 * (1 + std::abs(expected))) << m;
   }
   // [[1, 1], [1, 1]]: the second pivot is 0.
   detail::SymmetricPatternLu lu;

@@ -198,6 +198,14 @@ struct DantzigParams {
   // there than the damped steps (Bullet's 15-box pyramid, n = 280: ~4 ms against ~9 ms).
   // Default 500.
   int autoWarmMinRows = 500;
+  // Block steps with at most this many sliding rows solve them by Woodbury on the symmetric
+  // factor of A_CC (k sparse forward solves and a k x k dense LU); more: the nonsymmetric LU.
+  // Default 16.
+  int blockWoodburyRows = 16;
+  // A block step whose sets differ from the last factored ones by at most this many rows
+  // (joined + left the clamped set + sliding) reuses that factor through a bordered system;
+  // 0 factors every step afresh. Default 40.
+  int blockUpdateRows = 40;
 };
 
 class DantzigSolver : public Solver {
@@ -218,6 +226,8 @@ class DantzigSolver : public Solver {
   // Factorizations of the block stage in the last solve (0 when it did not run), and whether
   // it produced the answer (else incremental pivoting finished from its best index sets).
   int blockSteps() const { return blockSteps_; }
+  // Of those, the steps that factored their clamped block afresh (the others reused a factor).
+  int blockFactorizations() const { return blockFactorizations_; }
   bool blockSettled() const { return blockSettled_; }
 
  protected:
@@ -232,6 +242,7 @@ class DantzigSolver : public Solver {
   std::unique_ptr<detail::BlockPivoting> block_;
   DantzigParams params_;
   int blockSteps_ = 0;
+  int blockFactorizations_ = 0;
   bool blockSettled_ = false;
   int coldMissed_ = 0;      // solves since the last cold trial, which did not settle (0: it did)
   int coldMissedRows_ = 0;  // that trial's problem size: another size tries again
