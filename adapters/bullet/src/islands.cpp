@@ -42,6 +42,8 @@ bool sameUpdate(const btSolverBody& b) {
 
 // How many rows ahead the passes over Bullet's rows fetch what they read or write next.
 constexpr int kAhead = 6;
+// How many rows ahead the packing pass fetches Bullet's rows (~50 ns a row: 0.5 us ahead).
+constexpr int kRowsAhead = 10;
 
 constexpr unsigned char kUnitLinear = 1, kUnitAngular = 2;
 bool allOnes(const btVector3& v) { return v[0] == 1 && v[1] == 1 && v[2] == 1; }
@@ -332,10 +334,12 @@ inline RowPgs::RowView IslandBuilder::view(Island& isl, int r, bool split, doubl
 }
 
 inline RowPgs::RowView IslandBuilder::Source::row(int r) {
-  // The first read of Bullet's row r + kAhead's first four lines (build() read the fifth).
-  if (r + kAhead < static_cast<int>(island_.rows.size())) {
-    const char* ahead = reinterpret_cast<const char*>(island_.rows[r + kAhead]);
-    for (int line = 0; line < 4; ++line) __builtin_prefetch(ahead + 64 * line);
+  // Bullet's row r + kRowsAhead fetched: its 288 bytes start 16-byte aligned, so they span
+  // five lines when they do not start a line (the fields past byte 224, m_rhsPenetration among
+  // them, sit in the fifth).
+  if (r + kRowsAhead < static_cast<int>(island_.rows.size())) {
+    const char* ahead = reinterpret_cast<const char*>(island_.rows[r + kRowsAhead]);
+    for (int line = 0; line < 5; ++line) __builtin_prefetch(ahead + 64 * line);
   }
   return builder_.view(island_, r, split_, scratch_);
 }
