@@ -108,9 +108,20 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
       lastB = b;
     }
   };
-  for (int i = 0; i < nj; ++i) add(i, (*in.joints)[i], -1);
-  for (int i = 0; i < nc; ++i) add(nj + i, (*in.contacts)[i], -1);
+  // The first touch of each row's last line (its body indices): fetched ahead.
+  auto ahead = [](btConstraintArray& pool, int i) {
+    if (i + kRowsAhead < pool.size()) __builtin_prefetch(&pool[i + kRowsAhead].m_solverBodyIdA);
+  };
+  for (int i = 0; i < nj; ++i) {
+    ahead(*in.joints, i);
+    add(i, (*in.joints)[i], -1);
+  }
+  for (int i = 0; i < nc; ++i) {
+    ahead(*in.contacts, i);
+    add(nj + i, (*in.contacts)[i], -1);
+  }
   for (int i = 0; i < nf; ++i) {
+    ahead(*in.friction, i);
     btSolverConstraint& c = (*in.friction)[i];
     add(nj + nc + i, c, nj + c.m_frictionIndex);
   }
@@ -150,6 +161,9 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
   // index (no growth checks per row).
   rowsIn_.clear();
   int lastPairA = -2, lastPairB = -2, lastIsland = -1;
+  // The current island's row count kept here (written back when the island changes): counting
+  // in rowsIn_ chained every row through a store and a load.
+  int counted = 0;
   for (int i = 0; i < n; ++i) {
     const auto [a, b] = rowBodies_[i];
     if (a < 0 && b < 0) {
@@ -172,6 +186,10 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
         isl.perRowWriteBack = false;
       }
       k = islandOfRoot_[root];
+      if (k != lastIsland) {
+        if (lastIsland >= 0) rowsIn_[lastIsland] = counted;
+        counted = rowsIn_[k];
+      }
       localBody(islands_[k], a);
       localBody(islands_[k], b);
       lastPairA = a;
@@ -179,8 +197,9 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
       lastIsland = k;
     }
     rowIsland_[i] = k;
-    rowLocal_[i] = rowsIn_[k]++;
+    rowLocal_[i] = counted++;
   }
+  if (lastIsland >= 0) rowsIn_[lastIsland] = counted;
   for (int k = 0; k < count_; ++k) {
     Island& isl = islands_[k];
     const std::size_t m = static_cast<std::size_t>(rowsIn_[k]);
