@@ -38,24 +38,35 @@ bool SymmetricPatternLu::run(int m, const std::vector<int>& outer, const std::ve
                              const std::vector<double>& k, const std::vector<double>* kt,
                              double pivotTolerance) {
   symmetric_ = kt == nullptr;
-  // Symbolic: the elimination tree and the column counts of L (as SimplicialLDLT's analysis).
-  parent_.assign(m, -1);
-  tag_.assign(m, -1);
-  fill_.assign(m, 0);
-  for (int col = 0; col < m; ++col) {
-    tag_[col] = col;
-    for (int e = outer[col]; e < outer[col + 1]; ++e)
-      for (int i = inner[e]; i < col && tag_[i] != col; i = parent_[i]) {
-        if (parent_[i] < 0) parent_[i] = col;
-        ++fill_[i];
-        tag_[i] = col;
-      }
+  // Symbolic: the elimination tree and the column counts of L (as SimplicialLDLT's analysis),
+  // skipped for the pattern of the last call (a resting scene's clamped set repeats).
+  const int nz = outer[m];
+  const bool same = static_cast<int>(analyzedOuter_.size()) == m + 1 &&
+                    std::equal(outer.begin(), outer.begin() + m + 1, analyzedOuter_.begin()) &&
+                    static_cast<int>(analyzedInner_.size()) == nz &&
+                    std::equal(inner.begin(), inner.begin() + nz, analyzedInner_.begin());
+  if (!same) {
+    parent_.assign(m, -1);
+    tag_.assign(m, -1);
+    fill_.assign(m, 0);
+    for (int col = 0; col < m; ++col) {
+      tag_[col] = col;
+      for (int e = outer[col]; e < outer[col + 1]; ++e)
+        for (int i = inner[e]; i < col && tag_[i] != col; i = parent_[i]) {
+          if (parent_[i] < 0) parent_[i] = col;
+          ++fill_[i];
+          tag_[i] = col;
+        }
+    }
+    start_.assign(m + 1, 0);
+    for (int c = 0; c < m; ++c) start_[c + 1] = start_[c] + fill_[c];
+    analyzedOuter_.assign(outer.begin(), outer.begin() + m + 1);
+    analyzedInner_.assign(inner.begin(), inner.begin() + nz);
   }
-  start_.assign(m + 1, 0);
-  for (int c = 0; c < m; ++c) start_[c + 1] = start_[c] + fill_[c];
   rows_.resize(start_[m]);
   l_.resize(start_[m]);
   if (!symmetric_) u_.resize(start_[m]);
+  fill_.resize(m);
   std::copy(start_.begin(), start_.end() - 1, fill_.begin());
   d_.assign(m, 0.0);
   y_.assign(m, 0.0);

@@ -41,6 +41,7 @@ class SymmetricPatternLu {
   std::vector<int> start_, fill_, rows_;
   std::vector<double> l_, u_, d_, y_, z_;
   std::vector<int> parent_, tag_, stack_;
+  std::vector<int> analyzedOuter_, analyzedInner_;  // the pattern parent_ and start_ are for
   std::vector<char> reached_;
   bool symmetric_ = false;
 };

@@ -87,17 +87,25 @@
 // fixed, as the natural map at the current x says; a friction row at a bound is the linear
 // equation x_t = mu_t s_j x_j coupling it to its normal j (s_j the normal's sign), so findex is
 // exact without fixed-point passes, and friction rows whose normal is held at 0 are fixed at 0.
-// One step solves those equations. Without sliding rows A_CC is factored by a sparse LDL^T
-// (SimplicialLDLT in a fill-reducing AMD order of the whole A, computed once per pattern of A and
-// inherited by every clamped block); sliding rows (at a bound, normal clamped) are substituted,
-// which makes the matrix K nonsymmetric but keeps A_CC's pattern (a contact's friction and normal
-// rows touch the same bodies), so K = L D U is factored without pivoting by an up-looking sparse
-// LU whose L and U^T share the Cholesky pattern (twice an LDL^T's work, no symbolic phase; a K
-// outside A_CC's pattern falls back to Eigen's SparseLU, which cost 3-4x more per step on the
-// Bullet pyramids). One step of iterative refinement follows. First the steps are full (block
-// principal pivoting; the next sets change only rows violated beyond 0.01 tolerance (1 + |b|), so
-// that degenerate rows do not flip on rounding). When 3 full steps in a row bring no new lowest
-// merit
+// One step solves those equations. A_CC + rho I is factored by an up-looking sparse LDL^T
+// (core/src/dantzig_block.hpp: SymmetricPatternLu::factorSymmetric) in a fill-reducing AMD order
+// of the whole A, computed once per pattern of A and inherited by every clamped block. Sliding
+// rows (at a bound, normal clamped) are substituted, which makes the matrix K = B + U E^T
+// nonsymmetric (B = A_CC + rho I; U's column c_t A_{C,t} per sliding row t, E's the unit vector of
+// t's normal); up to DantzigParams::blockWoodburyRows of them are bordered onto B's factor
+// (Woodbury: a k x k capacitance S = I + E^T B^-1 U from sparse forward solves, whose reach in
+// the elimination tree is short; two solves with B per solve with K), more are factored as K = L
+// D U without pivoting by the up-looking LU whose L and U^T share the Cholesky pattern (K keeps
+// A_CC's pattern: a contact's friction and normal rows touch the same bodies; twice an LDL^T's
+// work; a K outside that pattern falls back to Eigen's SparseLU, 3-4x more per step on the Bullet
+// pyramids). A later step whose sets differ from the last factored ones by at most
+// DantzigParams::blockUpdateRows rows (joined, left the clamped set, sliding), with the same rho,
+// reuses that factor: the joined rows are bordered on, a left row's x is held at 0 by a
+// multiplier that frees its equation, and the p x p Schur complement of the border is factored
+// densely (p sparse forward solves each side). One step of iterative refinement follows. First the
+// steps are full (block principal pivoting; the next sets change only rows violated beyond 0.01
+// tolerance (1 + |b|), so that degenerate rows do not flip on rounding). When 3 full steps in a row
+// bring no new lowest merit
 // ||H||^2 (or a block is singular), the stage goes back to the best point and continues damped:
 // sets from the natural map at x, a proximal term rho (x_C - x_C,prev) on the clamped rows
 // (rho = 1e-2 max|A_ii| min(1, ||H||): coplanar contacts make clamped blocks nearly singular, and
