@@ -86,14 +86,16 @@ class RowSystem {
 // validation: each row is checked by the one-pass rule of RowSystem::validate as it is packed
 // (the bodies and array sizes before), and only a row that fails calls validate() itself to
 // say what is wrong; the caller's x is untouched until every row has passed. Engines that hold
-// their rows in their own form pack them straight from there (solve with a RowFill: no
-// RowSystem copy in between; same packing, same validation). The check is the natural-map
-// residual of residual.hpp at the current x, with w = J v + cfm x + b taken from the body
-// velocities the sweeps maintain: v changes by M^-1 J_i^T dx_i with every change dx_i of x, so
-// v = M^-1 J^T x up to round-off and w = A x + b is exact up to round-off as well. It reads the
-// packed rows only: step_i w_i = (1 - keep) x_i + shift + sA v (the sweep's own terms, scaled
-// back by 1 / step). The check thus costs about a tenth of a sweep instead of a second pass over
-// the rows to rebuild v (tests compare it with accuracy() on the assembled problem).
+// their rows in their own form pack them straight from there (solve with a RowFill, a
+// RowSource or solveFrom: no RowSystem copy in between; same packing, same validation). The check
+// is the natural-map residual of residual.hpp at the current x, with w = J v + cfm x + b taken from
+// the body velocities the sweeps maintain: v changes by M^-1 J_i^T dx_i with every change dx_i of
+// x, so v = M^-1 J^T x up to round-off and w = A x + b is exact up to round-off as well. It reads
+// the packed rows only: step_i w_i = (1 - keep) x_i + shift + sA v (the sweep's own terms, scaled
+// back by 1 / step). The check thus needs no second pass over the rows to rebuild v (tests
+// compare it with accuracy() on the assembled problem); measured in session 5 (Bullet drop-in,
+// 210 boxes) it still costs about a sweep, ~50 us against ~43 us: by perf shares ~40% w from the
+// packed rows, ~60% accuracy() itself.
 // The sweep is bound by the latency chain through the velocities of bodies shared by
 // consecutive rows (load v, dot, clamp, update v, store), not by memory. Four things keep the
 // chain short: ground rows take 8 zero-velocity world slots in turn (one shared slot chained
@@ -114,6 +116,16 @@ class RowSystem {
 // temporary read back from the stack; now computed in scalars). Round 2 of session 4: packing
 // ~23% (~0.2 ms, ~45 ns a row; the largest single cost is waiting for step = omega / A_ii, the
 // rest is spread thin), the couplings' step J_i computed once per row.
+// Session 5 (timers around the stages, 210 boxes, 10 sweeps, per step): packing ~250 us (~53 ns
+// a row, now with the reading of Bullet's rows: the engine's rows are read in place through a
+// RowSource, or inlined through solveFrom; its angular M^-1 J^T taken from the engine), sweeps
+// ~430 us (~9 ns a row a sweep), the check ~50 us (~11 ns a row: a second pass over the packed
+// rows for w, then accuracy()). In packing (perf with line numbers): the first reads of the
+// engine's rows ~11%, the wait for the division ~11%, the couplings ~7% (two at a time in the
+// lanes of one vector; doubling them cost ~40 us), the rest spread thin. Tried without gain:
+// A_ii and the divisions of 8 rows first, then the rest (staging the rows through a stack array
+// cost +25%); the couplings' dots before the division and scaled after; the division moved
+// ahead of the findex checks and the run bookkeeping.
 class RowPgs {
  public:
   Options& options() { return options_; }

@@ -59,7 +59,7 @@
 // Cost against SI, "pgs" at SI's sweep count (bulletIterations, bullet_bench --pgs-vs-si; CPU
 // time per step, median of 300 steps, 10 sweeps, two runs): Bullet's row setup and finish are
 // the same code in both. "pgs" islands take a path of their own (solveIslandFast): RowPgs packs
-// straight from Bullet's rows (IslandBuilder::fill; no RowSystem copy), the answer goes to the
+// in place from Bullet's rows (IslandBuilder::solvePgs; no RowSystem copy), the answer goes to the
 // bodies per body (RowPgs::velocityChange: M^-1 J^T (x - applied), what the per-row
 // internalApplyImpulse calls sum to) and the applied impulses are stored in remember()'s pass.
 // The two are the same only where our mass model is Bullet's body update. Bullet's solver body
@@ -88,6 +88,18 @@
 // still cost ~2x the gap to SI (~0.2 ms); the hot spots left are the first touches of Bullet's
 // rows and points (1.4 MB of rows; with 1.1 MB of packed rows more than a 2 MB L2 holds) and
 // the packing's division, the rest spread thin.
+// Session 5 (rows read in place by the packing, inlined: no Row batch copy; M^-1 J^T's angular
+// part read from Bullet's m_angularComponentA/B (islands.hpp); manifold points and remembered
+// answers only for the cached-impulse start; couplings two at a time; rows fetched further
+// ahead): 10 sweeps 1.08-1.12x / 1.11-1.13x / 1.08-1.09x SI at 15 / 55 / 210 boxes (the same
+// two runs with round 2's code: 1.30-1.31x / 1.22x / 1.17-1.20x on a busier machine), 20 sweeps
+// 0.88-0.90x / 0.92x / 0.90x, 50 sweeps 0.74-0.75x / 0.76x / 0.73-0.74x; residuals unchanged
+// (the same iterates). Stage timers at 210 boxes, per step: island split and numbering ~60 us,
+// packing (with the reading of Bullet's rows) ~250 us, sweeps ~430 us, check ~50 us, storing
+// impulses ~23 us: ~0.80 ms against SI's iterations ~0.66 ms. 1.0x at 10 sweeps is not reached:
+// the packing alone costs more than the gap (rows.hpp lists what it spends and what was tried).
+// The cached-impulse start (the default, not what --pgs-vs-si times) still reads the manifold
+// points in build() and keeps answers in remember().
 //
 // "si" runs Bullet's own SI iterations instead (for side-by-side runs with the same statistics).
 #pragma once
