@@ -146,7 +146,7 @@
 // per manifold point, residual 2e-5..1e-4): the cold trial never settled there (residual 0.14
 // after its factorization of all 1160 rows, 6-12 ms, more than the rest of the solve), hence no
 // trial for a guess within 1e-2 (ODE's stepper guesses have residuals 1.6-13 and keep it). From
-// the guess the stage takes 2 full steps (~2.5 ms each, one with a sliding row in the LU): 2-4
+// the guess the stage takes 2 full steps (the second reuses the first's factor): 2-4
 // rows of the guessed sets are wrong (a normal at 0 whose w0 is slightly negative, ~1e-5, is
 // guessed clamped and its friction row sliding; the answer holds it at 0), so the first step is
 // not the answer. Symmetry is checked on a mirror map of A's pattern (isSymmetric's transposed
@@ -159,6 +159,27 @@
 // diverge again: residual after 40 steps 1.8-5.9e-3 against 0.9-1.3e-3, 128 against 83 ms), and
 // other step budgets before the hand-over (CPU ms per step: 20 steps 123-137, 40 steps 85-88, 70
 // steps 92-98: the damped steps' linear rate does not beat the pivoting's finish).
+// Steady state of a demo that uses this solver from the start (bullet_bench --warmup 0 --settle
+// N --steps 10, 55 boxes, n = 1160, m ~ 800 clamped rows, L ~ 43k entries): each simulation step
+// ~13 normals change set (coplanar face contacts whose share of the load goes to 0 and back) with
+// their friction rows; from the guess the stage takes 4-15 steps: full steps, each later one
+// reusing the first's factor (p = 15-40 bordered rows: ~1.5 ms against ~2.5 ms for a fresh LDL^T
+// with its assembly), and when they stop improving damped steps whose rho changes every step (a
+// fresh factorization each; on some steps a 2-cycle between two sets at rho ~1e-10..1e-7 until
+// the 40-step budget). The counts are chaotic in N (rounding changes the trajectory): CPU ms per
+// step, this method against the previous (LU for sliding rows, no reuse), two runs each,
+// alternated: N = 80: 12.7-13.1 (5 steps) against 26-28 (8); N = 150: 19-20 (6) against 15-19 (4);
+// N = 300: 26-36 (9) against 66-74 (15); stock MLCP-Dantzig 285-420 ms per step on this loaded
+// machine, so 8-25x: the 20x goal is met at N = 80 only. Same trajectory, same steps: at rest after
+// SI (--warmup 30 --settle 60, 2 steps) 3.9-4.2 against 5.6-5.8 ms; after the switch (--warmup 30,
+// 263 pivots and steps per step) 76.6-76.8 against 76.1-76.4 ms (damped steps: no reuse). ODE
+// piles (ode_bench 10 5): 11.9x at 588 rows, 72-94x at 1728 (before 11x / 80x).
+// Tried without gain: CHOLMOD's supernodal LL^T (Debian's reference BLAS: 1.9 ms factor + 0.3 ms
+// analysis per new pattern at m = 812, against ~1.8 ms for the up-looking LDL^T; OpenBLAS 1.3 ms,
+// not a dependency worth adding), reusing a factor across a changed rho within 1e-3 or 0.1 of the
+// smallest pivot (never applicable: the pivots are cfm-sized), rho rounded up to powers of 2, 4
+// or 10 so that damped steps share it (step counts chaotic, no consistent gain), and a set change
+// threshold of 0.3 tolerance instead of 0.01 (N = 300: 17 steps against 9).
 //
 // Result::iterations counts pivots (direction computations: each row added or exchanged)
 // summed over all passes; Options::maxPivots (0: 50 n + 100) limits them per pass
