@@ -304,7 +304,11 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
     // The input is valid: a non-positive A_ii is a failure, not invalid input.
     if (!warm) x.setZero(n);
     std::ostringstream os;
-    os << "row " << bad_ << " has A_ii = " << badDiagonal_ << ": pgs needs a positive diagonal";
+    if (std::isfinite(badDiagonal_))
+      os << "row " << bad_ << " has A_ii = " << badDiagonal_ << ": pgs needs a positive diagonal";
+    else  // finite entries whose products leave the double range
+      os << "row " << bad_ << ": A_ii = J M^-1 J^T + cfm overflows (" << badDiagonal_
+         << ") although its entries are finite: pgs needs a positive finite diagonal";
     result.status = Status::Failed;
     result.message = os.str();
     // velocity_ does not hold M^-1 J^T x: the check uses the rows themselves.

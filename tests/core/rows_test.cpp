@@ -403,5 +403,22 @@ TEST(RowPgs, ZeroRowIsAFailureNotAConvergence) {
   EXPECT_NE(r.message.find("positive diagonal"), std::string::npos);
 }
 
+// Finite entries whose products overflow: the message says so instead of printing "A_ii = inf"
+// as if the row were merely non-positive.
+TEST(RowPgs, OverflowingDiagonalIsNamed) {
+  RowSystem s = stackRows(1, 5);
+  s.rows[2].jA.setConstant(1e200);
+  ASSERT_EQ(s.validate(), "");
+  for (bool engine : {false, true}) {
+    RowPgs pgs;
+    Vector x;
+    const Vector zero = Vector::Zero(s.size());
+    const Result r = engine ? solveFromRows(pgs, s, zero, zero, x) : pgs.solve(s, x);
+    EXPECT_EQ(r.status, Status::Failed) << engine;
+    EXPECT_NE(r.message.find("row 2: A_ii = J M^-1 J^T + cfm overflows"), std::string::npos)
+        << r.message;
+  }
+}
+
 }  // namespace
 }  // namespace mlcp

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "mlcp/rows.hpp"
 #include "mlcp/solver.hpp"
@@ -182,7 +183,7 @@ bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& row
     // A row joining a body to itself: A_ii = (jA + jB) M^-1 (jA + jB) has the cross terms too.
     if (r.bodyA == r.bodyB && r.bodyA >= 0)
       for (int k = 0; k < 6; ++k) d += jA[k] * mB[k] + jB[k] * mA[k];
-    if (!(d > 0)) return stop(i, d);
+    if (!(d > 0 && d <= std::numeric_limits<double>::max())) return stop(i, d);  // NaN, inf too
     const double step = options_.relaxation / d;
     for (int k = 0; k < 6; ++k) {
       p.sA[k] = step * jA[k];
