@@ -173,7 +173,7 @@
 // machine, so 8-25x: the 20x goal is met at N = 80 only. Same trajectory, same steps: at rest after
 // SI (--warmup 30 --settle 60, 2 steps) 3.9-4.2 against 5.6-5.8 ms; after the switch (--warmup 30,
 // 263 pivots and steps per step) 76.6-76.8 against 76.1-76.4 ms (damped steps: no reuse). ODE
-// piles (ode_bench 10 5): 11.9x at 588 rows, 72-94x at 1728 (before 11x / 80x).
+// piles (ode_bench 10 5, four runs): 11.8-11.9x at 588 rows, 72-98x at 1728 (before 11x / 80x).
 // Tried without gain: CHOLMOD's supernodal LL^T (Debian's reference BLAS: 1.9 ms factor + 0.3 ms
 // analysis per new pattern at m = 812, against ~1.8 ms for the up-looking LDL^T; OpenBLAS 1.3 ms,
 // not a dependency worth adding), reusing a factor across a changed rho within 1e-3 or 0.1 of the
