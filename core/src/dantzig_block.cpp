@@ -400,24 +400,31 @@ bool BlockPivoting::buildCapacitance(const Problem& pb, double rho, int maxExtra
       S(a, a) += 1;
     }
   }
-  // D^-1 L^-1 H column by column (applySolve uses H itself, on B^-1 r0).
+  // L^-1 H and D^-1 L^-1 H column by column (applySolve uses H itself, on B^-1 r0); a joined or
+  // left row's column of G equals its column of H, so L^-1 G is only solved for sliding rows.
   std::vector<int> hsStart(1, 0), hsIdx;
-  std::vector<double> hsVal;
+  std::vector<double> hsVal, hlVal;
   for (int a = 0; a < p; ++a) {
     reach_.assign(hIdx_.begin() + hStart_[a], hIdx_.begin() + hStart_[a + 1]);
     for (int q = hStart_[a]; q < hStart_[a + 1]; ++q) work_[hIdx_[q]] += hVal_[q];
     symLu_.forward(reach_, work_);
     for (int i : reach_) {
       hsIdx.push_back(i);
+      hlVal.push_back(work_[i]);
       hsVal.push_back(work_[i] / symLu_.pivot(i));
       work_[i] = 0;
     }
     hsStart.push_back(static_cast<int>(hsIdx.size()));
   }
   for (int b = 0; b < p; ++b) {
-    reach_.assign(gIdx_.begin() + gStart_[b], gIdx_.begin() + gStart_[b + 1]);
-    for (int q = gStart_[b]; q < gStart_[b + 1]; ++q) work_[gIdx_[q]] += gVal_[q];
-    symLu_.forward(reach_, work_);
+    if (b < left) {
+      reach_.assign(hsIdx.begin() + hsStart[b], hsIdx.begin() + hsStart[b + 1]);
+      for (int q = hsStart[b]; q < hsStart[b + 1]; ++q) work_[hsIdx[q]] = hlVal[q];
+    } else {
+      reach_.assign(gIdx_.begin() + gStart_[b], gIdx_.begin() + gStart_[b + 1]);
+      for (int q = gStart_[b]; q < gStart_[b + 1]; ++q) work_[gIdx_[q]] += gVal_[q];
+      symLu_.forward(reach_, work_);
+    }
     for (int a = 0; a < p; ++a) {
       double sum = 0;
       for (int q = hsStart[a]; q < hsStart[a + 1]; ++q) sum += hsVal[q] * work_[hsIdx[q]];
