@@ -163,17 +163,18 @@
 // N --steps 10, 55 boxes, n = 1160, m ~ 800 clamped rows, L ~ 43k entries): each simulation step
 // ~13 normals change set (coplanar face contacts whose share of the load goes to 0 and back) with
 // their friction rows; from the guess the stage takes 4-15 steps: full steps, each later one
-// reusing the first's factor (p = 15-40 bordered rows: ~1.5 ms against ~2.5 ms for a fresh LDL^T
-// with its assembly), and when they stop improving damped steps whose rho changes every step (a
-// fresh factorization each; on some steps a 2-cycle between two sets at rho ~1e-10..1e-7 until
-// the 40-step budget). The counts are chaotic in N (rounding changes the trajectory): CPU ms per
-// step, this method against the previous (LU for sliding rows, no reuse), two runs each,
-// alternated: N = 80: 12.7-13.1 (5 steps) against 26-28 (8); N = 150: 19-20 (6) against 15-19 (4);
-// N = 300: 26-36 (9) against 66-74 (15); stock MLCP-Dantzig 285-420 ms per step on this loaded
-// machine, so 8-25x: the 20x goal is met at N = 80 only. Same trajectory, same steps: at rest after
-// SI (--warmup 30 --settle 60, 2 steps) 3.9-4.2 against 5.6-5.8 ms; after the switch (--warmup 30,
-// 263 pivots and steps per step) 76.6-76.8 against 76.1-76.4 ms (damped steps: no reuse). ODE
-// piles (ode_bench 10 5, four runs): 11.8-11.9x at 588 rows, 72-98x at 1728 (before 11x / 80x).
+// reusing the first's factor (N = 80: p = 25 bordered rows on average, their Schur complement
+// ~0.6 ms, against ~2-2.5 ms for a fresh LDL^T with its assembly), and when they stop improving
+// damped steps whose rho changes every step (a fresh factorization each; on some steps a 2-cycle
+// between two sets at rho ~1e-10..1e-7 until the 40-step budget). The counts are chaotic in N
+// (rounding changes the trajectory): CPU ms per step, this method against the previous (LU for
+// sliding rows, no reuse), two runs each: N = 80: 11.1-11.2 (5 steps) against 26-28 (8); N = 150:
+// 12.3-17.7 (6) against 15-19 (4); N = 300: 22.1-22.5 (9) against 66-74 (15); stock MLCP-Dantzig
+// 285-420 ms per step on this loaded machine, so 13-26x: the 20x goal is not met at every N.
+// Same trajectory, same steps: at rest after SI (--warmup 30 --settle 60, 2 steps) 3.6-4.7
+// against 5.3-5.8 ms; after the switch (--warmup 30, 263 pivots and steps per step) 76.6-76.8
+// against 76.1-76.4 ms (damped steps: no reuse). ODE piles (ode_bench 10 5, four runs):
+// 11.8-11.9x at 588 rows, 72-98x at 1728 (before 11x / 80x).
 // Tried without gain: CHOLMOD's supernodal LL^T (Debian's reference BLAS: 1.9 ms factor + 0.3 ms
 // analysis per new pattern at m = 812, against ~1.8 ms for the up-looking LDL^T; OpenBLAS 1.3 ms,
 // not a dependency worth adding), reusing a factor across a changed rho within 1e-3 or 0.1 of the
