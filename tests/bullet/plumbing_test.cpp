@@ -245,6 +245,7 @@ TEST(BulletPlumbing, PgsPackedFromBulletsRowsMatchesThePgsOfTheRowSolver) {
 // manifold points by Bullet's finish) are equal, not just close.
 TEST(BulletPlumbing, PackedPgsImpulsesEqualTheRowSolversBitForBit) {
   for (bool siStart : {false, true}) {
+    btJointFeedback feedback[2];  // the hinge's in fast, in copied (outlive the worlds)
     sc::World fast, copied;
     Settings s;
     s.solver = "pgs";
@@ -257,6 +258,15 @@ TEST(BulletPlumbing, PackedPgsImpulsesEqualTheRowSolversBitForBit) {
       pose.setIdentity();
       pose.setOrigin(btVector3(10, 0.45, 0));
       w->addBox(btVector3(0.5, 0.5, 0.5), 1.0, pose)->setAngularFactor(btVector3(1, 0.5, 1));
+      // A door on a hinge to the world, swinging: joint rows read in place too.
+      pose.setOrigin(btVector3(-10, 2, 0));
+      btRigidBody* door = w->addBox(btVector3(0.5, 1.0, 0.05), 2.0, pose);
+      auto hinge =
+          std::make_unique<btHingeConstraint>(*door, btVector3(-0.5, 0, 0), btVector3(0, 1, 0));
+      hinge->enableFeedback(true);
+      hinge->setJointFeedback(&feedback[w == &copied]);
+      w->addConstraint(std::move(hinge));
+      door->setAngularVelocity(btVector3(0, 2, 0));
       w->step(30);  // stock SI
       w->setSolver(std::make_unique<ConstraintSolver>(s));
     }
@@ -264,7 +274,7 @@ TEST(BulletPlumbing, PackedPgsImpulsesEqualTheRowSolversBitForBit) {
     ASSERT_NE(reference->rowSolver(), nullptr);  // through the RowSolver from now on
     fast.step();
     copied.step();
-    EXPECT_EQ(static_cast<ConstraintSolver*>(fast.solver())->lastStep().packedIslands, 2);
+    EXPECT_EQ(static_cast<ConstraintSolver*>(fast.solver())->lastStep().packedIslands, 3);
     btDispatcher* a = fast.world().getDispatcher();
     btDispatcher* b = copied.world().getDispatcher();
     ASSERT_EQ(a->getNumManifolds(), b->getNumManifolds());
@@ -282,6 +292,13 @@ TEST(BulletPlumbing, PackedPgsImpulsesEqualTheRowSolversBitForBit) {
       }
     }
     EXPECT_GT(points, 40);
+    // The hinge's rows (joint rows, read in place too): Bullet's finish sums each row's impulse
+    // into the joint feedback (fresh every step), so equal rows give equal sums.
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_EQ(feedback[0].m_appliedForceBodyA[c], feedback[1].m_appliedForceBodyA[c]) << c;
+      EXPECT_EQ(feedback[0].m_appliedTorqueBodyA[c], feedback[1].m_appliedTorqueBodyA[c]) << c;
+    }
+    EXPECT_GT(feedback[0].m_appliedForceBodyA.length(), 1.0);  // the door hangs on it
   }
 }
 

@@ -353,9 +353,9 @@ inline RowPgs::RowView IslandBuilder::view(Island& isl, int r, bool split, doubl
 }
 
 inline RowPgs::RowView IslandBuilder::Source::row(int r) {
-  // Bullet's row r + kRowsAhead fetched: its 288 bytes start 16-byte aligned, so they span
-  // five lines when they do not start a line (the fields past byte 224, m_rhsPenetration among
-  // them, sit in the fifth).
+  // Bullet's row r + kRowsAhead fetched: its 288 bytes start 16-byte aligned and span five or
+  // six lines; the first five hold every field view() reads (bytes 0-264; m_rhsPenetration
+  // among the fields past byte 224).
   if (r + kRowsAhead < static_cast<int>(island_.rows.size())) {
     const char* ahead = reinterpret_cast<const char*>(island_.rows[r + kRowsAhead]);
     for (int line = 0; line < 5; ++line) __builtin_prefetch(ahead + 64 * line);

@@ -110,8 +110,11 @@ class IslandBuilder {
   // getInvInertiaTensorWorld() * m_relposNCrossNormal * getAngularFactor(): with the factor 1
   // that is bit for bit our invInertia (diag(f) I^-1 diag(f) = I^-1) times the same vector, row
   // by row left to right (double precision Bullet has no SIMD dot; neither side is built with
-  // fused multiply-adds). So the packing skips two 3x3 products per row and the iterates stay
-  // those of the RowSystem copy (tested bit for bit on a pyramid). Bullet's m_jacDiagABInv is
+  // fused multiply-adds: true of Debian's x86-64 builds; where a compiler contracts a * b + c
+  // by default, e.g. GCC on aarch64, the two may round apart and only agree to round-off).
+  // So the packing skips two 3x3 products per row and the iterates stay those of the RowSystem
+  // copy (tested bit for bit on a pyramid with contact, friction and hinge rows). Bullet's
+  // m_jacDiagABInv is
   // not used: it is 1 / (invMass + n . (I^-1 (r x n)) x r + Bullet's own cfm), a different
   // rounding of A_ii, and friction rows lack the cfm our CfmModel gives them.
   class Source final : public RowPgs::RowSource {
