@@ -751,7 +751,8 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
     result.message = blockMessage.empty() ? rep.message : blockMessage + "; " + rep.message;
   };
   bool symmetric = false;  // known after a first run of the block stage
-  block_->setLimits({params_.blockWoodburyRows, params_.blockUpdateRows});
+  block_->setLimits({params_.blockWoodburyRows, params_.blockUpdateRows, params_.blockDescentSteps,
+                     params_.blockBreakCycles});
   // Auto first tries a few full steps from the cold guess (every row clamped): resting piles
   // (ODE) settle in one step there, often sooner than from a warm guess whose sets are off by
   // a few rows; when they do not settle the trial is dropped (its iterate is a worse start than

@@ -662,8 +662,20 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
   double merit = meritAt(pb, x, w), bestRes = kInf;
   int uphill = 0;
   bool damped = false;
+  // Full steps without a new lowest merit that still descend from the step before (at most
+  // Limits::descentSteps per run) do not count as uphill: from a guess that is the best point so
+  // far the full steps often descend over several steps before beating it (Bullet's pyramid).
+  int descents = 0;
   double fullBest = merit;
   Vector fullBestX = x;
+  setPrev1_ = set_;
+  setPrev2_.clear();
+  auto toDamped = [&] {
+    x = fullBestX;
+    w = *a_ * x + pb.b;
+    merit = fullBest;
+    damped = true;
+  };
   Vector bestX = x;
   const double start = nowSeconds();
   std::ostringstream os;
@@ -701,12 +713,15 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
       os << "time budget spent after " << rep.steps << " block steps";
       break;
     }
-    if (rep.steps > 0) {
-      if (damped)
-        guess(pb, x, w, false);
-      else
-        setsAt(pb, x, w);
+    if (rep.steps > 0 && !damped) {
+      setsAt(pb, x, w);
+      // The sets of two steps ago again (a 2-cycle of full steps, which would repeat that step's
+      // x): damped steps from the best point at once.
+      if (!trial && limits_.breakCycles && set_ == setPrev2_) toDamped();
+      setPrev2_.swap(setPrev1_);
+      setPrev1_ = set_;
     }
+    if (rep.steps > 0 && damped) guess(pb, x, w, false);
     ++rep.steps;
     xOld = x;
     wOld = w;
@@ -714,10 +729,7 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
     const double rho = damped ? regularization * std::min(1.0, std::sqrt(merit)) : 0.0;
     if (!solveClamped(pb, x, xOld, rho, why)) {
       if (!damped && !trial) {  // a singular block: the proximal term regularizes it
-        x = fullBestX;
-        w = *a_ * x + pb.b;
-        merit = fullBest;
-        damped = true;
+        toDamped();
         continue;
       }
       os << why << " (block step " << rep.steps << ")";
@@ -729,6 +741,7 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
     if (!damped) {
       // Block principal pivoting: full steps; the merit may rise for a step or two.
       w = wNew;
+      const double before = merit;
       merit = meritAt(pb, x, w);
       if (merit < fullBest) {
         fullBest = merit;
@@ -738,12 +751,11 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
         x = bestX;
         os << "residual " << bestRes << " after " << rep.steps << " full steps";
         break;
+      } else if (merit < before && descents < limits_.descentSteps) {
+        ++descents;
       } else if (++uphill > kUphill) {  // no new best: damped steps from the best point
-        x = fullBestX;
-        w = *a_ * x + pb.b;
-        merit = fullBest;
         uphill = 0;
-        damped = true;
+        toDamped();
       }
       continue;
     }

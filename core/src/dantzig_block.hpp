@@ -68,9 +68,12 @@ class BlockPivoting {
   // Most sliding rows handled by Woodbury on the symmetric factor (more: the LU), and most
   // unknowns by which a step's sets may differ from the last factored ones (joined, left and
   // sliding rows) for the step to reuse that factor. DantzigParams documents them.
+  // descentSteps and breakCycles: see DantzigParams::blockDescentSteps / blockBreakCycles.
   struct Limits {
     int woodburyRows = 16;
     int updateRows = 40;
+    int descentSteps = 8;
+    bool breakCycles = true;
   };
   void setLimits(const Limits& limits) { limits_ = limits; }
 
@@ -97,7 +100,7 @@ class BlockPivoting {
   std::vector<int> mirror_;
   std::vector<int> byRank_;         // the rows in a fill-reducing order of A
   std::vector<int> problemFindex_;  // findex, -1 filled
-  std::vector<Set> set_;
+  std::vector<Set> set_, setPrev1_, setPrev2_;
   std::vector<int> pos_, order_, sliding_;  // pos_: row -> unknown index in K, or -1
   std::vector<double> coeff_;               // sliding row t: x_t = coeff_ * x_normal
   bool useLu_ = false;  // more than Limits::woodburyRows sliding rows: K is factored as it is

@@ -236,6 +236,13 @@ struct DantzigParams {
   // (joined + left the clamped set + sliding) reuses that factor through a bordered system;
   // 0 factors every step afresh. Default 40.
   int blockUpdateRows = 40;
+  // Full block steps that bring no new lowest merit but descend from the step before: up to
+  // this many per solve are taken without counting toward the hand-over to the damped steps
+  // (they reuse the factor); 0: every such step counts. Default 8.
+  int blockDescentSteps = 8;
+  // A full step whose index sets are those of two steps before (a 2-cycle) hands over to the
+  // damped steps at once instead of repeating that step. Default true.
+  bool blockBreakCycles = true;
 };
 
 class DantzigSolver : public Solver {
