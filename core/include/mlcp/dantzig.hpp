@@ -104,9 +104,14 @@
 // multiplier that frees its equation, and the p x p Schur complement of the border is factored
 // densely (p sparse forward solves each side). One step of iterative refinement follows. First the
 // steps are full (block principal pivoting; the next sets change only rows violated beyond 0.01
-// tolerance (1 + |b|), so that degenerate rows do not flip on rounding). When 3 full steps in a row
-// bring no new lowest merit
-// ||H||^2 (or a block is singular), the stage goes back to the best point and continues damped:
+// tolerance (1 + |b|), so that degenerate rows do not flip on rounding). A full step that brings no
+// new lowest merit ||H||^2 but is below the step before is free (up to
+// DantzigParams::blockDescentSteps per solve: from a guess that is itself the best point so far,
+// Bullet's full steps often descend for several steps, residual 5e-2 -> 1e-2 -> 2e-3 -> ..., before
+// beating it); a full step whose sets are those of two steps before (a 2-cycle, which would
+// repeat that step's x) ends the full steps at once (DantzigParams::blockBreakCycles). When 3 other
+// full steps in a row bring no new lowest merit (or a block is singular), the stage goes back to
+// the best point and continues damped:
 // sets from the natural map at x, a proximal term rho (x_C - x_C,prev) on the clamped rows
 // (rho = 1e-2 max|A_ii| min(1, ||H||): coplanar contacts make clamped blocks nearly singular, and
 // far from the answer their exact equations throw the null-space part far away), and the step
@@ -165,22 +170,44 @@
 // their friction rows; from the guess the stage takes 4-15 steps: full steps, each later one
 // reusing the first's factor (N = 80: p = 25 bordered rows on average, their Schur complement
 // ~0.6 ms, against ~2-2.5 ms for a fresh LDL^T with its assembly), and when they stop improving
-// damped steps whose rho changes every step (a fresh factorization each; on some steps a 2-cycle
-// between two sets at rho ~1e-10..1e-7 until the 40-step budget). The counts are chaotic in N
-// (rounding changes the trajectory): CPU ms per step, this method against the previous (LU for
-// sliding rows, no reuse), two runs each: N = 80: 11.1-11.2 (5 steps) against 26-28 (8); N = 150:
-// 12.3-17.7 (6) against 15-19 (4); N = 300: 22.1-22.5 (9) against 66-74 (15); stock MLCP-Dantzig
-// 285-420 ms per step on this loaded machine, so 13-26x: the 20x goal is not met at every N.
-// Same trajectory, same steps: at rest after SI (--warmup 30 --settle 60, 2 steps) 3.6-4.7
-// against 5.3-5.8 ms; after the switch (--warmup 30, 263 pivots and steps per step) 76.6-76.8
-// against 76.1-76.4 ms (damped steps: no reuse). ODE piles (ode_bench 10 5, four runs):
-// 11.8-11.9x at 588 rows, 72-98x at 1728 (before 11x / 80x).
+// damped steps whose rho changes every step (a fresh factorization each). Two patterns cost most
+// of the fresh factorizations (traced at N = 150 and 300): the full steps 2-cycle between two sets
+// near the answer (residual ~1e-5, merits repeating exactly) until the 3 uphill steps are spent,
+// then 1-2 damped steps settle; and on about every other solve the first full step lands above
+// the guess's merit (residual 5e-2 from a guess at ~1e-3) while the next ones descend, so the 3
+// uphill steps ran out and 7-10 damped steps (7-10 factorizations) followed. blockBreakCycles and
+// blockDescentSteps remove both: traced at N = 120, the solves then finished in 4-8 full steps on
+// one factorization (one of 15 took a damped step).
+// The counts are chaotic in N (rounding changes the trajectory): CPU ms per step (steps per
+// simulation step), with both against without (HEAD before them), alternated, two runs (three
+// at N = 150 and 300): N = 80: 11.3-12.7 (6) against 11.1-11.3 (5); N = 120: 8.8 (5) against
+// 8.2 (4); N = 150: 9.7-11.9 (6) against 11.0-11.4 (6); N = 200: 10.0 (7) against 12.4 (6); N =
+// 300: 12.7-19.2 (6) against 22.8-24.9 (9). Against the LU for sliding rows without reuse (earlier,
+// other runs): N = 80 26-28 (8), N = 150 15-19 (4), N = 300 66-74 (15). Stock MLCP-Dantzig took
+// 285-420 ms per step in earlier runs on this loaded machine (not re-measured), so 15-43x: the
+// 20x goal is still not met at every N. At rest after SI
+// (--warmup 30 --settle 60, 2 steps, same trajectory) 3.8-5.6 against 3.8-5.8 ms. After the
+// switch (--warmup 30: 40 damped steps, then the pivoting) 270 against 263 pivots and steps per
+// step, 77-100 against 79-106 ms (the machine's noise; the damped steps there have more than
+// blockWoodburyRows sliding rows: the LU, no factor to reuse, and sets that change by more than
+// blockUpdateRows rows). ODE piles (ode_bench 10 5, two runs each, unchanged: the cold trial
+// settles in one full step): 11.4-11.5x at 588 rows, 89-100x at 1728.
 // Tried without gain: CHOLMOD's supernodal LL^T (Debian's reference BLAS: 1.9 ms factor + 0.3 ms
 // analysis per new pattern at m = 812, against ~1.8 ms for the up-looking LDL^T; OpenBLAS 1.3 ms,
 // not a dependency worth adding), reusing a factor across a changed rho within 1e-3 or 0.1 of the
 // smallest pivot (never applicable: the pivots are cfm-sized), rho rounded up to powers of 2, 4
 // or 10 so that damped steps share it (step counts chaotic, no consistent gain), and a set change
-// threshold of 0.3 tolerance instead of 0.01 (N = 300: 17 steps against 9).
+// threshold of 0.3 tolerance instead of 0.01 (N = 300: 17 steps against 9). Tried in the demo's
+// steady state (CPU ms per step, single runs against 10.9-13.4 / 11.0-12.5 / 20.2-24.9 ms at N =
+// 80 / 150 / 300 without): single principal pivots where the full steps stop improving (only the
+// most violated row changes set, its friction rows following; up to 2 per violated row; each
+// reuses the factor): they 2-cycle too (a degenerate normal leaves and rejoins: residual 2e-7,
+// 2e-5, 2e-7, ...) until their budget, N = 150 28.8 ms (17 steps), N = 300 41.4 (19); rho held
+// across damped steps while the rule's rho stays within a factor 10 of it: 14.4 / 17.9 / 19.5 ms
+// (8 / 5 / 9 steps), no change after the switch (its damped steps factor the LU, see above);
+// damped steps at rho = 0 (the full steps' factor reused, the line search keeping descent) until
+// one does not descend: 16.6 / 28.5 / 21.8 ms (8 / 14 / 10 steps: exact steps on the nearly
+// singular blocks jump to residual ~2e-3 and the line search then creeps).
 //
 // Result::iterations counts pivots (direction computations: each row added or exchanged)
 // summed over all passes; Options::maxPivots (0: 50 n + 100) limits them per pass
