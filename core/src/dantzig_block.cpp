@@ -254,7 +254,8 @@ bool BlockPivoting::solveClamped(const Problem& pb, Vector& x, const Vector& pre
       haveBase_ = false;
       ++factorizations_;
       if (!factorCoupled(rho, true, why)) return false;
-    } else if (!(haveBase_ && rho == baseRho_ && buildCapacitance(pb, rho, limits_.updateRows))) {
+    } else if (!(haveBase_ && limits_.updateRows > 0 && rho == baseRho_ &&
+                 buildCapacitance(pb, rho, limits_.updateRows))) {
       // A new base: B = A_CC + rho I for the current set, the sliding rows by Woodbury.
       ++factorizations_;
       haveBase_ = false;

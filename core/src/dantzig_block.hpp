@@ -15,7 +15,8 @@ namespace mlcp::detail {
 // K = L D U without pivoting (L unit lower, U unit upper) for a sparse square K whose pattern
 // is symmetric, in the given order: up-looking, row k of L and column k of U from two sparse
 // triangular solves over the elimination tree (built as it goes), so L and U^T share one
-// pattern, that of the Cholesky factor of the pattern. Twice an LDL^T's work, no symbolic phase.
+// pattern, that of the Cholesky factor of the pattern. Twice an LDL^T's work; the symbolic pass
+// (elimination tree, column counts) is skipped when the pattern is the last factorization's.
 // factorSymmetric is the same for a symmetric K (U = L^T, one triangular solve per row).
 class SymmetricPatternLu {
  public:

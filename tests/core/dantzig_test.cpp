@@ -730,6 +730,39 @@ TEST(DantzigBlock, BorderedUpdatesMatchFreshFactorizations) {
   EXPECT_LT(factorizations, steps) << "no block step reused a factor";
 }
 
+// A warm guess with wrong sets makes rows join the clamped set between block steps: through a
+// reused factor their bordered columns (and their coupling to sliding rows) must give the steps
+// of fresh factorizations, the same number of them and the same answer (review of session 5:
+// the pyramid sequences above only ever had rows leave or slide).
+TEST(DantzigBlock, JoinedRowsThroughAReusedFactorTakeTheFreshSteps) {
+  test::Generator g(57);
+  int reused = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    const test::KnownProblem kp = trial % 2 ? g.friction(20) : g.boxed(g.spd(60));
+    Vector guess = kp.solution;
+    for (int i = 0; i < guess.size(); ++i)
+      if (g.uniform(0, 1) < 0.3) guess[i] += g.uniform(-0.5, 0.5);
+    DantzigSolver updated = withStage(DantzigParams::BlockStage::Always);
+    updated.params().blockUpdateRows = 200;
+    updated.params().blockWoodburyRows = 200;
+    DantzigSolver fresh = withStage(DantzigParams::BlockStage::Always);
+    fresh.params().blockUpdateRows = 0;
+    fresh.params().blockWoodburyRows = 0;
+    Vector xu, xf;
+    const Result ru = updated.solveWithGuess(kp.problem, guess, xu);
+    const Result rf = fresh.solveWithGuess(kp.problem, guess, xf);
+    ASSERT_TRUE(ru.converged()) << trial << ": " << ru.message;
+    ASSERT_TRUE(rf.converged()) << trial << ": " << rf.message;
+    EXPECT_LE(accuracy(kp.problem, xu).residual, 1e-10) << trial;
+    EXPECT_EQ(updated.blockSteps(), fresh.blockSteps()) << trial;
+    EXPECT_EQ(fresh.blockFactorizations(), fresh.blockSteps()) << trial;
+    EXPECT_LE((xu - xf).lpNorm<Eigen::Infinity>(), 1e-8 * (1 + xf.lpNorm<Eigen::Infinity>()))
+        << trial;
+    reused += updated.blockSteps() - updated.blockFactorizations();
+  }
+  EXPECT_GT(reused, 0) << "no block step reused a factor";
+}
+
 // A random guess is a bad warm start: the answer is right or the status says it is not.
 TEST(DantzigBlock, RandomWarmStartConvergesOrFailsHonestly) {
   test::PyramidSpec spec;

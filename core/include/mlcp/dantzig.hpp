@@ -102,26 +102,25 @@
 // DantzigParams::blockUpdateRows rows (joined, left the clamped set, sliding), with the same rho,
 // reuses that factor: the joined rows are bordered on, a left row's x is held at 0 by a
 // multiplier that frees its equation, and the p x p Schur complement of the border is factored
-// densely (p sparse forward solves each side). One step of iterative refinement follows. First the
-// steps are full (block principal pivoting; the next sets change only rows violated beyond 0.01
-// tolerance (1 + |b|), so that degenerate rows do not flip on rounding). A full step that brings no
-// new lowest merit ||H||^2 but is below the step before is free (up to
-// DantzigParams::blockDescentSteps per solve: from a guess that is itself the best point so far,
-// Bullet's full steps often descend for several steps, residual 5e-2 -> 1e-2 -> 2e-3 -> ..., before
-// beating it); a full step whose sets are those of two steps before (a 2-cycle, which would
-// repeat that step's x) ends the full steps at once (DantzigParams::blockBreakCycles). When 3 other
-// full steps in a row bring no new lowest merit (or a block is singular), the stage goes back to
-// the best point and continues damped:
-// sets from the natural map at x, a proximal term rho (x_C - x_C,prev) on the clamped rows
-// (rho = 1e-2 max|A_ii| min(1, ||H||): coplanar contacts make clamped blocks nearly singular, and
-// far from the answer their exact equations throw the null-space part far away), and the step
-// shortened by backtracking until ||H||^2 decreases (Armijo); at a kink where no step length
-// descends the full step is taken up to 2 times in a row. Warm starts take the first sets from
-// the natural map at the guess; cold starts clamp every row. The stage ends when the residual
-// (residual.hpp) is within Options::tolerance (then it is the answer, projected onto the bounds
-// when that keeps it within tolerance: Result::iterations counts its steps), or after
-// DantzigParams::maxBlockSteps, no descent, a singular damped block or the time budget: then the
-// best iterate is handed to the incremental pivoting below as its warm start.
+// densely (a sparse forward solve per bordered row, one more per sliding row). One step of
+// iterative refinement follows. First the steps are full (block principal pivoting; the next sets
+// change only rows violated beyond 0.01 tolerance (1 + |b|), so that degenerate rows do not flip on
+// rounding). A full step that brings no new lowest merit ||H||^2 but is below the step before is
+// free (up to DantzigParams::blockDescentSteps per solve: from a guess that is itself the best
+// point so far, Bullet's full steps often descend for several steps, residual 5e-2 -> 1e-2 -> 2e-3
+// -> ..., before beating it); a full step whose sets are those of two steps before (a 2-cycle,
+// which would repeat that step's x) ends the full steps at once (DantzigParams::blockBreakCycles).
+// When 3 other full steps in a row bring no new lowest merit (or a block is singular), the stage
+// goes back to the best point and continues damped: sets from the natural map at x, a proximal term
+// rho (x_C - x_C,prev) on the clamped rows (rho = 1e-2 max|A_ii| min(1, ||H||): coplanar contacts
+// make clamped blocks nearly singular, and far from the answer their exact equations throw the
+// null-space part far away), and the step shortened by backtracking until ||H||^2 decreases
+// (Armijo); at a kink where no step length descends the full step is taken up to 2 times in a row.
+// Warm starts take the first sets from the natural map at the guess; cold starts clamp every row.
+// The stage ends when the residual (residual.hpp) is within Options::tolerance (then it is the
+// answer, projected onto the bounds when that keeps it within tolerance: Result::iterations counts
+// its steps), or after DantzigParams::maxBlockSteps, no descent, a singular damped block or the
+// time budget: then the best iterate is handed to the incremental pivoting below as its warm start.
 // Measured (CPU time on a loaded 2-core machine, islands captured from tests/bench/bullet_bench's
 // worlds, tests/bench/ode_bench.cpp). Bullet adapter's pyramids (warm start from the cached
 // impulses, globalCfm 1e-5, one friction row per contact): the guesses are poor (residual
@@ -237,13 +236,14 @@ struct DantzigParams {
     Never,   // incremental pivoting only (the dense path)
   };
   BlockStage blockStage = BlockStage::Auto;  // default Auto
-  // Factorizations the block stage may spend before it hands over. Default 40.
+  // Block steps (each a fresh factorization or a reuse of the last one) the block stage may take
+  // before it hands over. Default 40.
   int maxBlockSteps = 40;
   // Auto: the smallest problem (rows) that gets the block stage. Default 100.
   int autoMinRows = 100;
   // Auto: the largest fraction of nonzero entries in A. Default 0.3.
   double autoMaxDensity = 0.3;
-  // Auto: most factorizations of the trial from the cold guess (it ends at its first full step
+  // Auto: most block steps of the trial from the cold guess (it ends at its first full step
   // that brings no new lowest merit). Default 3.
   int autoColdSteps = 3;
   // Auto: after a cold trial that did not settle, warm solves of this solver on problems of the
@@ -261,7 +261,7 @@ struct DantzigParams {
   int blockWoodburyRows = 16;
   // A block step whose sets differ from the last factored ones by at most this many rows
   // (joined + left the clamped set + sliding) reuses that factor through a bordered system;
-  // 0 factors every step afresh. Default 40.
+  // 0 factors every step afresh (even one whose sets equal the factored ones). Default 40.
   int blockUpdateRows = 40;
   // Full block steps that bring no new lowest merit but descend from the step before: up to
   // this many per solve are taken without counting toward the hand-over to the damped steps
@@ -287,7 +287,7 @@ class DantzigSolver : public Solver {
   // Friction fixed-point passes of the last solve (1 without findex, with FixedOnce, or when
   // the block stage settled).
   int passes() const;
-  // Factorizations of the block stage in the last solve (0 when it did not run), and whether
+  // Block steps of the block stage in the last solve (0 when it did not run), and whether
   // it produced the answer (else incremental pivoting finished from its best index sets).
   int blockSteps() const { return blockSteps_; }
   // Of those, the steps that factored their clamped block afresh (the others reused a factor).
