@@ -33,6 +33,15 @@ double stateDifference(sc::World& a, sc::World& b) {
 // The stock btMLCPSolver's matrix: globalCfm / dt on every row. With globalCfm 1e-5 (Bullet's
 // setting for direct solvers) the face contacts' matrix is not singular, so the stock Dantzig
 // rarely falls back and the answers are unique.
+// pgs as SI runs it: a fixed sweep count, every answer accepted (the tests compare paths).
+Settings fixedSweepPgs(int sweeps) {
+  Settings s;
+  s.solver = "pgs";
+  s.options.maxIterations = sweeps;
+  s.acceptResidual = INFINITY;
+  return s;
+}
+
 Settings stockLike(const std::string& solver) {
   Settings s;
   s.solver = solver;
@@ -196,10 +205,7 @@ TEST(BulletPlumbing, GroupsAreSplitIntoConnectedComponents) {
 TEST(BulletPlumbing, PgsPackedFromBulletsRowsMatchesThePgsOfTheRowSolver) {
   for (bool split : {true, false}) {
     sc::World fast, copied;
-    Settings s;
-    s.solver = "pgs";
-    s.options.maxIterations = 30;
-    s.acceptResidual = INFINITY;
+    Settings s = fixedSweepPgs(30);
     for (sc::World* w : {&fast, &copied}) {
       w->info().m_splitImpulse = split;
       sc::pyramid(*w, 6);
@@ -247,10 +253,7 @@ TEST(BulletPlumbing, PackedPgsImpulsesEqualTheRowSolversBitForBit) {
   for (bool siStart : {false, true}) {
     btJointFeedback feedback[2];  // the hinge's in fast, in copied (outlive the worlds)
     sc::World fast, copied;
-    Settings s;
-    s.solver = "pgs";
-    s.options.maxIterations = 10;
-    s.acceptResidual = INFINITY;
+    Settings s = fixedSweepPgs(10);
     s.siStart = siStart;
     for (sc::World* w : {&fast, &copied}) {
       sc::pyramid(*w, 10);
@@ -607,10 +610,7 @@ TEST(BulletPlumbing, PackedPgsAppliesImpulsesAsBulletDoesForLinearAndAngularFact
   for (const auto& [angularFactor, linearFactor] : factors)
     for (bool split : {false, true}) {
       sc::World fast, copied;
-      Settings s;
-      s.solver = "pgs";
-      s.options.maxIterations = 20;
-      s.acceptResidual = INFINITY;
+      Settings s = fixedSweepPgs(20);
       for (sc::World* w : {&fast, &copied}) {
         w->info().m_splitImpulse = split;
         w->addGround(0.6);

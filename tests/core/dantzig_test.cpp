@@ -491,6 +491,15 @@ TEST(DantzigSmall, ReuseAcrossSizesAndBoundPatternsMatchesAFreshSolver) {
 
 // ---- the sparse block stage on engine-like contact scenes (tests/common/contact_scenes.hpp) ----
 
+// A pyramid of `levels` levels whose boxes move sideways (0.5 m/s): sliding contacts, index
+// sets that change between steps.
+test::PyramidSpec slidingPyramid(int levels) {
+  test::PyramidSpec spec;
+  spec.levels = levels;
+  spec.sideVelocity = 0.5;
+  return spec;
+}
+
 DantzigSolver withStage(DantzigParams::BlockStage stage) {
   DantzigSolver s;
   s.params().blockStage = stage;
@@ -625,10 +634,7 @@ TEST(DantzigBlock, AutoTrustedGuessSkipsTheColdTrial) {
 // Auto's cold trial after a miss: warm solves of the same solver skip it until autoColdRetry
 // solves have passed (Bullet's moving pyramid never settles from the cold sets), then try again.
 TEST(DantzigBlock, AutoColdTrialAfterAMissIsRetriedEveryAutoColdRetrySolves) {
-  test::PyramidSpec spec;
-  spec.levels = 4;
-  spec.sideVelocity = 0.5;
-  test::BoxPyramid pyramid(spec);
+  test::BoxPyramid pyramid(slidingPyramid(4));
   pyramid.nextStep(1e-4);
   const Problem p = pyramid.rows().assemble(true);
   DantzigSolver autoStage = withStage(DantzigParams::BlockStage::Auto);
@@ -675,10 +681,7 @@ TEST(DantzigBlock, NonsymmetricValuesOnASymmetricPatternSkipTheStage) {
 
 // Sliding contacts (sideways velocities) exercise the sliding rows' low-rank update.
 TEST(DantzigBlock, SlidingPyramidWarmStart) {
-  test::PyramidSpec spec;
-  spec.levels = 4;
-  spec.sideVelocity = 0.5;
-  test::BoxPyramid pyramid(spec);
+  test::BoxPyramid pyramid(slidingPyramid(4));
   DantzigSolver block = withStage(DantzigParams::BlockStage::Always);
   Vector x;
   ASSERT_TRUE(withStage(DantzigParams::BlockStage::Never)
@@ -707,10 +710,7 @@ TEST(DantzigBlock, SlidingPyramidWarmStart) {
 // answers of factoring every step afresh with the LU, on a sliding pyramid where the sets change
 // between steps; the reuse happens (fewer factorizations than steps).
 TEST(DantzigBlock, BorderedUpdatesMatchFreshFactorizations) {
-  test::PyramidSpec spec;
-  spec.levels = 5;
-  spec.sideVelocity = 0.5;
-  test::BoxPyramid pyramid(spec);
+  test::BoxPyramid pyramid(slidingPyramid(5));
   DantzigSolver updated = withStage(DantzigParams::BlockStage::Always);
   updated.params().blockWoodburyRows = 200;  // the scene slides: every friction row by Woodbury
   updated.params().blockUpdateRows = 200;
@@ -895,10 +895,7 @@ TEST(DantzigBlock, SymmetricPatternLuSolves) {
 // Total block steps over a 6-step sequence of a sliding 10-box pyramid (each step's b moved by
 // 1e-3 g dt), warm started from the last answer; every answer within 1e-10 of the dense path's.
 int pyramidSequenceSteps(DantzigSolver& s) {
-  test::PyramidSpec spec;
-  spec.levels = 4;
-  spec.sideVelocity = 0.5;
-  test::BoxPyramid pyramid(spec);
+  test::BoxPyramid pyramid(slidingPyramid(4));
   DantzigSolver dense = withStage(DantzigParams::BlockStage::Never);
   dense.options().tolerance = 1e-13;
   Vector x;
