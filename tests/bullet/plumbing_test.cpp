@@ -252,6 +252,7 @@ TEST(BulletPlumbing, PgsPackedFromBulletsRowsMatchesThePgsOfTheRowSolver) {
 TEST(BulletPlumbing, PackedPgsImpulsesEqualTheRowSolversBitForBit) {
   for (bool siStart : {false, true}) {
     btJointFeedback feedback[2];  // the hinge's in fast, in copied (outlive the worlds)
+    const btCollisionObject* fastBall = nullptr;
     sc::World fast, copied;
     Settings s = fixedSweepPgs(10);
     s.siStart = siStart;
@@ -270,6 +271,15 @@ TEST(BulletPlumbing, PackedPgsImpulsesEqualTheRowSolversBitForBit) {
       hinge->setJointFeedback(&feedback[w == &copied]);
       w->addConstraint(std::move(hinge));
       door->setAngularVelocity(btVector3(0, 2, 0));
+      // A ball rolling with rolling and spinning friction: its 3 rolling rows are read in place
+      // too and couple with its contact's friction row (r x t is not 0), so the friction impulse
+      // written back to its point equals only if they do.
+      btRigidBody* ball = w->addSphere(0.5, 1.0, btVector3(0, 0.5, 10), 1.0);
+      if (w == &fast) fastBall = ball;
+      ball->setRollingFriction(0.05);
+      ball->setSpinningFriction(0.05);
+      ball->setLinearVelocity(btVector3(2, 0, 0));
+      ball->setAngularVelocity(btVector3(0, 1, -4));
       w->step(30);  // stock SI
       w->setSolver(std::make_unique<ConstraintSolver>(s));
     }
@@ -277,15 +287,19 @@ TEST(BulletPlumbing, PackedPgsImpulsesEqualTheRowSolversBitForBit) {
     ASSERT_NE(reference->rowSolver(), nullptr);  // through the RowSolver from now on
     fast.step();
     copied.step();
-    EXPECT_EQ(static_cast<ConstraintSolver*>(fast.solver())->lastStep().packedIslands, 3);
+    const mlcp::bullet::StepStats& st = static_cast<ConstraintSolver*>(fast.solver())->lastStep();
+    EXPECT_EQ(st.packedIslands, 4);
     btDispatcher* a = fast.world().getDispatcher();
     btDispatcher* b = copied.world().getDispatcher();
     ASSERT_EQ(a->getNumManifolds(), b->getNumManifolds());
-    int points = 0;
+    int points = 0, ballPoints = 0;
     for (int m = 0; m < a->getNumManifolds(); ++m) {
       const btPersistentManifold* ma = a->getManifoldByIndexInternal(m);
       const btPersistentManifold* mb = b->getManifoldByIndexInternal(m);
       ASSERT_EQ(ma->getNumContacts(), mb->getNumContacts());
+      if (ma->getBody0() == fastBall || ma->getBody1() == fastBall) {
+        ballPoints += ma->getNumContacts();
+      }
       for (int k = 0; k < ma->getNumContacts(); ++k, ++points) {
         const btManifoldPoint& pa = ma->getContactPoint(k);
         const btManifoldPoint& pb = mb->getContactPoint(k);
@@ -295,6 +309,10 @@ TEST(BulletPlumbing, PackedPgsImpulsesEqualTheRowSolversBitForBit) {
       }
     }
     EXPECT_GT(points, 40);
+    // Every point has a normal and one friction row, the hinge 5 rows, each of the ball's
+    // points 3 rolling rows (spinning and two rolling directions).
+    EXPECT_GT(ballPoints, 0);
+    EXPECT_EQ(st.rows, 2 * points + 5 + 3 * ballPoints);
     // The hinge's rows (joint rows, read in place too): Bullet's finish sums each row's impulse
     // into the joint feedback (fresh every step), so equal rows give equal sums.
     for (int c = 0; c < 3; ++c) {
