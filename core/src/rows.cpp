@@ -267,18 +267,6 @@ void RowSystem::assemble(bool sparse, Problem& p, AssembleScratch& scratch) cons
   p.swapA(A);
 }
 
-void RowPgs::slackFromVelocities(const Vector& x) {
-  const int n = static_cast<int>(packed_.size());
-  w_.resize(n);
-  for (int i = 0; i < n; ++i) {
-    const PackedRow& p = packed_[i];
-    // step w_i = (1 - keep) x_i + shift + step J v: the sweep's own terms (see rows.hpp).
-    const double jv =
-        (p.sA.cwiseProduct(velocity_[p.a].v) + p.sB.cwiseProduct(velocity_[p.b].v)).sum();
-    w_[i] = scale_[i] * ((1 - p.keep) * x[i] + p.shift + jv);
-  }
-}
-
 Result RowPgs::solve(const RowSystem& s, Vector& x) {
   const double t0 = nowSeconds();
   const Options& opt = options_;
@@ -319,7 +307,7 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
   }
   // The input is valid from here on: x is the iterate (no copy).
   if (!warm) x.setZero(n);
-  return iterate(x, s.lo, s.hi, s.findex, n ? s.b.lpNorm<Eigen::Infinity>() : 0.0, t0);
+  return iterate(x, n ? s.b.lpNorm<Eigen::Infinity>() : 0.0, t0);
 }
 
 void RowPgs::toSystem(const std::vector<BodyInverseMass>& bodies, int n, const RowFill& fill,
@@ -358,21 +346,37 @@ Result RowPgs::iteratePacked(int bodies, Vector& x, double bNorm, double t0) {
   // A non-finite base would make every velocityChange NaN: no per-body changes then (the
   // caller applies x row by row, as after the slow path).
   for (int k = 0; k < bodies; ++k)
-    if (!base_[k].v.allFinite()) return iterate(x, lo_, hi_, findex_, bNorm, t0);
+    if (!base_[k].v.allFinite()) return iterate(x, bNorm, t0);
   baseValid_ = true;
-  return iterate(x, lo_, hi_, findex_, bNorm, t0);
+  return iterate(x, bNorm, t0);
 }
 
-Result RowPgs::iterate(Vector& x, const Vector& lo, const Vector& hi,
-                       const std::vector<int>& findex, double bNorm, double t0) {
+Result RowPgs::iterate(Vector& x, double bNorm, double t0) {
   const Options& opt = options_;
   const int n = static_cast<int>(packed_.size());
   Result result;
   Accuracy last;           // accuracy of x as it is after the last check
   bool lastValid = false;  // whether x is unchanged since
+  // The residual of x from the packed rows in one pass (no w vector written and read back):
+  // step_i w_i = (1 - keep) x_i + shift + sA va + sB vb, the sweep's own terms (rows.hpp),
+  // scaled back by scale_i = 1 / step_i; the bounds with findex applied at x.
   auto check = [&]() {
-    slackFromVelocities(x);
-    last = accuracy(x, w_, lo, hi, findex, bNorm);
+    const double* xs = x.data();
+    AccuracyAccumulator a;
+    for (int i = 0; i < n; ++i) {
+      const PackedRow& p = packed_[i];
+      const double jv =
+          (p.sA.cwiseProduct(velocity_[p.a].v) + p.sB.cwiseProduct(velocity_[p.b].v)).sum();
+      const double w = scale_[i] * ((1 - p.keep) * xs[i] + p.shift + jv);
+      double lo = p.lo, hi = p.hi;
+      if (p.findex >= 0) {
+        const double normal = std::abs(xs[p.findex]);
+        lo *= normal;
+        hi *= normal;
+      }
+      if (!a.add(xs[i], w, lo, hi)) break;
+    }
+    last = a.result(bNorm);
     lastValid = true;
   };
   detail::SweepMonitor monitor(opt, result);

@@ -9,6 +9,9 @@
 // scales. It is computed here from the problem alone, independently of any solver's claims.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
+
 #include "mlcp/problem.hpp"
 
 namespace mlcp {
@@ -29,6 +32,48 @@ Accuracy accuracy(const Problem& problem, const Vector& x);
 Accuracy accuracy(const Problem& problem, const Vector& x, const Vector& w);
 // Shorthand for accuracy(problem, x).residual.
 double residual(const Problem& problem, const Vector& x);
+
+// The per-row rule all of the accuracy() functions run, for a solver that has w one row at a
+// time (RowPgs' check computes w_i from its packed rows and feeds it here: one pass, no w
+// vector). add() every row with its effective bounds (findex applied), then result().
+class AccuracyAccumulator {
+ public:
+  // false once x or w was not finite: the result is then +inf whatever follows.
+  bool add(double x, double w, double lo, double hi) {
+    if (!std::isfinite(x) || !std::isfinite(w)) {
+      finite_ = false;
+      return false;
+    }
+    r_ = std::max(r_, std::abs(x - std::clamp(x - w, lo, hi)));
+    complementarity_ =
+        std::max(complementarity_, gapTimes(lo, x, w, 1.0) + gapTimes(hi, x, -w, -1.0));
+    boundViolation_ = std::max({boundViolation_, lo - x, x - hi});
+    return true;
+  }
+  // bInfNorm: ||b||_inf of the problem.
+  Accuracy result(double bInfNorm) const {
+    Accuracy a;
+    if (!finite_) {
+      a.finite = false;
+      a.residual = a.complementarity = a.boundViolation = kInf;
+      return a;
+    }
+    a.residual = r_ / (1.0 + bInfNorm);
+    a.complementarity = complementarity_;
+    a.boundViolation = boundViolation_;
+    return a;
+  }
+
+ private:
+  // w's violation times the distance to the bound it points at; with an infinite bound there is
+  // no distance to measure and the violation is |w| itself.
+  static double gapTimes(double bound, double x, double force, double sign) {
+    if (force <= 0) return 0;
+    return std::isfinite(bound) ? force * std::max(sign * (x - bound), 0.0) : force;
+  }
+  double r_ = 0, complementarity_ = 0, boundViolation_ = 0;
+  bool finite_ = true;
+};
 
 // The primitive all of the above call: for forms that compute w without an assembled A (the
 // adapters' factored rows). bInfNorm is ||b||_inf of the problem; findex may be empty.

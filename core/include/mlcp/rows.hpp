@@ -235,8 +235,6 @@ class RowPgs {
   // Longest run of rows on the same two bodies swept as one (longer ones are split): its
   // couplings take (kMaxRun - 1) kMaxRun / 2 numbers. 8 = a box face's 4 contacts' friction rows.
   static constexpr int kMaxRun = 8;
-  // w = J v + cfm x + b for every row, from the maintained velocities (see above).
-  void slackFromVelocities(const Vector& x);
   // Fills packed_ and velocity_ from rowAt(i) (detail/row_pack.hpp); false at the first invalid row
   // or non-positive A_ii (bad_, badDiagonal_ say which).
   template <class RowAt>
@@ -244,11 +242,11 @@ class RowPgs {
             bool withBase);
   static Result negativeRows();
   // After the engine path's packing: per-body changes offered when the bases are finite, then
-  // iterate() on lo_, hi_, findex_.
+  // iterate().
   Result iteratePacked(int bodies, Vector& x, double bNorm, double t0);
-  // The sweeps and checks on packed_ from x; lo, hi, findex and bNorm for the check.
-  Result iterate(Vector& x, const Vector& lo, const Vector& hi, const std::vector<int>& findex,
-                 double bNorm, double t0);
+  // The sweeps and checks on packed_ from x (the check reads the bounds and findex from the
+  // packed rows too); bNorm = ||b||_inf for the check.
+  Result iterate(Vector& x, double bNorm, double t0);
 
   Options options_;
   std::vector<PackedRow> packed_;  // reused between solves
@@ -259,10 +257,6 @@ class RowPgs {
   // step_i J_i M^-1 J_k^T (sA_i . mA_k + sB_i . mB_k).
   std::vector<double> coupling_;
   std::vector<BodyVelocity> velocity_, base_;
-  Vector w_;
-  // The engine path's copies of what the check reads (the RowSystem path reads the system's).
-  Vector lo_, hi_;
-  std::vector<int> findex_;
   bool baseValid_ = false;
   int bad_ = -1;            // the row that stopped pack()
   double badDiagonal_ = 0;  // its A_ii, or NaN when the row was invalid

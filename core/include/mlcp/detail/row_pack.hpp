@@ -276,17 +276,11 @@ Result RowPgs::solveFrom(const std::vector<BodyInverseMass>& bodies, int n, Sour
   for (const BodyInverseMass& body : bodies)
     if (!detail::bodyValid(body)) return slow();
   x.resize(n);
-  lo_.resize(n);
-  hi_.resize(n);
-  findex_.resize(n);
   double bNorm = 0;
   const bool packed = pack(
       bodies, n,
       [&](int i) {
         const RowView r = source.row(i);
-        lo_[i] = r.lo;
-        hi_[i] = r.hi;
-        findex_[i] = r.findex;
         bNorm = std::max(bNorm, std::abs(r.b));
         return r;
       },
