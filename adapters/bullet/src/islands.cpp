@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <numeric>
 
 #include "mlcp/bullet/constraint_solver.hpp"
 #include "mlcp/detail/row_pack.hpp"
@@ -96,12 +97,14 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
   findex_.resize(n);
   rowBodies_.resize(n);
   int lastA = -1, lastB = -1;  // the last pair joined (a manifold's rows repeat it)
+  int inert = 0;               // rows on no dynamic body
   auto add = [&](int i, btSolverConstraint& c, int f) {
     all_[i] = &c;
     findex_[i] = f;
     const int a = c.m_solverBodyIdA >= 0 ? dynamic_[c.m_solverBodyIdA] : -1;
     const int b = c.m_solverBodyIdB >= 0 ? dynamic_[c.m_solverBodyIdB] : -1;
     rowBodies_[i] = {a, b};
+    inert += a < 0 && b < 0;
     if (a >= 0 && b >= 0 && (a != lastA || b != lastB)) {
       parent_[find(a)] = find(b);
       lastA = a;
@@ -160,11 +163,44 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
   // bodies: no find() for them), then each island's arrays at their final sizes, written by
   // index (no growth checks per row).
   rowsIn_.clear();
+  auto newIsland = [&] {
+    if (static_cast<int>(islands_.size()) < ++count_) islands_.resize(count_);
+    rowsIn_.push_back(0);
+    Island& isl = islands_[count_ - 1];
+    isl.system.bodies.clear();
+    isl.solverBody.clear();
+    isl.hasSplit = false;
+    isl.filled = false;
+    isl.perRowWriteBack = false;
+  };
+  // One component with every row on a dynamic body (a pile, a pyramid): the rows are island 0 in
+  // their own order and only the bodies need numbering (no island lookup and no place per row,
+  // and the island's arrays are copies). Every dynamic body has the same root (a body without
+  // rows is a component of its own: the general numbering then).
+  bool single = n > 0 && inert == 0;
+  for (int k = 0, root = -1; single && k < nb; ++k) {
+    if (dynamic_[k] < 0) continue;
+    const int rk = find(k);
+    if (root < 0) root = rk;
+    single = rk == root;
+  }
   int lastPairA = -2, lastPairB = -2, lastIsland = -1;
   // The current island's row count kept here (written back when the island changes): counting
   // in rowsIn_ chained every row through a store and a load.
   int counted = 0;
-  for (int i = 0; i < n; ++i) {
+  if (single) {
+    newIsland();
+    for (int i = 0; i < n; ++i) {
+      const auto [a, b] = rowBodies_[i];
+      if (a == lastPairA && b == lastPairB) continue;
+      localBody(islands_[0], a);
+      localBody(islands_[0], b);
+      lastPairA = a;
+      lastPairB = b;
+    }
+    rowsIn_[0] = n;
+  }
+  for (int i = 0; i < n && !single; ++i) {
     const auto [a, b] = rowBodies_[i];
     if (a < 0 && b < 0) {
       rowIsland_[i] = -1;
@@ -175,15 +211,8 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     if (a != lastPairA || b != lastPairB) {
       const int root = find(a >= 0 ? a : b);
       if (islandOfRoot_[root] < 0) {
-        islandOfRoot_[root] = count_++;
-        if (static_cast<int>(islands_.size()) < count_) islands_.resize(count_);
-        rowsIn_.push_back(0);
-        Island& isl = islands_[count_ - 1];
-        isl.system.bodies.clear();
-        isl.solverBody.clear();
-        isl.hasSplit = false;
-        isl.filled = false;
-        isl.perRowWriteBack = false;
+        islandOfRoot_[root] = count_;
+        newIsland();
       }
       k = islandOfRoot_[root];
       if (k != lastIsland) {
@@ -213,16 +242,24 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     isl.memo.resize(withPoints);
   }
   points_ = start == Start::CachedImpulse;
-  for (int i = 0; i < n; ++i) {
-    const int k = rowIsland_[i];
+  if (single) {
+    Island& isl = islands_[0];
+    std::copy(all_.begin(), all_.end(), isl.rows.begin());
+    std::iota(isl.rowIndex.begin(), isl.rowIndex.end(), 0);
+    std::copy(findex_.begin(), findex_.end(), isl.system.findex.begin());
+  }
+  for (int i = 0; i < n && (points_ || !single); ++i) {
+    const int k = single ? 0 : rowIsland_[i];
     if (k < 0) continue;
     Island& isl = islands_[k];
-    const int r = rowLocal_[i];
+    const int r = single ? i : rowLocal_[i];
     btSolverConstraint& c = *all_[i];
-    isl.rows[r] = &c;
-    isl.rowIndex[r] = i;
-    const int f = findex_[i] >= 0 ? rowLocal_[findex_[i]] : -1;
-    isl.system.findex[r] = f;
+    const int f = single ? findex_[i] : findex_[i] >= 0 ? rowLocal_[findex_[i]] : -1;
+    if (!single) {
+      isl.rows[r] = &c;
+      isl.rowIndex[r] = i;
+      isl.system.findex[r] = f;
+    }
     if (!points_) continue;
     const btManifoldPoint* point = nullptr;
     const Remembered* last = nullptr;

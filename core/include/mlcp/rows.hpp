@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "mlcp/problem.hpp"
+#include "mlcp/residual.hpp"
 #include "mlcp/result.hpp"
 
 namespace mlcp {
@@ -247,9 +248,12 @@ class RowPgs {
   // The sweeps and checks on packed_ from x (the check reads the bounds and findex from the
   // packed rows too); bNorm = ||b||_inf for the check.
   Result iterate(Vector& x, double bNorm, double t0);
+  // The check: accuracy() of x with w = J v + cfm x + b from the packed rows and velocities.
+  Accuracy packedAccuracy(const Vector& x, double bNorm) const;
 
   Options options_;
   std::vector<PackedRow> packed_;  // reused between solves
+  std::vector<int> findexOf_;      // packed_[i].findex again, compact (pack() validates with it)
   // Per row 1 / step, for the check only (kept apart: the sweep's stream stays 240 bytes a row):
   // w_i = scale_i ((1 - keep) x_i + shift + sA va + sB vb).
   std::vector<double> scale_;
