@@ -102,6 +102,9 @@ inline void setRow(RowSystem& s, Vector& start, int i, const RowPgs::RowView& r)
 
 }  // namespace detail
 
+// How many rows ahead pack() fetches the packed rows it will write.
+constexpr int kPackAhead = 8;
+
 template <class RowAt>
 bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& rowAt, bool warm,
                   double* xOut, bool withBase) {
@@ -147,6 +150,14 @@ bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& row
     detail::jacobianOf(r.linB, r.angB, jB);
     if (!detail::rowValid(r, jA, jB, i, n, slots)) return stop(i, std::nan(""));
     PackedRow& p = packed_[i];
+    // The packed rows written a few rows ahead are fetched for writing: after the engine's own
+    // setup they are mostly out of L2, and ~30 stores a row waiting on their lines filled the
+    // store buffer.
+    if (i + kPackAhead < n) {
+      const char* ahead = reinterpret_cast<const char*>(&packed_[i + kPackAhead]);
+      for (int line = 0; line < static_cast<int>(sizeof(PackedRow)); line += 64)
+        __builtin_prefetch(ahead + line, 1);
+    }
     p.findex = r.findex;
     // Each row's findex again in a compact array, for the check that a friction row's normal
     // row has none: reading it from the normal's packed row (thousands of rows back, out of L1)
