@@ -763,6 +763,8 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
   // cold sets are never right: Bullet's moving pyramid), re-trying every autoColdRetry solves.
   const bool autoStage = params_.blockStage == DantzigParams::BlockStage::Auto;
   const bool trusted = warm && autoStage && residual(problem, x) <= kTrustedGuess;
+  const bool setsAtGuess = params_.blockTrustedSets && warm &&
+                           (trusted || (!autoStage && residual(problem, x) <= kTrustedGuess));
   bool coldTrial = autoStage && !trusted;
   if (coldTrial && warm && coldMissed_ > 0 && coldMissedRows_ == problem.size()) {
     coldTrial = coldMissed_ % std::max(1, params_.autoColdRetry) == 0;
@@ -788,8 +790,8 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
   const bool warmStage = warm && (trusted || problem.size() >= params_.autoWarmMinRows);
   const bool blockIterate = warmStage || params_.blockStage == DantzigParams::BlockStage::Always;
   if (blockIterate) {
-    const detail::BlockPivoting::Report rep =
-        block_->run(problem, x, options(), std::max(1, params_.maxBlockSteps), false, symmetric);
+    const detail::BlockPivoting::Report rep = block_->run(
+        problem, x, options(), std::max(1, params_.maxBlockSteps), false, symmetric, setsAtGuess);
     blockSteps_ += rep.steps;
     blockFactorizations_ += rep.factorizations;
     if (rep.settled) {

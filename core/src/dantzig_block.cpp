@@ -16,6 +16,10 @@ constexpr double kMinStep = 1.0 / 1024;  // shortest line-search step before the
 // part of nearly singular clamped blocks far from the answer, vanishes near it.
 constexpr double kProximal = 1e-2;
 constexpr int kUphill = 2;  // full steps in a row taken without descent before handing over
+// A guess's row within this fraction of its bound counts as at the bound (guess() with atGuess):
+// an engine hands a sliding friction row's last answer back rotated onto the new friction
+// direction, a relative change of the order of the rotation squared.
+constexpr double kAtBound = 1e-6;
 bool isFriction(const Problem& pb, int i) { return !pb.findex.empty() && pb.findex[i] >= 0; }
 double signOf(double v) { return v < 0 ? -1.0 : 1.0; }
 // The value a non-clamped, uncoupled row is held at.
@@ -175,12 +179,22 @@ double BlockPivoting::frictionBound(const Problem& pb, int t, Set s, const Vecto
 // The first index sets. Cold: every row clamped (the Newton step of the linear system A x = -b).
 // Warm: from the natural map at the guess (w0 = A x0 + b), z = x0 - w0 against the bounds at x0
 // (lo' when z <= lo', hi' when z >= hi', clamped between), which is right for a guess that solves a
-// nearby problem even where it holds rows only close to their bounds.
-void BlockPivoting::guess(const Problem& pb, const Vector& x0, const Vector& w0, bool cold) {
+// nearby problem even where it holds rows only close to their bounds. atGuess: where x0 lies
+// instead (a row at a bound, within kAtBound of it, held there; the others clamped), which is right
+// for a guess that is the last answer of a slowly changing problem whose w0 is as small as x0's
+// changes.
+void BlockPivoting::guess(const Problem& pb, const Vector& x0, const Vector& w0, bool cold,
+                          bool atGuess) {
   const int n = pb.size();
   set_.assign(n, Set::Clamped);
   auto place = [&](int i, double lo, double hi) {
     if (cold) return;
+    if (atGuess) {
+      set_[i] = x0[i] <= lo + kAtBound * std::abs(lo)   ? Set::AtLo
+                : x0[i] >= hi - kAtBound * std::abs(hi) ? Set::AtHi
+                                                        : Set::Clamped;
+      return;
+    }
     const double z = x0[i] - w0[i];
     set_[i] = z <= lo ? Set::AtLo : z >= hi ? Set::AtHi : Set::Clamped;
   };
@@ -616,7 +630,8 @@ bool BlockPivoting::symmetricValues() const {
 }
 
 BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Options& opt,
-                                         int maxSteps, bool trial, bool symmetryKnown) {
+                                         int maxSteps, bool trial, bool symmetryKnown,
+                                         bool atGuess) {
   Report rep;
   const int n = pb.size();
   if (pb.isSparse()) {
@@ -651,7 +666,7 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
   factorizations_ = 0;
   const bool cold = x.isZero(0.0);
   Vector w = *a_ * x + pb.b, xOld(n), wOld(n), wNew(n);
-  guess(pb, x, w, cold);
+  guess(pb, x, w, cold, atGuess);
 
   // Full steps (block principal pivoting) while they keep finding new lowest merits
   // ||H(x)||^2 (H_i = x_i - clamp(x_i - w_i, lo', hi')); then damped Newton steps on the natural

@@ -62,7 +62,7 @@ class BlockPivoting {
   // symmetryKnown: a previous run() on the same problem found it so). A trial takes full steps
   // only and ends at the first one that brings no new lowest merit.
   Report run(const Problem& problem, Vector& x, const Options& options, int maxSteps,
-             bool trial = false, bool symmetryKnown = false);
+             bool trial = false, bool symmetryKnown = false, bool atGuess = false);
 
   int orderings() const { return aPattern_.analyses(); }
 
@@ -82,7 +82,8 @@ class BlockPivoting {
   enum class Set : unsigned char { Clamped, AtLo, AtHi, Fixed };
   using ColMajor = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 
-  void guess(const Problem& pb, const Vector& x0, const Vector& w0, bool cold);
+  void guess(const Problem& pb, const Vector& x0, const Vector& w0, bool cold,
+             bool atGuess = false);
   bool solveClamped(const Problem& pb, Vector& x, const Vector& prev, double rho, std::string& why);
   bool factorCoupled(double rho, bool coupled, std::string& why);
   void applySolve(Vector& y);

@@ -717,6 +717,9 @@ TEST(DantzigBlock, BorderedUpdatesMatchFreshFactorizations) {
   DantzigSolver fresh = withStage(DantzigParams::BlockStage::Always);
   fresh.params().blockUpdateRows = 0;
   fresh.params().blockWoodburyRows = 0;
+  // Sets from the natural map at the guess: more than one step per solve (from the sets where
+  // the guess lies each solve settles in its first step, nothing to reuse).
+  updated.params().blockTrustedSets = fresh.params().blockTrustedSets = false;
   Vector x;
   ASSERT_TRUE(withStage(DantzigParams::BlockStage::Never)
                   .solve(pyramid.rows().assemble(true), x)
@@ -918,13 +921,26 @@ int pyramidSequenceSteps(DantzigSolver& s) {
 
 // Full steps that descend from the step before without beating the guess's merit keep going
 // (blockDescentSteps) instead of handing over to the damped steps after kUphill of them: on
-// this sequence one solve takes 4 steps instead of 11; the answers are the same.
+// this sequence one solve takes 4 steps instead of 11; the answers are the same. (The first
+// sets from the natural map at the guess: the sets where it lies need no descents here.)
 TEST(DantzigBlock, DescendingFullStepsContinue) {
   DantzigSolver on = withStage(DantzigParams::BlockStage::Always);
   DantzigSolver off = withStage(DantzigParams::BlockStage::Always);
+  on.params().blockTrustedSets = off.params().blockTrustedSets = false;
   off.params().blockDescentSteps = 0;
   const int withDescents = pyramidSequenceSteps(on), without = pyramidSequenceSteps(off);
   EXPECT_LT(withDescents, without);
+}
+
+// A trusted guess (the last answer, residual within 1e-2) gives the first index sets by where it
+// lies (blockTrustedSets) rather than by the natural map at it: on this sequence fewer block
+// steps in all; the answers are the same (pyramidSequenceSteps checks them against the dense path).
+TEST(DantzigBlock, TrustedGuessSetsTakeFewerSteps) {
+  DantzigSolver on = withStage(DantzigParams::BlockStage::Always);
+  DantzigSolver off = withStage(DantzigParams::BlockStage::Always);
+  off.params().blockTrustedSets = false;
+  const int atGuess = pyramidSequenceSteps(on), naturalMap = pyramidSequenceSteps(off);
+  EXPECT_LT(atGuess, naturalMap) << "block steps with and without blockTrustedSets";
 }
 
 // A full step whose sets are those of two steps before would repeat that step's x: with

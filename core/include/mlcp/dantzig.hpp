@@ -116,7 +116,8 @@
 // make clamped blocks nearly singular, and far from the answer their exact equations throw the
 // null-space part far away), and the step shortened by backtracking until ||H||^2 decreases
 // (Armijo); at a kink where no step length descends the full step is taken up to 2 times in a row.
-// Warm starts take the first sets from the natural map at the guess; cold starts clamp every row.
+// Warm starts take the first sets from the natural map at the guess, trusted ones (below) from
+// where the guess lies; cold starts clamp every row.
 // The stage ends when the residual (residual.hpp) is within Options::tolerance (then it is the
 // answer, projected onto the bounds when that keeps it within tolerance: Result::iterations counts
 // its steps), or after DantzigParams::maxBlockSteps, no descent, a singular damped block or the
@@ -207,6 +208,23 @@
 // damped steps at rho = 0 (the full steps' factor reused, the line search keeping descent) until
 // one does not descend: 16.6 / 28.5 / 21.8 ms (8 / 14 / 10 steps: exact steps on the nearly
 // singular blocks jump to residual ~2e-3 and the line search then creeps).
+// Trusted guesses (DantzigParams::blockTrustedSets; a warm guess whose residual is within 1e-2, an
+// engine's own last answer). In the demo's steady state the guess's residual is 2-5e-5, yet the
+// natural map at it put 24-31 normals in the wrong set (traced at N = 300): coplanar face
+// contacts whose share of the load is ~1e-6 N s, whose w0 = A x0 + b is of the same size as the
+// change of b between steps (up to ~6e-5) and of either sign, so z = x0 - w0 sent loaded normals to
+// 0 and unloaded ones into the clamped set, while the answer kept every one of them where the guess
+// had it (the same zero / positive pattern) - and their friction rows followed the wrong normals.
+// The first full step from those sets jumped to residual 2-3e-3 and 4-8 more steps (1-3 fresh
+// factorizations) came back. The first sets are therefore taken from where the guess lies: a row
+// at a bound (within 1e-6 of it relatively: the adapter rotates a sliding friction row's last
+// impulse onto the new friction direction) is held there, the others are clamped; only the first
+// sets (the damped steps' natural map at their iterates is unchanged). The steady-state solves
+// then take 3 steps on one factorization (1-2 rows wrong: the normals that do go to 0 or come
+// back), the at-rest solves after SI 1 step (2 before). Ours-only CPU ms per step, old (HEAD
+// before) against new, alternated, two runs each: at rest after SI 5.7-6.0 -> 2.9-4.1; the demo's
+// first 300 steps 21.5-22.7 -> 11.4-13.2; its steady state (N = 300) 16.8-19.6 -> 7.3-8.8; after
+// the switch (the guess is SI's, not trusted) the same path, 270 pivots and steps per step.
 //
 // Result::iterations counts pivots (direction computations: each row added or exchanged)
 // summed over all passes; Options::maxPivots (0: 50 n + 100) limits them per pass
@@ -270,6 +288,10 @@ struct DantzigParams {
   // A full step whose index sets are those of two steps before (a 2-cycle) hands over to the
   // damped steps at once instead of repeating that step. Default true.
   bool blockBreakCycles = true;
+  // A warm guess whose residual is within 1e-2 takes its first index sets from where it lies
+  // (rows at a bound held there, the others clamped) instead of from the natural map at it (see
+  // "Trusted guesses" above). Default true.
+  bool blockTrustedSets = true;
 };
 
 class DantzigSolver : public Solver {
