@@ -94,9 +94,12 @@ class RowSystem {
 // x, so v = M^-1 J^T x up to round-off and w = A x + b is exact up to round-off as well. It reads
 // the packed rows only: step_i w_i = (1 - keep) x_i + shift + sA v (the sweep's own terms, scaled
 // back by 1 / step). The check thus needs no second pass over the rows to rebuild v (tests
-// compare it with accuracy() on the assembled problem); measured in session 5 (Bullet drop-in,
-// 210 boxes) it still costs about a sweep, ~50 us against ~43 us: by perf shares ~40% w from the
-// packed rows, ~60% accuracy() itself.
+// compare it with accuracy() on the assembled problem). It runs in blocks of 64 packed rows: w
+// of the block into an L1 buffer, then the block's rows through AccuracyAccumulator (the per-row
+// rule of accuracy(); bounds and findex read from the packed rows, so the engine path keeps no
+// copies of them). Session 6: ~20% fewer cycles than session 5's w vector then accuracy()
+// (perf, 210 boxes); one loop for both was slower than the two passes (it spilled the
+// accumulators to the stack, chaining every row through a store and a load).
 // The sweep is bound by the latency chain through the velocities of bodies shared by
 // consecutive rows (load v, dot, clamp, update v, store), not by memory. Four things keep the
 // chain short: ground rows take 8 zero-velocity world slots in turn (one shared slot chained
@@ -127,6 +130,24 @@ class RowSystem {
 // A_ii and the divisions of 8 rows first, then the rest (staging the rows through a stack array
 // cost +25%); the couplings' dots before the division and scaled after; the division moved
 // ahead of the findex checks and the run bookkeeping.
+// Session 6: the packing's cycles down ~18% (its share of a bench run's cycles 6.7% -> ~5.5%,
+// perf cycles:u, 210 boxes) by three changes: shorter addition chains (each coupling in four
+// partial sums, A_ii's linear and angular parts apart: a row's ~400 instructions retire only
+// after its longest chain, and a row does not fit the reorder buffer twice, so a row's latency
+// is the packing's throughput; the iterates move by round-off); the packed rows fetched for
+// writing 8 rows ahead (after the engine's setup they are out of L2); friction rows validated
+// from a compact findex array (reading the normal row's findex from its packed row, thousands
+// of rows back, missed L1 on every friction row). Tried without gain: the sweep's last coupling
+// subtracted after the clamp's other terms (one addition less on the chain between a run's
+// rows: 10 sweeps 1.15 -> 1.21x SI at 55 boxes); rowValid's sum as a tree; fetching 16 rows
+// ahead instead of 8 (within the noise). Not done, and why: the first sweep fused into the
+// packing (the brief's first candidate) cannot keep the iterates: with a warm start row i's
+// first update needs v = M^-1 J^T x_start over all rows, rows after i included, which only
+// exists after the packing; an engine's bodies hold it before (SI's setup applied the start),
+// but in the engine's rounding and order. Deriving step from Bullet's m_jacDiagABInv instead of
+// dividing: friction rows' Bullet denominator has no CFM while ours has (StockMlcp, Regularized),
+// contacts' is another rounding of A_ii (invMass + n . ((I^-1 (r x n)) x r)), and the RowSystem
+// path has no such number (bit for bit would need a RowSystem field: an API change).
 class RowPgs {
  public:
   Options& options() { return options_; }

@@ -100,6 +100,16 @@
 // the packing alone costs more than the gap (rows.hpp lists what it spends and what was tried).
 // The cached-impulse start (the default, not what --pgs-vs-si times) still reads the manifold
 // points in build() and keeps answers in remember().
+// Session 6 (packing with shorter addition chains and its rows fetched for writing, the check in
+// L1 blocks, one-component groups numbered without a per-row island lookup: rows.hpp,
+// islands.hpp): 10 sweeps 1.06-1.07x / 1.12x / 1.05-1.07x SI at 15 / 55 / 210 boxes against
+// 1.09-1.10x / 1.15-1.17x / 1.11-1.13x for session 5's code in the same two runs (alternated
+// per run, three more: 55 boxes 1.15-1.16x -> 1.09-1.10x, 210 boxes 1.12-1.16x -> 1.04-1.08x);
+// 20 sweeps 0.90-0.91x / 0.92-0.93x / 0.88-0.89x, 50 sweeps 0.78-0.81x / 0.78-0.88x /
+// 0.75x. Our stages at 210 boxes ~0.76 ms against SI's iterations ~0.69-0.72 ms (session 5's
+// code ~0.79-0.81 ms in the same runs). Still above 1.0x at 10 sweeps. The iterates moved by
+// round-off (the packing's sums), so over 300 steps of the pyramid the worst residuals differ
+// from session 5's (15 boxes 4.20e-3 -> 4.69e-3, SI's 4.22e-3) while the medians are the same.
 //
 // "si" runs Bullet's own SI iterations instead (for side-by-side runs with the same statistics).
 #pragma once

@@ -26,6 +26,11 @@
 // perf shares: see constraint_solver.hpp). Session 5: the conversion is read by the packing in
 // place (Source, inlined through RowPgs::solveFrom), and without the cached-impulse start the
 // points are not read at all: the split and numbering ~60 us at 210 boxes (~13 ns a row).
+// Session 6: a group that is one component (every dynamic body under one root after the
+// union-find, no inert row: a pile, a pyramid) skips the per-row island lookup and placing:
+// its rows are island 0 in their own order, the island's arrays are copies, only the bodies are
+// numbered (by first use, as the general numbering does; tested equal bit for bit to it). The
+// split's cycles ~30% fewer at 210 boxes (perf cycles:u share of build() and find()).
 #pragma once
 
 #include <BulletDynamics/ConstraintSolver/btSequentialImpulseConstraintSolver.h>
