@@ -766,6 +766,7 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
   const bool setsAtGuess = params_.blockTrustedSets && warm &&
                            (trusted || (!autoStage && residual(problem, x) <= kTrustedGuess));
   bool coldTrial = autoStage && !trusted;
+  bool continued = false;  // the cold trial's iterate is the block stage's start
   if (coldTrial && warm && coldMissed_ > 0 && coldMissedRows_ == problem.size()) {
     coldTrial = coldMissed_ % std::max(1, params_.autoColdRetry) == 0;
     ++coldMissed_;
@@ -786,8 +787,16 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
       return;
     }
     blockMessage = "cold trial: " + rep.message;
+    // A cold solve whose trial came within kTrustedGuess continues from the trial's best iterate
+    // (Bullet's first step of a new pyramid: a few steps, where pivoting from zero took ~5600).
+    if (!warm && params_.autoColdContinue && problem.size() >= params_.autoWarmMinRows &&
+        residual(problem, trial) <= kTrustedGuess) {
+      x = trial;
+      continued = true;
+    }
   }
-  const bool warmStage = warm && (trusted || problem.size() >= params_.autoWarmMinRows);
+  const bool warmStage =
+      (warm || continued) && (trusted || problem.size() >= params_.autoWarmMinRows);
   const bool blockIterate = warmStage || params_.blockStage == DantzigParams::BlockStage::Always;
   if (blockIterate) {
     const detail::BlockPivoting::Report rep = block_->run(

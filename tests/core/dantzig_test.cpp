@@ -943,6 +943,33 @@ TEST(DantzigBlock, TrustedGuessSetsTakeFewerSteps) {
   EXPECT_LT(atGuess, naturalMap) << "block steps with and without blockTrustedSets";
 }
 
+// Auto, cold: a trial that does not settle but comes within 1e-2 is continued by the block stage
+// from its best iterate (autoColdContinue) instead of pivoting from zero. A 15-box pyramid with
+// cfm 1e-3 / dt (its trial ends at residual ~8e-3): the stage settles in 2 more steps where the
+// pivoting took ~430 pivots; the same answer (A is positive definite).
+TEST(DantzigBlock, AutoColdTrialWithinTrustContinues) {
+  test::PyramidSpec spec;
+  spec.cfm = 1e-3 / spec.dt;
+  test::BoxPyramid pyramid(spec);
+  pyramid.nextStep(1e-4);
+  const Problem p = pyramid.rows().assemble(true);
+  Vector x[2];
+  int pivotsAndSteps[2];
+  for (int cfg = 0; cfg < 2; ++cfg) {
+    DantzigSolver s = withStage(DantzigParams::BlockStage::Auto);
+    s.params().autoWarmMinRows = 100;  // n = 300
+    s.params().autoColdContinue = cfg == 1;
+    const Result r = s.solve(p, x[cfg]);
+    ASSERT_TRUE(r.converged()) << r.message;
+    EXPECT_LE(accuracy(p, x[cfg]).residual, s.options().tolerance);
+    ASSERT_NE(r.message.find("cold trial"), std::string::npos) << r.message;
+    EXPECT_EQ(s.blockSettled(), cfg == 1) << r.message;
+    pivotsAndSteps[cfg] = r.iterations;
+  }
+  EXPECT_LT(pivotsAndSteps[1], pivotsAndSteps[0]);
+  EXPECT_LE((x[1] - x[0]).lpNorm<Eigen::Infinity>(), 1e-9 * (1 + x[0].lpNorm<Eigen::Infinity>()));
+}
+
 // A full step whose sets are those of two steps before would repeat that step's x: with
 // blockBreakCycles the stage goes to the damped steps at once. Random friction pyramids from
 // random guesses where the full steps 2-cycle: fewer steps, never a wrong status (a few of

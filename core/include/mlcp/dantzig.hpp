@@ -225,6 +225,15 @@
 // before) against new, alternated, two runs each: at rest after SI 5.7-6.0 -> 2.9-4.1; the demo's
 // first 300 steps 21.5-22.7 -> 11.4-13.2; its steady state (N = 300) 16.8-19.6 -> 7.3-8.8; after
 // the switch (the guess is SI's, not trusted) the same path, 270 pivots and steps per step.
+// The demo's first step is cold (no cached impulses): its cold trial ended at residual 2.6e-3
+// after 3 full steps and the pivoting from zero then took ~5600 pivots and 11 friction passes
+// (~0.45 s CPU, 1.5 ms of the 300-step mean; under load its wall time passed bullet_bench's 1 s
+// limit, which then stopped the configuration after that step). A trial that comes within 1e-2
+// is now continued by the block stage from its best iterate (DantzigParams::autoColdContinue):
+// 3 more steps, ~25 ms. Synthetic pyramids' trials end at 0.09-0.15 (unchanged: pivoting from
+// zero). With both: the demo's first 300 steps 11.4-11.5 ms (5 pivots and steps per step, 23-26
+// before) against 19.4-24.5 for HEAD before this session, steady state 5.1-5.3 against 12.7-17.7,
+// at rest after SI 3.0-3.1 against 4.0-5.4 (ours only, CPU ms, alternated, two runs).
 //
 // Result::iterations counts pivots (direction computations: each row added or exchanged)
 // summed over all passes; Options::maxPivots (0: 50 n + 100) limits them per pass
@@ -247,7 +256,8 @@ struct DantzigParams {
     // n >= autoMinRows and at most autoMaxDensity n^2 nonzeros in A: a warm guess whose
     // residual is within 1e-2 (an engine's own last answers at rest) gets up to maxBlockSteps
     // from it at once; otherwise first a trial of autoColdSteps from the cold guess (dropped
-    // when it does not settle), then warm starts with n >= autoWarmMinRows get up to
+    // when it does not settle, unless autoColdContinue applies), then warm starts with n >=
+    // autoWarmMinRows get up to
     // maxBlockSteps from their guess; the others pivot from their guess (cold: from zero).
     Auto,
     Always,  // whenever it applies (Exact friction, symmetric A), cold starts too
@@ -268,6 +278,10 @@ struct DantzigParams {
   // same size skip the trial except every autoColdRetry-th one (a trial that settles, or a
   // problem of another size, resets this). Default 8.
   int autoColdRetry = 8;
+  // Auto: a cold solve of at least autoWarmMinRows rows whose cold trial did not settle but came
+  // within 1e-2 (residual) continues the block stage from the trial's best iterate (else the
+  // incremental pivoting runs from zero). Default true.
+  bool autoColdContinue = true;
   // Auto: the smallest problem (rows) whose warm start gets the block stage after an unsettled
   // cold trial; smaller ones go to the incremental pivoting from their guess, which is cheaper
   // there than the damped steps (Bullet's 15-box pyramid, n = 280: ~4 ms against ~9 ms).
