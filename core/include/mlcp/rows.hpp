@@ -97,9 +97,10 @@ class RowSystem {
 // compare it with accuracy() on the assembled problem). It runs in blocks of 64 packed rows: w
 // of the block into an L1 buffer, then the block's rows through AccuracyAccumulator (the per-row
 // rule of accuracy(); bounds and findex read from the packed rows, so the engine path keeps no
-// copies of them). Session 6: ~20% fewer cycles than session 5's w vector then accuracy()
-// (perf, 210 boxes); one loop for both was slower than the two passes (it spilled the
-// accumulators to the stack, chaining every row through a store and a load).
+// copies of them). Session 6 (stage timers, 210 boxes, median per step): ~46 us against ~49
+// us for session 5's w vector then accuracy(); one loop for both was slower than the two
+// passes (it spilled the accumulators to the stack, chaining every row through a store and a
+// load).
 // The sweep is bound by the latency chain through the velocities of bodies shared by
 // consecutive rows (load v, dot, clamp, update v, store), not by memory. Four things keep the
 // chain short: ground rows take 8 zero-velocity world slots in turn (one shared slot chained
@@ -130,8 +131,8 @@ class RowSystem {
 // A_ii and the divisions of 8 rows first, then the rest (staging the rows through a stack array
 // cost +25%); the couplings' dots before the division and scaled after; the division moved
 // ahead of the findex checks and the run bookkeeping.
-// Session 6: the packing's cycles down ~18% (its share of a bench run's cycles 6.7% -> ~5.5%,
-// perf cycles:u, 210 boxes) by three changes: shorter addition chains (each coupling in four
+// Session 6: packing ~200-220 us against ~250-255 us at 210 boxes (stage timers, median per
+// step, quiet runs; ~44 ns a row) by three changes: shorter addition chains (each coupling in four
 // partial sums, A_ii's linear and angular parts apart: a row's ~400 instructions retire only
 // after its longest chain, and a row does not fit the reorder buffer twice, so a row's latency
 // is the packing's throughput; the iterates move by round-off); the packed rows fetched for

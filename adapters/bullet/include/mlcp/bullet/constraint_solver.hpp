@@ -106,8 +106,10 @@
 // 1.09-1.10x / 1.15-1.17x / 1.11-1.13x for session 5's code in the same two runs (alternated
 // per run, three more: 55 boxes 1.15-1.16x -> 1.09-1.10x, 210 boxes 1.12-1.16x -> 1.04-1.08x);
 // 20 sweeps 0.90-0.91x / 0.92-0.93x / 0.88-0.89x, 50 sweeps 0.78-0.81x / 0.78-0.88x /
-// 0.75x. Our stages at 210 boxes ~0.76 ms against SI's iterations ~0.69-0.72 ms (session 5's
-// code ~0.79-0.81 ms in the same runs). Still above 1.0x at 10 sweeps. The iterates moved by
+// 0.75x. Stage timers at 210 boxes (median per step, quiet runs, session 5's code in brackets):
+// split and numbering ~42-46 us (~53-56), packing ~200-220 us (~250-255), sweeps ~425-460 us
+// (~425-450, unchanged), check ~46 us (~49), storing impulses ~20 us (~20): ~0.75 ms (~0.80)
+// against SI's iterations ~0.67-0.72 ms. Still above 1.0x at 10 sweeps. The iterates moved by
 // round-off (the packing's sums), so over 300 steps of the pyramid the worst residuals differ
 // from session 5's (15 boxes 4.20e-3 -> 4.69e-3, SI's 4.22e-3) while the medians are the same.
 //

@@ -30,7 +30,7 @@
 // union-find, no inert row: a pile, a pyramid) skips the per-row island lookup and placing:
 // its rows are island 0 in their own order, the island's arrays are copies, only the bodies are
 // numbered (by first use, as the general numbering does; tested equal bit for bit to it). The
-// split's cycles ~30% fewer at 210 boxes (perf cycles:u share of build() and find()).
+// split and numbering at 210 boxes ~42-46 us against ~53-56 us (stage timers, median per step).
 #pragma once
 
 #include <BulletDynamics/ConstraintSolver/btSequentialImpulseConstraintSolver.h>
