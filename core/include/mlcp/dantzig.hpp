@@ -165,27 +165,28 @@
 // other step budgets before the hand-over (CPU ms per step: 20 steps 123-137, 40 steps 85-88, 70
 // steps 92-98: the damped steps' linear rate does not beat the pivoting's finish).
 // Steady state of a demo that uses this solver from the start (bullet_bench --warmup 0 --settle
-// N --steps 10, 55 boxes, n = 1160, m ~ 800 clamped rows, L ~ 43k entries): each simulation step
-// ~13 normals change set (coplanar face contacts whose share of the load goes to 0 and back) with
-// their friction rows; from the guess the stage takes 4-15 steps: full steps, each later one
-// reusing the first's factor (N = 80: p = 25 bordered rows on average, their Schur complement
-// ~0.6 ms, against ~2-2.5 ms for a fresh LDL^T with its assembly), and when they stop improving
-// damped steps whose rho changes every step (a fresh factorization each). Two patterns cost most
-// of the fresh factorizations (traced at N = 150 and 300): the full steps 2-cycle between two sets
-// near the answer (residual ~1e-5, merits repeating exactly) until the 3 uphill steps are spent,
-// then 1-2 damped steps settle; and on about every other solve the first full step lands above
-// the guess's merit (residual 5e-2 from a guess at ~1e-3) while the next ones descend, so the 3
-// uphill steps ran out and 7-10 damped steps (7-10 factorizations) followed. blockBreakCycles and
-// blockDescentSteps remove both: traced at N = 120, the solves then finished in 4-8 full steps on
-// one factorization (one of 15 took a damped step).
-// The counts are chaotic in N (rounding changes the trajectory): CPU ms per step (steps per
-// simulation step), with both against without (HEAD before them), alternated, two runs (three
-// at N = 150 and 300): N = 80: 11.3-12.7 (6) against 11.1-11.3 (5); N = 120: 8.8 (5) against
-// 8.2 (4); N = 150: 9.7-11.9 (6) against 11.0-11.4 (6); N = 200: 10.0 (7) against 12.4 (6); N =
-// 300: 12.7-19.2 (6) against 22.8-24.9 (9). Against the LU for sliding rows without reuse (earlier,
-// other runs): N = 80 26-28 (8), N = 150 15-19 (4), N = 300 66-74 (15). Stock MLCP-Dantzig took
-// 285-420 ms per step in earlier runs on this loaded machine (not re-measured), so 15-43x: the
-// 20x goal is still not met at every N. At rest after SI
+// N --steps 10, 55 boxes, n = 1160, m ~ 800 clamped rows, L ~ 43k entries), with the first sets
+// from the natural map at the guess (as before blockTrustedSets; "Trusted guesses" below for
+// now): each simulation step ~13 normals change set (coplanar face contacts whose share of the
+// load goes to 0 and back) with their friction rows; from the guess the stage takes 4-15 steps:
+// full steps, each later one reusing the first's factor (N = 80: p = 25 bordered rows on average,
+// their Schur complement ~0.6 ms, against ~2-2.5 ms for a fresh LDL^T with its assembly), and when
+// they stop improving damped steps whose rho changes every step (a fresh factorization each). Two
+// patterns cost most of the fresh factorizations (traced at N = 150 and 300): the full steps
+// 2-cycle between two sets near the answer (residual ~1e-5, merits repeating exactly) until the 3
+// uphill steps are spent, then 1-2 damped steps settle; and on about every other solve the first
+// full step lands above the guess's merit (residual 5e-2 from a guess at ~1e-3) while the next ones
+// descend, so the 3 uphill steps ran out and 7-10 damped steps (7-10 factorizations) followed.
+// blockBreakCycles and blockDescentSteps remove both: traced at N = 120, the solves then finished
+// in 4-8 full steps on one factorization (one of 15 took a damped step). The counts are chaotic in
+// N (rounding changes the trajectory): CPU ms per step (steps per simulation step), with both
+// against without (HEAD before them), alternated, two runs (three at N = 150 and 300): N =
+// 80: 11.3-12.7 (6) against 11.1-11.3 (5); N = 120: 8.8 (5) against 8.2 (4); N = 150: 9.7-11.9 (6)
+// against 11.0-11.4 (6); N = 200: 10.0 (7) against 12.4 (6); N = 300: 12.7-19.2 (6)
+// against 22.8-24.9 (9). Against the LU for sliding rows without reuse (earlier, other runs): N =
+// 80 26-28 (8), N = 150 15-19 (4), N = 300 66-74 (15). Stock MLCP-Dantzig took 285-420 ms per step
+// in earlier runs on this loaded machine (not re-measured), so 15-43x: the 20x goal is still not
+// met at every N. At rest after SI
 // (--warmup 30 --settle 60, 2 steps, same trajectory) 3.8-5.6 against 3.8-5.8 ms. After the
 // switch (--warmup 30: 40 damped steps, then the pivoting) 270 against 263 pivots and steps per
 // step, 77-100 against 79-106 ms (the machine's noise; the damped steps there have more than
@@ -234,6 +235,25 @@
 // zero). With both: the demo's first 300 steps 11.4-11.5 ms (5 pivots and steps per step, 23-26
 // before) against 19.4-24.5 for HEAD before this session, steady state 5.1-5.3 against 12.7-17.7,
 // at rest after SI 3.0-3.1 against 4.0-5.4 (ours only, CPU ms, alternated, two runs).
+// Whole bullet_bench runs (stock MLCP-Dantzig in the same run, CPU ms per step, two runs, HEAD
+// before this session's two changes run between them): the demo's first 300 steps 14.9-16.0
+// against stock's 283.6-325.2 (19.0-20.3x; before 17.4x, and 12.8x in a run where stock's wall
+// time passed the 1 s limit and it stopped early), its steady state 5.6 against 261.5-448.5
+// (47-80x; before 12.5-14.7x), at rest after SI 2.9-3.6 against 258-263 (71-90x; before 50-72x),
+// after the switch 76.9-112.8 against 386-518 (4.6-5.0x; before 5.8-6.0x: the same path, noise).
+// ODE piles (ode_bench 10 5, two runs, alternated): the same path (the stepper's guesses are not
+// trusted; the cold trial settles), 12.2x dWorldStep at 588 rows against 11.7-12.7x before, 83-101x
+// at 1728 against 83-90x.
+// What the demo's first 300 steps still cost: about half is steps 2-30 (the pyramid falling
+// into place), 15-34 full steps per solve with 30-200 sliding rows, each a fresh LU (no reuse).
+// Tried in session 6 without gain: (a) for a normal whose zero / positive state changed between
+// the last two simulation steps, the adapter's start from the answer two steps back (the chatter
+// is period 2: ~5-8 such normals flip against the last step per 800 contacts, 0-1 against two
+// steps back; but the wrong first sets were the natural map's, not those normals): steady state
+// 17.5 against 17.7 ms without trusted sets, 8.7 against 5.4 with them (single runs); (b) more
+// Woodbury rows and reuse (blockWoodburyRows / blockUpdateRows 32 / 64, 64 / 64, 64 / 96 against
+// 16 / 40, with both changes above): the first 300 steps 10.3 / 11.8 / 14.4 against 11.2 ms,
+// steady state 5.1 / 6.6 / 12.2 against 5.4 (single runs; the step counts are chaotic).
 //
 // Result::iterations counts pivots (direction computations: each row added or exchanged)
 // summed over all passes; Options::maxPivots (0: 50 n + 100) limits them per pass
