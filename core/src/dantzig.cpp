@@ -762,9 +762,10 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
   // A warm solve also skips it while the last trial of this solver missed (an engine whose
   // cold sets are never right: Bullet's moving pyramid), re-trying every autoColdRetry solves.
   const bool autoStage = params_.blockStage == DantzigParams::BlockStage::Auto;
-  const bool trusted = warm && autoStage && residual(problem, x) <= kTrustedGuess;
-  const bool setsAtGuess = params_.blockTrustedSets && warm &&
-                           (trusted || (!autoStage && residual(problem, x) <= kTrustedGuess));
+  const double guessResidual = warm ? residual(problem, x) : kInf;
+  const bool trusted = autoStage && guessResidual <= kTrustedGuess;
+  const bool setsAtGuess =
+      params_.blockTrustedSets && warm && guessResidual <= params_.blockSetsAtGuessResidual;
   bool coldTrial = autoStage && !trusted;
   bool continued = false;  // the cold trial's iterate is the block stage's start
   if (coldTrial && warm && coldMissed_ > 0 && coldMissedRows_ == problem.size()) {

@@ -244,8 +244,13 @@
 // ODE piles (ode_bench 10 5, two runs, alternated): the same path (the stepper's guesses are not
 // trusted; the cold trial settles), 12.2x dWorldStep at 588 rows against 11.7-12.7x before, 83-101x
 // at 1728 against 83-90x.
-// What the demo's first 300 steps still cost: about half is steps 2-30 (the pyramid falling
-// into place), 15-34 full steps per solve with 30-200 sliding rows, each a fresh LU (no reuse).
+// What the demo's first 300 steps cost (traced, per solve: block steps, factorizations, sliding
+// rows, set changes): about half of the block stage's time is solves 5-30 (the pyramid falling
+// into place), 12-29 block steps each, every one a fresh factorization (mostly the LU: 40-240
+// sliding rows), ~2.5 ms each (LDL^T with its capacitance ~2.1 ms, a reused factor ~0.4 ms);
+// 70% of those solves' CPU time is the numeric factorization itself. The full steps change
+// 30-570 rows each (no reuse applies), and their first sets were the natural map's: the guesses
+// there (our last answers) have residuals 2e-2..5e-2, outside the trusted 1e-2.
 // Tried in session 6 without gain: (a) for a normal whose zero / positive state changed between
 // the last two simulation steps, the adapter's start from the answer two steps back (the chatter
 // is period 2: ~5-8 such normals flip against the last step per 800 contacts, 0-1 against two
@@ -254,6 +259,21 @@
 // Woodbury rows and reuse (blockWoodburyRows / blockUpdateRows 32 / 64, 64 / 64, 64 / 96 against
 // 16 / 40, with both changes above): the first 300 steps 10.3 / 11.8 / 14.4 against 11.2 ms,
 // steady state 5.1 / 6.6 / 12.2 against 5.4 (single runs; the step counts are chaotic).
+// Guesses of a moving scene (DantzigParams::blockSetsAtGuessResidual, session 6 round 2). The
+// first sets are taken from where every warm guess lies, not only a trusted one's (the cold-trial
+// rule keeps kTrustedGuess = 1e-2). Traced on the falling pyramid (solve 8): the natural map at
+// the guess (residual 4.7e-2) put 566 rows in the wrong set and the first full step jumped to
+// residual 1.1; from where the guess lies 113 rows changed and the first step reached 1.3e-2.
+// Block steps over the demo's first 300 solves 1661 -> 1351 (any limit from 0.1 to 100 gave
+// 1351-1368); after the switch (SI's guesses, residual 0.1-0.7) 674 -> 625 over 20 solves, but
+// pivots and steps per step 156 -> 166; the steady state's pivots and steps per step 4 -> 3;
+// ODE's piles unchanged (their cold trial settles: no warm stage). Ours-only CPU ms per step, old
+// (HEAD before) against new, alternated, two runs each: the first 300 steps 13.4-13.7 -> 11.9-12.4
+// (another pair 17.2 / 13.0 -> 12.9 / 10.3), steady state (--settle 300) 5.9-6.2 -> 5.6-5.7, at
+// rest after SI 2.9-3.7 -> 2.7-4.5, after the switch 86-129 -> 100-109 (the machine's noise: a
+// CI run used both cores). Tried without gain there: the natural map's set for rows whose |w0|
+// exceeds 1e-3 / 1e-2 / 1e-1 (1 + |b|) (new contacts), the guess's elsewhere: 1532 / 2174 / 1452
+// block steps against 1351; blockDescentSteps 0 / 2 / 4 against 8: 2223 / 1342 / 1350 (chaotic).
 //
 // Result::iterations counts pivots (direction computations: each row added or exchanged)
 // summed over all passes; Options::maxPivots (0: 50 n + 100) limits them per pass
@@ -322,10 +342,14 @@ struct DantzigParams {
   // A full step whose index sets are those of two steps before (a 2-cycle) hands over to the
   // damped steps at once instead of repeating that step. Default true.
   bool blockBreakCycles = true;
-  // A warm guess whose residual is within 1e-2 takes its first index sets from where it lies
-  // (rows at a bound held there, the others clamped) instead of from the natural map at it (see
-  // "Trusted guesses" above). Default true.
+  // A warm guess whose residual is within blockSetsAtGuessResidual takes its first index sets from
+  // where it lies (rows at a bound held there, the others clamped) instead of from the natural map
+  // at it (see "Trusted guesses" above). Default true.
   bool blockTrustedSets = true;
+  // The largest residual (residual.hpp) of a warm guess that blockTrustedSets applies to (1e-2:
+  // an engine's own last answers at rest only, the rule before "Guesses of a moving scene"
+  // above). Default infinity (every warm guess).
+  double blockSetsAtGuessResidual = kInf;
 };
 
 class DantzigSolver : public Solver {
