@@ -274,14 +274,14 @@
 // CI run used both cores). Tried without gain there: the natural map's set for rows whose |w0|
 // exceeds 1e-3 / 1e-2 / 1e-1 (1 + |b|) (new contacts), the guess's elsewhere: 1532 / 2174 / 1452
 // block steps against 1351; blockDescentSteps 0 / 2 / 4 against 8: 2223 / 1342 / 1350 (chaotic).
-// Whole bullet_bench run with stock in the same run (one run, under the CI's load): the first 300
-// steps 9.7 ms against stock's 290 ms CPU (30x; wall 42x). ODE (ode_bench 10 5, two runs): 11.6x
-// and 14.2x dWorldStep at 588 rows, 77x and 105x at 1728, the same residuals as before.
-// Also tried there without gain: the LU's inner loop on interleaved (L, U) and (y, z) pairs, plain
-// and with SSE2 packed operations (the loop is bound by its scattered loads, not by instructions:
-// 40 steps 34-38 against 34-46 ms CPU, alternated, three runs); no iterative refinement in the
-// block steps (pivots and steps per step 4 -> 5 in the first 300 steps, 3 -> 4 in the steady
-// state, times within the noise).
+// Whole bullet_bench runs with stock in the same run (two runs, under the CI's load): the first 300
+// steps 9.7 / 9.3 ms against stock's 290 / 277 ms CPU (30.1x / 29.8x; wall 41.8x / 29.3x). ODE
+// (ode_bench 10 5, two runs): 11.6x and 14.2x dWorldStep at 588 rows, 77x and 105x at 1728, the
+// same residuals as before. Also tried there without gain: the LU's inner loop on interleaved (L,
+// U) and (y, z) pairs, plain and with SSE2 packed operations (the loop is bound by its scattered
+// loads, not by instructions: 40 steps 34-38 against 34-46 ms CPU, alternated, three runs); no
+// iterative refinement in the block steps (pivots and steps per step 4 -> 5 in the first 300 steps,
+// 3 -> 4 in the steady state, times within the noise).
 //
 // Result::iterations counts pivots (direction computations: each row added or exchanged)
 // summed over all passes; Options::maxPivots (0: 50 n + 100) limits them per pass
