@@ -279,9 +279,10 @@
 // (ode_bench 10 5, two runs): 11.6x and 14.2x dWorldStep at 588 rows, 77x and 105x at 1728, the
 // same residuals as before. Also tried there without gain: the LU's inner loop on interleaved (L,
 // U) and (y, z) pairs, plain and with SSE2 packed operations (the loop is bound by its scattered
-// loads, not by instructions: 40 steps 34-38 against 34-46 ms CPU, alternated, three runs); no
-// iterative refinement in the block steps (pivots and steps per step 4 -> 5 in the first 300 steps,
-// 3 -> 4 in the steady state, times within the noise).
+// loads, not by instructions: the first 40 steps 36-41 (pairs) and 36-58 (SSE2) against 33-46 and
+// 34-38 ms CPU without, alternated, three runs each); no iterative refinement in the block steps
+// (pivots and steps per step 4 -> 5 in the first 300 steps, 3 -> 4 in the steady state, times
+// within the noise).
 //
 // Result::iterations counts pivots (direction computations: each row added or exchanged)
 // summed over all passes; Options::maxPivots (0: 50 n + 100) limits them per pass
