@@ -9,13 +9,8 @@ Accuracy accuracy(const Vector& x, const Vector& w, const Vector& lo, const Vect
                   const std::vector<int>& findex, double bInfNorm) {
   AccuracyAccumulator a;
   for (Eigen::Index i = 0; i < x.size(); ++i) {
-    double l = lo[i], h = hi[i];
-    if (!findex.empty() && findex[i] >= 0) {
-      const double normal = std::abs(x[findex[i]]);
-      l *= normal;
-      h *= normal;
-    }
-    if (!a.add(x[i], w[i], l, h)) break;
+    const int f = findex.empty() ? -1 : findex[i];
+    if (!a.add(x[i], w[i], lo[i], hi[i], f, x.data())) break;
   }
   return a.result(bInfNorm);
 }

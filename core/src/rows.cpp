@@ -374,13 +374,7 @@ Result RowPgs::iteratePacked(int bodies, Vector& x, double bNorm, double t0) {
     }
     for (int k = 0; k < count; ++k) {
       const PackedRow& p = rows[k];
-      double lo = p.lo, hi = p.hi;
-      if (p.findex >= 0) {
-        const double normal = std::abs(xs[p.findex]);
-        lo *= normal;
-        hi *= normal;
-      }
-      if (!a.add(xs[first + k], w[k], lo, hi)) return a.result(bNorm);
+      if (!a.add(xs[first + k], w[k], p.lo, p.hi, p.findex, xs)) return a.result(bNorm);
     }
   }
   return a.result(bNorm);

@@ -35,7 +35,7 @@ double residual(const Problem& problem, const Vector& x);
 
 // The per-row rule all of the accuracy() functions run, for a solver that has w one row at a
 // time (RowPgs' check computes w_i from its packed rows and feeds it here: one pass, no w
-// vector). add() every row with its effective bounds (findex applied), then result().
+// vector). add() every row (with its findex, or with its effective bounds), then result().
 class AccuracyAccumulator {
  public:
   // false once x or w was not finite: the result is then +inf whatever follows.
@@ -49,6 +49,15 @@ class AccuracyAccumulator {
         std::max(complementarity_, gapTimes(lo, x, w, 1.0) + gapTimes(hi, x, -w, -1.0));
     boundViolation_ = std::max({boundViolation_, lo - x, x - hi});
     return true;
+  }
+  // A row with friction coupling (f >= 0): its bounds are lo |x_f| .. hi |x_f| (xs: all of x).
+  bool add(double x, double w, double lo, double hi, int f, const double* xs) {
+    if (f >= 0) {
+      const double normal = std::abs(xs[f]);
+      lo *= normal;
+      hi *= normal;
+    }
+    return add(x, w, lo, hi);
   }
   // bInfNorm: ||b||_inf of the problem.
   Accuracy result(double bInfNorm) const {
