@@ -396,23 +396,14 @@ Result RowPgs::iterate(Vector& x, double bNorm, double t0) {
     result.message = "empty problem";
   }
   double* xs = x.data();
-  // One row's update from jv = step J_i v; returns the change of x_i that moves the velocities.
-  auto update = [&](const PackedRow& p, int i, double jv) {
-    double lo = p.lo, hi = p.hi;
-    if (p.findex >= 0) {
-      const double normal = std::abs(xs[p.findex]);
-      lo *= normal;
-      hi *= normal;
-    }
-    // The new x is clamp(c - jv, lo, hi) with c = keep x - shift. The change that moves the
-    // velocities is clamped on its own, clamp((c - x) - jv, lo - x, hi - x) (the same up to
-    // round-off), so that the chain does not wait for the subtraction x_new - x.
-    const double xo = xs[i], c = p.keep * xo - p.shift;
-    const double dx = std::clamp((c - xo) - jv, lo - xo, hi - xo);
-    xs[i] = std::clamp(c - jv, lo, hi);
-    return dx;
-  };
-  for (int sweep = 1; n > 0 && sweep <= opt.maxIterations; ++sweep) {
+  auto update = [&](const PackedRow& p, int i, double jv) { return RowPgs::update(p, xs, i, jv); };
+  // pack() may have done the first sweep already.
+  int sweep = 1 + fusedSweeps_;
+  if (n > 0 && fusedSweeps_ && monitor.wantsCheck(fusedSweeps_)) {
+    check();
+    if (monitor.stop(fusedSweeps_, last)) sweep = opt.maxIterations + 1;
+  }
+  for (; n > 0 && sweep <= opt.maxIterations; ++sweep) {
     const double* coupling = coupling_.data();
     for (int i = 0; i < n;) {
       const PackedRow& first = packed_[i];
