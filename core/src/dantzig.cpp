@@ -7,6 +7,7 @@
 
 #include "dantzig_block.hpp"
 #include "dantzig_small.hpp"
+#include "mlcp/pgs.hpp"
 #include "mlcp/residual.hpp"
 #include "sparse_pattern.hpp"
 
@@ -31,6 +32,17 @@ constexpr double kTrustedGuess = 1e-2;
 // Sizes (rows of a product or of the clamped block) up to which plain loops beat Eigen's
 // vectorized kernels: islands of a few joints.
 constexpr int kSmall = 8;
+
+// Projected Gauss-Seidel sweeps (pgs.hpp) over x; none when a diagonal entry is not positive.
+void preSweeps(const Problem& problem, int sweeps, Vector& x) {
+  Vector invDiag(problem.size());
+  for (int i = 0; i < problem.size(); ++i) {
+    const double d = problem.diagonal(i);
+    if (!(d > 0)) return;
+    invDiag[i] = 1.0 / d;
+  }
+  for (int k = 0; k < sweeps; ++k) detail::pgsSweep(problem, invDiag, 1.0, x);
+}
 
 }  // namespace
 
@@ -800,6 +812,10 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
       (warm || continued) && (trusted || problem.size() >= params_.autoWarmMinRows);
   const bool blockIterate = warmStage || params_.blockStage == DantzigParams::BlockStage::Always;
   if (blockIterate) {
+    // A guess far from the answer (Bullet's pyramid right after the switch from SI) starts the
+    // block stage from a few projected Gauss-Seidel sweeps over it ("Pre-sweeps" in dantzig.hpp).
+    if (warm && params_.blockPgsSweeps > 0 && guessResidual > params_.blockPgsResidual)
+      preSweeps(problem, params_.blockPgsSweeps, x);
     const detail::BlockPivoting::Report rep = block_->run(
         problem, x, options(), std::max(1, params_.maxBlockSteps), false, symmetric, setsAtGuess);
     blockSteps_ += rep.steps;

@@ -9,6 +9,14 @@
 
 namespace mlcp {
 
+void detail::pgsSweep(const Problem& problem, const Vector& invDiag, double omega, Vector& x) {
+  for (int i = 0; i < problem.size(); ++i) {
+    const double wi = problem.rowDot(i, x) + problem.b[i];
+    const double xi = x[i] - omega * wi * invDiag[i];
+    x[i] = std::clamp(xi, problem.effectiveLo(i, x), problem.effectiveHi(i, x));
+  }
+}
+
 std::string PgsSolver::refuse(const Problem&) const { return ""; }
 
 std::string GaussSeidelSolver::refuse(const Problem& problem) const {
@@ -53,11 +61,7 @@ void PgsSolver::run(const Problem& problem, Vector& x, Result& result) {
   const double omega = opt.relaxation;
   detail::SweepMonitor monitor(opt, result);
   for (int sweep = 1; sweep <= opt.maxIterations; ++sweep) {
-    for (int i = 0; i < n; ++i) {
-      const double wi = problem.rowDot(i, x) + problem.b[i];
-      const double xi = x[i] - omega * wi * invDiag[i];
-      x[i] = std::clamp(xi, problem.effectiveLo(i, x), problem.effectiveHi(i, x));
-    }
+    detail::pgsSweep(problem, invDiag, omega, x);
     if (monitor.wantsCheck(sweep) && monitor.stop(sweep, accuracy(problem, x))) return;
   }
 }

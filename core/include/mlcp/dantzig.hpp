@@ -283,6 +283,32 @@
 // 34-38 ms CPU without, alternated, three runs each); no iterative refinement in the block steps
 // (pivots and steps per step 4 -> 5 in the first 300 steps, 3 -> 4 in the steady state, times
 // within the noise).
+// Pre-sweeps (DantzigParams::blockPgsSweeps, blockPgsResidual; session 7). Right after the switch
+// from SI the guesses' residuals are 0.19-0.8 and every solve took 40 damped block steps (fresh
+// factorizations) and then 56-540 pivots. Traced over the first 10 solves: the start had 75-407
+// rows in another set than the answer (7-139 normals positive at the start and 0 at the answer,
+// by up to 0.5; 80-200 friction rows inside their bounds at the start and sliding at the answer).
+// Projected Gauss-Seidel from the guess (K = 10 / 30 / 100 sweeps) reaches residual ~1e-2 / 3e-3 /
+// 1e-3 but still leaves 60-380 rows in the wrong set (the exact answer's split of the load among
+// coplanar contacts hangs on cfm-sized terms that the sweeps do not resolve): pivoting from the
+// PGS iterate after 1 block step took 600-3300 pivots, its sets alone (the block stage from the
+// guess) 279 pivots and steps per step against 301 without. As a start point the iterate pays:
+// the damped steps start near 1e-2 instead of 0.2-0.8 and more solves settle within maxBlockSteps.
+// K = 5 (any of 2-8 alike): over 10 solves block steps 402 -> 358, pivots 2616 -> 1031; over 30
+// solves 753 -> 626 and 2618 -> 1054; pivots and steps per step (bullet_bench --steps 10) 301 ->
+// 138 (K = 10 / 15 / 20, sweeps above 1e-2: 135 / 217 / 297). PGS sweeps between damped steps (3 or
+// 10 after each, kept when they lower the merit, as PGS-SM alternates them): 784-1209, worse. The
+// falling pyramid's own last answers (residual 0.01-0.3 in solves 5-30 of a demo) are made worse
+// starts by the sweeps (rows in the wrong set 67 -> 205: the guess already has the exact answer's
+// structure, the sweeps blur it; block steps per solve up to 3x), hence blockPgsResidual = 0.2:
+// after the switch 9 of 10 solves get them, of the demo's first 300 solves 2 (block steps 1346 ->
+// 1352). Ours-only CPU ms per step, old (HEAD before) against new, alternated, two runs each,
+// load average ~3: after the switch 129.8-129.9 -> 94.9-98.2 (30 steps: 69.2-84.2 -> 50.3-52.1;
+// pivots and steps per step 112 -> 56); the first 300 steps 12.4-13.3 -> 10.0-16.0 (noise: 4
+// per step both), steady state 5.7-7.7 -> 7.3 (the same path), at rest after SI 4.4-4.8 ->
+// 3.4-5.1 (the same path). ODE (ode_bench 10 5): the same path (no solve gets the sweeps: the
+// cold trial settles), 13.6-13.8x -> 11.9-12.0x dWorldStep at 588 rows, 94-103x -> 84-95x at
+// 1728 (noise), the same residuals.
 //
 // Result::iterations counts pivots (direction computations: each row added or exchanged)
 // summed over all passes; Options::maxPivots (0: 50 n + 100) limits them per pass
@@ -359,6 +385,14 @@ struct DantzigParams {
   // an engine's own last answers at rest only, the rule before "Guesses of a moving scene"
   // above). Default infinity (every warm guess).
   double blockSetsAtGuessResidual = kInf;
+  // Projected Gauss-Seidel sweeps (pgs.hpp, relaxation 1) over a warm guess whose residual
+  // (residual.hpp) exceeds blockPgsResidual; the block stage starts from their iterate (its first
+  // sets from where it lies, see "Pre-sweeps" above). 0: none. Default 5.
+  int blockPgsSweeps = 5;
+  // The smallest residual of a warm guess that gets blockPgsSweeps (0.2: Bullet's guesses right
+  // after the switch from SI, 0.19-0.8, but not most of a falling pyramid's own last answers,
+  // 0.01-0.3, which the sweeps make worse starts). Default 0.2.
+  double blockPgsResidual = 0.2;
 };
 
 class DantzigSolver : public Solver {

@@ -39,4 +39,10 @@ class GaussSeidelSolver : public PgsSolver {
   std::string refuse(const Problem& problem) const override;
 };
 
+namespace detail {
+// One sweep (the update above) over the rows in order, with invDiag[i] = 1 / A_ii and omega the
+// relaxation; shared with dantzig's pre-sweeps (DantzigParams::blockPgsSweeps).
+void pgsSweep(const Problem& problem, const Vector& invDiag, double omega, Vector& x);
+}  // namespace detail
+
 }  // namespace mlcp
