@@ -308,7 +308,15 @@
 // per step both), steady state 5.7-7.7 -> 7.3 (the same path), at rest after SI 4.4-4.8 ->
 // 3.4-5.1 (the same path). ODE (ode_bench 10 5): the same path (no solve gets the sweeps: the
 // cold trial settles), 13.6-13.8x -> 11.9-12.0x dWorldStep at 588 rows, 94-103x -> 84-95x at
-// 1728 (noise), the same residuals.
+// 1728 (noise), the same residuals. Whole bullet_bench runs with stock in the same run (CPU ms per
+// step): after the switch 83.9 / 62.1 against 438.9 / 360.8 (5.2x / 5.8x; before 4.4-5.0x; the 20x
+// goal is not met: ~35 damped block steps per solve remain, ~1.5-2 ms each, a fresh LU each), the
+// first 300 steps 11.0 against 299.4 (27x), steady state 8.1 against 320.0 (40x), at rest after SI
+// 2.9 against 278.4 (95x). Tried with the pre-sweeps without gain: maxBlockSteps 60 / 80 (pivots
+// and steps per step after the switch 138 -> 96 / 81, CPU ms within the noise: 10 steps 58-89
+// against 62-75 at 40, 30 steps 43.9 / 45.8 against 41.6; the first 300 steps unchanged),
+// relaxation 0.7 / 1.3 (pivots and steps per step 293 / 172 at K = 5, 184 / 215 at K = 10, against
+// 138).
 //
 // Result::iterations counts pivots (direction computations: each row added or exchanged)
 // summed over all passes; Options::maxPivots (0: 50 n + 100) limits them per pass
