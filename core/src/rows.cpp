@@ -397,13 +397,7 @@ Result RowPgs::iterate(Vector& x, double bNorm, double t0) {
   }
   double* xs = x.data();
   auto update = [&](const PackedRow& p, int i, double jv) { return RowPgs::update(p, xs, i, jv); };
-  // pack() may have done the first sweep already.
-  int sweep = 1 + fusedSweeps_;
-  if (n > 0 && fusedSweeps_ && monitor.wantsCheck(fusedSweeps_)) {
-    check();
-    if (monitor.stop(fusedSweeps_, last)) sweep = opt.maxIterations + 1;
-  }
-  for (; n > 0 && sweep <= opt.maxIterations; ++sweep) {
+  for (int sweep = 1; n > 0 && sweep <= opt.maxIterations; ++sweep) {
     const double* coupling = coupling_.data();
     for (int i = 0; i < n;) {
       const PackedRow& first = packed_[i];

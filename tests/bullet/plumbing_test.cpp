@@ -286,16 +286,9 @@ TEST(BulletPlumbing, PgsPackedFromBulletsRowsMatchesThePgsOfTheRowSolver) {
 // The packing reads M^-1 J^T's angular part from Bullet's m_angularComponentA/B where a body's
 // angular factor is (1, 1, 1) and computes it otherwise (islands.hpp): either way the iterates
 // are those of the RowSystem copy bit for bit, so the first step's impulses (written back to the
-// manifold points by Bullet's finish) are equal, not just close. From SI's start the first sweep
-// is fused into the packing, from the velocities Bullet's setup applied (RowPgs::solveFrom): the
-// iterates are the copy's up to round-off then (its sums in another order; 10 sweeps keep it
-// far below 1e-9 of an impulse).
+// manifold points by Bullet's finish) are equal, not just close.
 TEST(BulletPlumbing, PackedPgsImpulsesEqualTheRowSolversBitForBit) {
   for (bool siStart : {false, true}) {
-    // Equal, or within round-off from SI's start.
-    auto same = [siStart](double a, double b) {
-      return siStart ? std::abs(a - b) <= 1e-9 * (1 + std::abs(b)) : a == b;
-    };
     btJointFeedback feedback[2];  // the hinge's in fast, in copied (outlive the worlds)
     const btCollisionObject* fastBall = nullptr;
     sc::World fast, copied;
@@ -348,9 +341,9 @@ TEST(BulletPlumbing, PackedPgsImpulsesEqualTheRowSolversBitForBit) {
       for (int k = 0; k < ma->getNumContacts(); ++k, ++points) {
         const btManifoldPoint& pa = ma->getContactPoint(k);
         const btManifoldPoint& pb = mb->getContactPoint(k);
-        EXPECT_PRED2(same, pa.m_appliedImpulse, pb.m_appliedImpulse) << m << "/" << k;
-        EXPECT_PRED2(same, pa.m_appliedImpulseLateral1, pb.m_appliedImpulseLateral1) << m;
-        EXPECT_PRED2(same, pa.m_appliedImpulseLateral2, pb.m_appliedImpulseLateral2) << m;
+        EXPECT_EQ(pa.m_appliedImpulse, pb.m_appliedImpulse) << m << "/" << k;
+        EXPECT_EQ(pa.m_appliedImpulseLateral1, pb.m_appliedImpulseLateral1) << m << "/" << k;
+        EXPECT_EQ(pa.m_appliedImpulseLateral2, pb.m_appliedImpulseLateral2) << m << "/" << k;
       }
     }
     EXPECT_GT(points, 40);
@@ -361,8 +354,8 @@ TEST(BulletPlumbing, PackedPgsImpulsesEqualTheRowSolversBitForBit) {
     // The hinge's rows (joint rows, read in place too): Bullet's finish sums each row's impulse
     // into the joint feedback (fresh every step), so equal rows give equal sums.
     for (int c = 0; c < 3; ++c) {
-      EXPECT_PRED2(same, feedback[0].m_appliedForceBodyA[c], feedback[1].m_appliedForceBodyA[c]);
-      EXPECT_PRED2(same, feedback[0].m_appliedTorqueBodyA[c], feedback[1].m_appliedTorqueBodyA[c]);
+      EXPECT_EQ(feedback[0].m_appliedForceBodyA[c], feedback[1].m_appliedForceBodyA[c]) << c;
+      EXPECT_EQ(feedback[0].m_appliedTorqueBodyA[c], feedback[1].m_appliedTorqueBodyA[c]) << c;
     }
     EXPECT_GT(feedback[0].m_appliedForceBodyA.length(), 1.0);  // the door hangs on it
   }

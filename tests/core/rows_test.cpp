@@ -8,7 +8,6 @@
 #include <limits>
 #include <random>
 
-#include "mlcp/detail/row_pack.hpp"
 #include "mlcp/pgs.hpp"
 #include "mlcp/residual.hpp"
 
@@ -391,104 +390,6 @@ TEST(RowPgs, NonFiniteBaseOffersNoVelocityChanges) {
   EXPECT_EQ(ra.status, rb.status);
   EXPECT_EQ(ra.residual, rb.residual);
   EXPECT_EQ(xa, xb);
-}
-
-// A RowSystem's rows read in place by RowPgs::solveFrom, each row's base its start.
-struct SystemRows {
-  const RowSystem& s;
-  const Vector& start;
-  RowPgs::RowView row(int i) const {
-    const ConstraintRow& c = s.rows[i];
-    RowPgs::RowView r;
-    r.bodyA = c.bodyA;
-    r.bodyB = c.bodyB;
-    r.linA = c.jA.data();
-    r.angA = c.jA.data() + 3;
-    r.linB = c.jB.data();
-    r.angB = c.jB.data() + 3;
-    r.b = s.b[i];
-    r.cfm = s.cfm[i];
-    r.lo = s.lo[i];
-    r.hi = s.hi[i];
-    r.findex = s.findex[i];
-    r.start = r.base = start[i];
-    return r;
-  }
-};
-
-// M^-1 J^T x as solveFrom's startVelocity: 6 doubles per body.
-std::vector<double> flatVelocities(const RowSystem& s, const Vector& x) {
-  std::vector<double> out;
-  for (const Vector6& v : s.bodyVelocities(x)) out.insert(out.end(), v.data(), v.data() + 6);
-  return out;
-}
-
-// With the engine's start velocities the first sweep is fused into the packing (rows.hpp): the
-// iterates are those of solve(RowSystem) up to round-off (the first sweep's sums in another order,
-// without the couplings; 7 sweeps of a contraction do not amplify it past 1e-9 here). The check
-// stays that of x on the assembled problem even when the start velocities are wrong (the
-// velocities are moved onto our own M^-1 J^T start after the pass), and a row whose start is not
-// its base makes the pass start over unfused (then x is the unfused path's bit for bit).
-TEST(RowPgs, FirstSweepFusedIntoThePackingKeepsTheIteratesAndTheCheck) {
-  const RowSystem s = stackRows(30, 9);
-  const int n = s.size();
-  std::mt19937 rng(2);
-  std::uniform_real_distribution<double> u(0, 0.5);
-  Vector start(n);
-  for (int i = 0; i < n; ++i) start[i] = s.findex[i] < 0 ? u(rng) : 0.1 * u(rng);
-  const std::vector<double> exact = flatVelocities(s, start);
-  const std::vector<double> wrong(exact.size(), 0.25);
-  for (int sweeps : {1, 7}) {
-    RowPgs reference;
-    reference.options().maxIterations = sweeps;
-    reference.options().warmStart = true;
-    Vector xr = start;
-    const Result rr = reference.solve(s, xr);
-    for (const std::vector<double>* velocities : {&exact, &wrong}) {
-      RowPgs pgs;
-      pgs.options() = reference.options();
-      SystemRows rows{s, start};
-      Vector x;
-      const Result r = pgs.solveFrom(s.bodies, n, rows, x, velocities->data());
-      const bool right = velocities == &exact;
-      ASSERT_TRUE(pgs.velocityChanges());
-      EXPECT_EQ(r.iterations, rr.iterations);
-      EXPECT_NEAR(r.residual, accuracy(s.assemble(true), x).residual, 1e-12 * (1 + r.residual))
-          << sweeps << " " << right;
-      const std::vector<Vector6> dv = s.bodyVelocities(x - start);
-      for (int k = 0; k < static_cast<int>(s.bodies.size()); ++k)
-        EXPECT_LE((pgs.velocityChange(k) - dv[k]).lpNorm<Eigen::Infinity>(),
-                  1e-12 * (1 + dv[k].lpNorm<Eigen::Infinity>()))
-            << "body " << k;
-      const double apart = (x - xr).lpNorm<Eigen::Infinity>();
-      if (right) {
-        EXPECT_LE(apart, 1e-9 * (1 + xr.lpNorm<Eigen::Infinity>())) << sweeps;
-        EXPECT_NEAR(r.residual, rr.residual, 1e-9 * (1 + rr.residual)) << sweeps;
-      } else {
-        EXPECT_GT(apart, 1e-3) << sweeps;  // the first sweep did use the given velocities
-      }
-    }
-  }
-  // One row's base unlike its start: no fusing, the unfused path's iterates bit for bit.
-  Vector base = start;
-  base[40] *= 0.5;
-  RowPgs unfused, pgs;
-  for (RowPgs* p : {&unfused, &pgs}) {
-    p->options().maxIterations = 7;
-    p->options().warmStart = true;
-  }
-  Vector xu, x;
-  solveFromRows(unfused, s, start, base, xu);
-  struct Rows : SystemRows {
-    const Vector& base;
-    RowPgs::RowView row(int i) const {
-      RowPgs::RowView r = SystemRows::row(i);
-      r.base = base[i];
-      return r;
-    }
-  } rows{{s, start}, base};
-  pgs.solveFrom(s.bodies, n, rows, x, wrong.data());
-  EXPECT_EQ(x, xu);
 }
 
 TEST(RowPgs, ZeroRowIsAFailureNotAConvergence) {

@@ -402,28 +402,7 @@ inline RowPgs::RowView IslandBuilder::Source::row(int r) {
 
 Result IslandBuilder::solvePgs(RowPgs& pgs, Island& island, bool split, Vector& x) {
   Source rows(*this, island, split);
-  // From SI's start Bullet's setup has applied the start to the solver bodies (M^-1 J^T x0 in its
-  // rounding, where the body update is ours: not with perRowWriteBack): RowPgs fuses the first
-  // sweep into the packing from them.
-  const double* startVelocity = nullptr;
-  if (start_ == Start::AppliedImpulse && !island.perRowWriteBack) {
-    const int m = static_cast<int>(island.solverBody.size());
-    startVelocity_.resize(6 * static_cast<std::size_t>(m));
-    for (int k = 0; k < m; ++k) {
-      btSolverBody& body = (*in_.bodies)[island.solverBody[k]];
-      const btVector3& linear =
-          split ? body.internalGetPushVelocity() : body.internalGetDeltaLinearVelocity();
-      const btVector3& angular =
-          split ? body.internalGetTurnVelocity() : body.internalGetDeltaAngularVelocity();
-      for (int c = 0; c < 3; ++c) {
-        startVelocity_[6 * k + c] = linear[c];
-        startVelocity_[6 * k + 3 + c] = angular[c];
-      }
-    }
-    startVelocity = startVelocity_.data();
-  }
-  return pgs.solveFrom(island.system.bodies, static_cast<int>(island.rows.size()), rows, x,
-                       startVelocity);
+  return pgs.solveFrom(island.system.bodies, static_cast<int>(island.rows.size()), rows, x);
 }
 
 void IslandBuilder::fillSystem(Island& isl) {

@@ -141,19 +141,23 @@ class RowSystem {
 // of rows back, missed L1 on every friction row). Tried without gain: the sweep's last coupling
 // subtracted after the clamp's other terms (one addition less on the chain between a run's
 // rows: 10 sweeps 1.15 -> 1.21x SI at 55 boxes); rowValid's sum as a tree; fetching 16 rows
-// ahead instead of 8 (within the noise). Not done, and why: deriving step from Bullet's
-// m_jacDiagABInv instead of
+// ahead instead of 8 (within the noise). Not done, and why: the first sweep fused into the
+// packing (the brief's first candidate) cannot keep the iterates: with a warm start row i's
+// first update needs v = M^-1 J^T x_start over all rows, rows after i included, which only
+// exists after the packing; an engine's bodies hold it before (SI's setup applied the start),
+// but in the engine's rounding and order. Deriving step from Bullet's m_jacDiagABInv instead of
 // dividing: friction rows' Bullet denominator has no CFM while ours has (StockMlcp, Regularized),
 // contacts' is another rounding of A_ii (invMass + n . ((I^-1 (r x n)) x r)), and the RowSystem
 // path has no such number (bit for bit would need a RowSystem field: an API change).
-// Session 7: the first sweep fused into the packing where the engine's bodies already carry the
-// start (solveFrom's startVelocity: Bullet from SI's start). With a warm start row i's first
-// update needs v = M^-1 J^T x_start over all rows, rows after i included, which our own pass only
-// has after the packing; the engine's bodies hold it before, in the engine's rounding. The pass
-// sums our own M^-1 J^T x_start beside the sweep and moves the velocities onto it at the end, so
-// the check stays exact whatever the engine's velocities are; the iterates move by round-off
-// (the RowSystem path stays bit for bit the unfused engine path). The fused update costs the
-// packing less than a sweep: its dot and clamp overlap the packing's own work.
+// Session 7, tried without gain (stage timers, min of 6 runs alternated with the code before):
+// the first sweep fused into the packing from the velocities Bullet's setup applied (SI's start;
+// our own M^-1 J^T x_start summed beside it and the velocities moved onto it after the pass, so
+// the check stayed exact): the packing grew by about the sweep it saved (55 boxes +7-9 us packing,
+// -4-8 us sweeps; 210 boxes +21-27 us, -16-43 us), with row i updated right after it was packed,
+// through the run's couplings, or trailing the packing by 8 rows alike: each packed row's latency
+// is the packing's throughput, and the update's chain (dot, clamp, velocities) adds about what a
+// sweep of the row costs. A packed row padded from 240 to 304 bytes cost the 210-box stages ~2%:
+// bytes streamed are not what bounds the sweep either (so a smaller row format would gain ~1-2%).
 class RowPgs {
  public:
   Options& options() { return options_; }
@@ -216,20 +220,8 @@ class RowPgs {
   Result solve(const std::vector<BodyInverseMass>& bodies, int rows, RowSource& source, Vector& x);
   // The same for any class with RowView row(int) (a final RowSource, or none): defined in
   // mlcp/detail/row_pack.hpp, where the source's row() can be inlined into the packing loop.
-  // startVelocity: null, or 6 doubles per body ([linear; angular]), the velocity changes the
-  // engine's bodies already carry, M^-1 J^T base in the engine's own rounding (Bullet's setup
-  // applies SI's start). With it, when every row's start equals its base, is finite and every
-  // findex points back, the first sweep is fused into the packing pass: row i is updated as it is
-  // packed, from these velocities and the changes of rows 0 .. i-1 (the velocities of the rows
-  // after i need no pass of their own). After the pass the velocities are moved onto our own
-  // M^-1 J^T start (summed in the same pass), so v = M^-1 J^T x up to round-off as without it
-  // and the check stays exact; a start velocity that is not M^-1 J^T base only makes the first
-  // sweep a worse one. The iterates differ from the unfused path's by round-off (the first
-  // sweep's products in another order, no couplings). Any other row: the pass starts over
-  // without it.
   template <class Source>
-  Result solveFrom(const std::vector<BodyInverseMass>& bodies, int rows, Source& source, Vector& x,
-                   const double* startVelocity = nullptr);
+  Result solveFrom(const std::vector<BodyInverseMass>& bodies, int rows, Source& source, Vector& x);
   // After solve(bodies, rows, fill, x) took the fast path: body k's M^-1 J^T (x - base),
   // [linear; angular], from the velocities the sweeps maintain (what an engine adds to its
   // body's velocity to apply the answer, instead of one impulse per row). velocityChanges()
@@ -277,10 +269,9 @@ class RowPgs {
   static constexpr int kMaxRun = 8;
   // Fills packed_ and velocity_ from rowAt(i) (detail/row_pack.hpp); false at the first invalid row
   // or non-positive A_ii (bad_, badDiagonal_ say which).
-  // startVelocity (with x and withBase): the first sweep fused (solveFrom; fusedSweeps_ = 1).
   template <class RowAt>
   bool pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& rowAt, bool warm, double* x,
-            bool withBase, const double* startVelocity = nullptr);
+            bool withBase);
   // One row's update from jv = step J_i v (x[i] takes its new value); returns the change of x_i
   // that moves the velocities.
   static double update(const PackedRow& p, double* x, int i, double jv);
@@ -305,7 +296,6 @@ class RowPgs {
   std::vector<double> coupling_;
   std::vector<BodyVelocity> velocity_, base_;
   bool baseValid_ = false;
-  int fusedSweeps_ = 0;     // sweeps pack() did (0 or 1), counted by iterate()
   int bad_ = -1;            // the row that stopped pack()
   double badDiagonal_ = 0;  // its A_ii, or NaN when the row was invalid
 };

@@ -8,7 +8,6 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
-#include <utility>
 
 #include "mlcp/rows.hpp"
 #include "mlcp/solver.hpp"
@@ -124,11 +123,7 @@ inline double RowPgs::update(const PackedRow& p, double* xs, int i, double jv) {
 
 template <class RowAt>
 bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& rowAt, bool warm,
-                  double* xOut, bool withBase, const double* startVelocity) {
-  // The first sweep fused (solveFrom): velocity_ starts from the engine's velocities, base_
-  // sums our M^-1 J^T start.
-  const bool fused = startVelocity && xOut && withBase && warm && options_.maxIterations >= 1;
-  fusedSweeps_ = 0;
+                  double* xOut, bool withBase) {
   const int world = static_cast<int>(bodies.size());  // the first zero-velocity slot
   const unsigned slots = static_cast<unsigned>(world) + 1;
   // Ground rows take the world slots in turn (per run of rows on the same bodies): one shared
@@ -152,8 +147,6 @@ bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& row
   scale_.resize(n);
   velocity_.resize(world + kWorldSlots);
   for (BodyVelocity& v : velocity_) v.v.setZero();
-  if (fused)
-    for (int k = 0; k < world; ++k) std::memcpy(velocity_[k].v.data(), startVelocity + 6 * k, 48);
   if (withBase) {
     base_.resize(world + kWorldSlots);
     for (BodyVelocity& v : base_) v.v.setZero();
@@ -270,24 +263,6 @@ bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& row
       p.mA[k] = mA[k];
       p.mB[k] = mB[k];
     }
-    if (fused) {
-      // Sweep 1's update of row i from the velocities so far; the start in base_ (the rows'
-      // starts are their bases). A row it does not fit: the pass again, unfused.
-      if (r.base != xi || !std::isfinite(xi) || r.findex > i)
-        return pack(bodies, n, std::forward<RowAt>(rowAt), warm, xOut, withBase, nullptr);
-      double* ba = base_[runA].v.data();
-      double* bb = base_[runB].v.data();
-      for (int k = 0; k < 6; ++k) {
-        ba[k] += mA[k] * xi;
-        bb[k] += mB[k] * xi;
-      }
-      double jv = 0;
-      for (int k = 0; k < 6; ++k) jv += sJ[k] * va[k] + sJ[6 + k] * vb[k];
-      const double dx = update(p, xOut, i, jv);
-      for (int k = 0; k < 6; ++k) va[k] += mA[k] * dx;
-      for (int k = 0; k < 6; ++k) vb[k] += mB[k] * dx;
-      continue;
-    }
     if (xi != 0) {
       for (int k = 0; k < 6; ++k) {
         va[k] += mA[k] * xi;
@@ -310,13 +285,6 @@ bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& row
     if (findexOf_[i] > i && findexOf_[findexOf_[i]] >= 0) return stop(i, std::nan(""));
   // The world never moves (its blocks are zero anyway).
   for (int k = 0; k < kWorldSlots; ++k) velocity_[world + k].v.setZero();
-  if (fused) {
-    // From the engine's start velocities to ours: v = M^-1 J^T x up to round-off (the check).
-    for (int k = 0; k < world; ++k)
-      velocity_[k].v += base_[k].v - Eigen::Map<const Vector6>(startVelocity + 6 * k);
-    fusedSweeps_ = 1;
-    return true;
-  }
   if (withBase)
     for (int k = 0; k < world; ++k) base_[k].v += velocity_[k].v;
   return true;
@@ -324,7 +292,7 @@ bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& row
 
 template <class Source>
 Result RowPgs::solveFrom(const std::vector<BodyInverseMass>& bodies, int n, Source& source,
-                         Vector& x, const double* startVelocity) {
+                         Vector& x) {
   const double t0 = nowSeconds();
   baseValid_ = false;
   // The slow path: the same rows as a RowSystem, solved (or refused) by solve(RowSystem).
@@ -348,7 +316,7 @@ Result RowPgs::solveFrom(const std::vector<BodyInverseMass>& bodies, int n, Sour
         bNorm = std::max(bNorm, std::abs(r.b));
         return r;
       },
-      opt.warmStart, x.data(), true, startVelocity);
+      opt.warmStart, x.data(), true);
   if (!packed) return slow();
   // A non-finite start: solve(RowSystem) starts cold (velocity_ and base_ hold NaN here).
   if (!x.allFinite()) return slow();

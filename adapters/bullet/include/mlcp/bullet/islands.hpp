@@ -175,7 +175,6 @@ class IslandBuilder {
   // Per solver body: kUnitLinear / kUnitAngular when its linear / angular factor is (1, 1, 1).
   std::vector<unsigned char> unit_;
   std::vector<std::pair<int, int>> rowBodies_;  // each row's dynamic bodies (-1: none)
-  std::vector<double> startVelocity_;           // solvePgs(): the island's bodies' velocities
   // What view() needs of the last build() call.
   BulletRows in_;
   CfmModel cfm_{};
