@@ -316,7 +316,9 @@
 // and steps per step after the switch 138 -> 96 / 81, CPU ms within the noise: 10 steps 58-89
 // against 62-75 at 40, 30 steps 43.9 / 45.8 against 41.6; the first 300 steps unchanged),
 // relaxation 0.7 / 1.3 (pivots and steps per step 293 / 172 at K = 5, 184 / 215 at K = 10, against
-// 138).
+// 138), the first sets from the natural map at the swept iterate (142 against 138, 30 steps 62
+// against 56), damped steps at once from it (no full steps: 144 against 138; CPU ms per step over
+// 20 steps, four alternated runs, 58.6-85.3 against 56.6-82.2: the noise).
 //
 // Result::iterations counts pivots (direction computations: each row added or exchanged)
 // summed over all passes; Options::maxPivots (0: 50 n + 100) limits them per pass
