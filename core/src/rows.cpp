@@ -380,6 +380,68 @@ Result RowPgs::iteratePacked(int bodies, Vector& x, double bNorm, double t0) {
   return a.result(bNorm);
 }
 
+// A function of its own: compiled apart from the checks and the stopping logic around it (the
+// sweep's code and speed moved with whatever else iterate() held).
+[[gnu::noinline]] void RowPgs::sweepOnce(double* xs) {
+  const int n = static_cast<int>(packed_.size());
+  auto update = [&](const PackedRow& p, int i, double jv) { return RowPgs::update(p, xs, i, jv); };
+  const double* coupling = coupling_.data();
+  for (int i = 0; i < n;) {
+    const PackedRow& first = packed_[i];
+    if (first.a == first.b) {
+      // A row joining a body to itself: va and vb are the same object.
+      Vector6& v = velocity_[first.a].v;
+      const double dx =
+          update(first, i, (first.sA.cwiseProduct(v) + first.sB.cwiseProduct(v)).sum());
+      v += first.mA * dx;
+      v += first.mB * dx;
+      ++i;
+      continue;
+    }
+    // A run on two bodies: each row's step J v is its product with the velocities at the
+    // run's start plus its couplings to the changes of the run's earlier rows, so the chain
+    // from one row to the next is a multiply-add instead of the 12-wide dot after a 12-wide
+    // velocity update; the velocities take the run's changes at its end. Unrolled per length
+    // so that the changes stay in registers (reading them back from a stack array in pairs
+    // stalled store forwarding on every coupling).
+    const int length = first.run;
+    auto sweepRun = [&](auto size) {
+      constexpr int L = decltype(size)::value;
+      const Vector6 va = velocity_[first.a].v, vb = velocity_[first.b].v;
+      double dxs[L];
+#pragma GCC unroll 8
+      for (int k = 0; k < L; ++k) {
+        const PackedRow& p = packed_[i + k];
+        double jv = (p.sA.cwiseProduct(va) + p.sB.cwiseProduct(vb)).sum();
+#pragma GCC unroll 8
+        for (int m = 0; m < k; ++m) jv += coupling[m] * dxs[m];
+        coupling += k;
+        dxs[k] = update(p, i + k, jv);
+      }
+      Vector6 da = Vector6::Zero(), db = Vector6::Zero();
+#pragma GCC unroll 8
+      for (int k = 0; k < L; ++k) {
+        da += packed_[i + k].mA * dxs[k];
+        db += packed_[i + k].mB * dxs[k];
+      }
+      velocity_[first.a].v = va + da;
+      velocity_[first.b].v = vb + db;
+    };
+    static_assert(kMaxRun == 8, "one case per run length");
+    switch (length) {
+      case 1: sweepRun(std::integral_constant<int, 1>()); break;
+      case 2: sweepRun(std::integral_constant<int, 2>()); break;
+      case 3: sweepRun(std::integral_constant<int, 3>()); break;
+      case 4: sweepRun(std::integral_constant<int, 4>()); break;
+      case 5: sweepRun(std::integral_constant<int, 5>()); break;
+      case 6: sweepRun(std::integral_constant<int, 6>()); break;
+      case 7: sweepRun(std::integral_constant<int, 7>()); break;
+      default: sweepRun(std::integral_constant<int, 8>()); break;
+    }
+    i += length;
+  }
+}
+
 Result RowPgs::iterate(Vector& x, double bNorm, double t0) {
   const Options& opt = options_;
   const int n = static_cast<int>(packed_.size());
@@ -395,64 +457,8 @@ Result RowPgs::iterate(Vector& x, double bNorm, double t0) {
     result.status = Status::Converged;
     result.message = "empty problem";
   }
-  double* xs = x.data();
-  auto update = [&](const PackedRow& p, int i, double jv) { return RowPgs::update(p, xs, i, jv); };
   for (int sweep = 1; n > 0 && sweep <= opt.maxIterations; ++sweep) {
-    const double* coupling = coupling_.data();
-    for (int i = 0; i < n;) {
-      const PackedRow& first = packed_[i];
-      if (first.a == first.b) {
-        // A row joining a body to itself: va and vb are the same object.
-        Vector6& v = velocity_[first.a].v;
-        const double dx =
-            update(first, i, (first.sA.cwiseProduct(v) + first.sB.cwiseProduct(v)).sum());
-        v += first.mA * dx;
-        v += first.mB * dx;
-        ++i;
-        continue;
-      }
-      // A run on two bodies: each row's step J v is its product with the velocities at the
-      // run's start plus its couplings to the changes of the run's earlier rows, so the chain
-      // from one row to the next is a multiply-add instead of the 12-wide dot after a 12-wide
-      // velocity update; the velocities take the run's changes at its end. Unrolled per length
-      // so that the changes stay in registers (reading them back from a stack array in pairs
-      // stalled store forwarding on every coupling).
-      const int length = first.run;
-      auto sweepRun = [&](auto size) {
-        constexpr int L = decltype(size)::value;
-        const Vector6 va = velocity_[first.a].v, vb = velocity_[first.b].v;
-        double dxs[L];
-#pragma GCC unroll 8
-        for (int k = 0; k < L; ++k) {
-          const PackedRow& p = packed_[i + k];
-          double jv = (p.sA.cwiseProduct(va) + p.sB.cwiseProduct(vb)).sum();
-#pragma GCC unroll 8
-          for (int m = 0; m < k; ++m) jv += coupling[m] * dxs[m];
-          coupling += k;
-          dxs[k] = update(p, i + k, jv);
-        }
-        Vector6 da = Vector6::Zero(), db = Vector6::Zero();
-#pragma GCC unroll 8
-        for (int k = 0; k < L; ++k) {
-          da += packed_[i + k].mA * dxs[k];
-          db += packed_[i + k].mB * dxs[k];
-        }
-        velocity_[first.a].v = va + da;
-        velocity_[first.b].v = vb + db;
-      };
-      static_assert(kMaxRun == 8, "one case per run length");
-      switch (length) {
-        case 1: sweepRun(std::integral_constant<int, 1>()); break;
-        case 2: sweepRun(std::integral_constant<int, 2>()); break;
-        case 3: sweepRun(std::integral_constant<int, 3>()); break;
-        case 4: sweepRun(std::integral_constant<int, 4>()); break;
-        case 5: sweepRun(std::integral_constant<int, 5>()); break;
-        case 6: sweepRun(std::integral_constant<int, 6>()); break;
-        case 7: sweepRun(std::integral_constant<int, 7>()); break;
-        default: sweepRun(std::integral_constant<int, 8>()); break;
-      }
-      i += length;
-    }
+    sweepOnce(x.data());
     lastValid = false;
     if (!monitor.wantsCheck(sweep)) continue;
     check();

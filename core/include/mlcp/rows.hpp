@@ -275,6 +275,8 @@ class RowPgs {
   // One row's update from jv = step J_i v (x[i] takes its new value); returns the change of x_i
   // that moves the velocities.
   static double update(const PackedRow& p, double* x, int i, double jv);
+  // One sweep over packed_ (x and the velocities updated in place).
+  void sweepOnce(double* x);
   static Result negativeRows();
   // After the engine path's packing: per-body changes offered when the bases are finite, then
   // iterate().
