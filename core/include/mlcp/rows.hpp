@@ -149,11 +149,19 @@ class RowSystem {
 // dividing: friction rows' Bullet denominator has no CFM while ours has (StockMlcp, Regularized),
 // contacts' is another rounding of A_ii (invMass + n . ((I^-1 (r x n)) x r)), and the RowSystem
 // path has no such number (bit for bit would need a RowSystem field: an API change).
-// Session 7, tried without gain (stage timers, min of 6 runs alternated with the code before):
-// the first sweep fused into the packing from the velocities Bullet's setup applied (SI's start;
-// our own M^-1 J^T x_start summed beside it and the velocities moved onto it after the pass, so
-// the check stayed exact): the packing grew by about the sweep it saved (55 boxes +7-9 us packing,
-// -4-8 us sweeps; 210 boxes +21-27 us, -16-43 us), with row i updated right after it was packed,
+// Session 7 (stage timers, mean per step, min of 5 runs alternated with session 6's code): the
+// row update written once (RowPgs::update, which session 6's sweep called out of line at one
+// site) and one sweep a noinline function of its own (sweepOnce): sweeps ~117 -> ~93 us at 55
+// boxes, ~479 -> ~379 us at 210 (~10.1 -> ~8.0 ns a row a sweep); packing ~48 / ~205 us (~43 ns
+// a row), check ~11 / ~46 us, the same. Which of the two changes of the compiled code pays was
+// not isolated; forcing update() inline and the run's velocity update into scalars made 55 boxes
+// ~7% slower again.
+// Session 7, tried without gain (stage timers, mean per step, min of 6 runs alternated with the
+// code before): the first sweep fused into the packing from the velocities Bullet's setup applied
+// (SI's start; our own M^-1 J^T x_start summed beside it and the velocities moved onto it after
+// the pass, so the check stayed exact): the packing grew by about the sweep it saved (55 boxes
+// +14-18 us packing, -8-16 us sweeps; 210 boxes +42-54 us, -32-86 us; sweeps of session 6's code),
+// with row i updated right after it was packed,
 // through the run's couplings, or trailing the packing by 8 rows alike: each packed row's latency
 // is the packing's throughput, and the update's chain (dot, clamp, velocities) adds about what a
 // sweep of the row costs. A packed row padded from 240 to 304 bytes cost the 210-box stages ~2%:

@@ -112,6 +112,13 @@
 // against SI's iterations ~0.67-0.72 ms. Still above 1.0x at 10 sweeps. The iterates moved by
 // round-off (the packing's sums), so over 300 steps of the pyramid the worst residuals differ
 // from session 5's (15 boxes 4.20e-3 -> 4.69e-3, SI's 4.22e-3) while the medians are the same.
+// Session 7 (the sweep ~20% faster, rows.hpp; min-median of 6 runs alternated with session 6's
+// code): 10 sweeps 1.02-1.03x / 1.06-1.07x / 1.00-1.04x SI at 15 / 55 / 210 boxes against
+// 1.06-1.07x / 1.10-1.11x / 1.05-1.06x; 20 sweeps 0.90-0.91x / 0.89x / 0.85-0.88x, 50 sweeps
+// 0.70-0.72x / 0.75x / 0.70x. The iterates and residuals are session 6's. Our stages at 55 boxes
+// (stage timers, mean per step): split ~10 us, packing ~48 us, sweeps ~93 us, check ~11 us,
+// storing ~2 us (~0.16 ms against SI's iterations ~0.15 ms); the fixed passes (~70 us) still
+// cost more than the sweeps save. The first sweep fused into the packing did not pay (rows.hpp).
 //
 // "si" runs Bullet's own SI iterations instead (for side-by-side runs with the same statistics).
 #pragma once
