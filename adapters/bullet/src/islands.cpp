@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <numeric>
 
 #include "mlcp/bullet/constraint_solver.hpp"
 #include "mlcp/detail/row_pack.hpp"
@@ -81,6 +80,10 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
   dynamic_.resize(nb);
   parent_.resize(nb);
   unit_.resize(nb);
+  bodyLocal_.assign(nb, -1);
+  if (islands_.empty()) islands_.resize(1);
+  std::vector<int>& firstUse = islands_[0].solverBody;
+  firstUse.clear();
   for (int k = 0; k < nb; ++k) {
     const btSolverBody& sb = bodies[k];
     const btRigidBody* rb = sb.m_originalBody;
@@ -96,8 +99,17 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
   all_.resize(n);
   findex_.resize(n);
   rowBodies_.resize(n);
-  int lastA = -1, lastB = -1;  // the last pair joined (a manifold's rows repeat it)
+  int lastA = -2, lastB = -2;  // the last row's pair (a manifold's rows repeat it)
   int inert = 0;               // rows on no dynamic body
+  int joined = 0;              // unions of two components
+  // Bodies numbered by first use in row order as they come (island 0's solverBody), for the
+  // case that the group is one component; the general numbering below starts again otherwise.
+  auto number = [&](int d) {
+    if (d >= 0 && bodyLocal_[d] < 0) {
+      bodyLocal_[d] = static_cast<int>(firstUse.size());
+      firstUse.push_back(d);
+    }
+  };
   auto add = [&](int i, btSolverConstraint& c, int f) {
     all_[i] = &c;
     findex_[i] = f;
@@ -105,8 +117,16 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     const int b = c.m_solverBodyIdB >= 0 ? dynamic_[c.m_solverBodyIdB] : -1;
     rowBodies_[i] = {a, b};
     inert += a < 0 && b < 0;
-    if (a >= 0 && b >= 0 && (a != lastA || b != lastB)) {
-      parent_[find(a)] = find(b);
+    if (a != lastA || b != lastB) {
+      if (a >= 0 && b >= 0) {
+        const int ra = find(a), rb = find(b);
+        if (ra != rb) {
+          parent_[ra] = rb;
+          ++joined;
+        }
+      }
+      number(a);
+      number(b);
       lastA = a;
       lastB = b;
     }
@@ -136,25 +156,27 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
   // Islands numbered by first appearance in row order; rows keep their relative order, bodies
   // are numbered by first use in their island's rows.
   islandOfRoot_.assign(nb, -1);
-  bodyLocal_.assign(nb, -1);
   rowIsland_.resize(n);
   rowLocal_.resize(n);
   count_ = 0;
   inert_ = 0;
+  auto mass = [&](Island& isl, int d) {
+    const btSolverBody& sb = bodies[d];
+    const btRigidBody* rb = sb.m_originalBody;
+    BodyInverseMass m;
+    m.invMass = rb->getInvMass();
+    const Eigen::Vector3d af = toEigen(sb.m_angularFactor);
+    const btMatrix3x3& I = rb->getInvInertiaTensorWorld();
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) m.invInertia(r, c) = af[r] * I[r][c] * af[c];
+    if (!sameUpdate(sb)) isl.perRowWriteBack = true;
+    isl.system.bodies.push_back(m);
+  };
   auto localBody = [&](Island& isl, int d) -> int {
     if (d < 0) return -1;
     if (bodyLocal_[d] < 0) {
-      const btSolverBody& sb = bodies[d];
-      const btRigidBody* rb = sb.m_originalBody;
-      BodyInverseMass m;
-      m.invMass = rb->getInvMass();
-      const Eigen::Vector3d af = toEigen(sb.m_angularFactor);
-      const btMatrix3x3& I = rb->getInvInertiaTensorWorld();
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) m.invInertia(r, c) = af[r] * I[r][c] * af[c];
-      if (!sameUpdate(sb)) isl.perRowWriteBack = true;
       bodyLocal_[d] = static_cast<int>(isl.system.bodies.size());
-      isl.system.bodies.push_back(m);
+      mass(isl, d);
       isl.solverBody.push_back(d);
     }
     return bodyLocal_[d];
@@ -174,31 +196,26 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     isl.perRowWriteBack = false;
   };
   // One component with every row on a dynamic body (a pile, a pyramid): the rows are island 0 in
-  // their own order and only the bodies need numbering (no island lookup and no place per row,
-  // and the island's arrays are copies). Every dynamic body has the same root (a body without
-  // rows is a component of its own: the general numbering then).
-  bool single = n > 0 && inert == 0;
-  for (int k = 0, root = -1; single && k < nb; ++k) {
-    if (dynamic_[k] < 0) continue;
-    const int rk = find(k);
-    if (root < 0) root = rk;
-    single = rk == root;
-  }
+  // their own order, its bodies were numbered in the pass above (first use, as the general
+  // numbering does), its rows and findex are the pass's arrays themselves (swapped in) and its
+  // rowIndex the identity (not written). The bodies the rows name less the unions that joined
+  // two components is the number of components.
+  const bool single = n > 0 && inert == 0 && static_cast<int>(firstUse.size()) - joined == 1;
   int lastPairA = -2, lastPairB = -2, lastIsland = -1;
   // The current island's row count kept here (written back when the island changes): counting
   // in rowsIn_ chained every row through a store and a load.
   int counted = 0;
   if (single) {
-    newIsland();
-    for (int i = 0; i < n; ++i) {
-      const auto [a, b] = rowBodies_[i];
-      if (a == lastPairA && b == lastPairB) continue;
-      localBody(islands_[0], a);
-      localBody(islands_[0], b);
-      lastPairA = a;
-      lastPairB = b;
-    }
-    rowsIn_[0] = n;
+    count_ = 1;
+    rowsIn_.push_back(n);
+    Island& isl = islands_[0];
+    isl.system.bodies.clear();
+    isl.hasSplit = false;
+    isl.filled = false;
+    isl.perRowWriteBack = false;
+    for (const int d : firstUse) mass(isl, d);
+  } else {
+    for (const int d : firstUse) bodyLocal_[d] = -1;
   }
   for (int i = 0; i < n && !single; ++i) {
     const auto [a, b] = rowBodies_[i];
@@ -232,9 +249,12 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
   for (int k = 0; k < count_; ++k) {
     Island& isl = islands_[k];
     const std::size_t m = static_cast<std::size_t>(rowsIn_[k]);
-    isl.rows.resize(m);
-    isl.rowIndex.resize(m);
-    isl.system.findex.resize(m);
+    isl.inOrder = single;
+    if (!single) {
+      isl.rows.resize(m);
+      isl.rowIndex.resize(m);
+      isl.system.findex.resize(m);
+    }
     // Only the cached-impulse start reads the points (and remember() keeps answers for it).
     const std::size_t withPoints = start == Start::CachedImpulse ? m : 0;
     isl.point.resize(withPoints);
@@ -242,12 +262,6 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     isl.memo.resize(withPoints);
   }
   points_ = start == Start::CachedImpulse;
-  if (single) {
-    Island& isl = islands_[0];
-    std::copy(all_.begin(), all_.end(), isl.rows.begin());
-    std::iota(isl.rowIndex.begin(), isl.rowIndex.end(), 0);
-    std::copy(findex_.begin(), findex_.end(), isl.system.findex.begin());
-  }
   for (int i = 0; i < n && (points_ || !single); ++i) {
     const int k = single ? 0 : rowIsland_[i];
     if (k < 0) continue;
@@ -286,6 +300,11 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     isl.last[r] = last;
     isl.memo[r] = memo;
   }
+  if (single) {
+    // all_ and findex_ take the island's old buffers (written whole by the next build()).
+    islands_[0].rows.swap(all_);
+    islands_[0].system.findex.swap(findex_);
+  }
 
   stockCfm_ = info.m_globalCfm / info.m_timeStep;
   // SI starts contacts and friction from the cached impulse times m_warmstartingFactor (0.85); a
@@ -305,7 +324,7 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
 }
 
 inline RowPgs::RowView IslandBuilder::view(Island& isl, int r, bool split, double* scratch) {
-  const int i = isl.rowIndex[r];
+  const int i = isl.inOrder ? r : isl.rowIndex[r];
   const btSolverConstraint& c = *isl.rows[r];
   const int a = rowBodies_[i].first, b = rowBodies_[i].second;
   const int findex = isl.system.findex[r];

@@ -63,6 +63,7 @@ struct Island {
   bool filled = false;
   std::vector<btSolverConstraint*> rows;  // Bullet's row for each system row
   std::vector<int> rowIndex;              // the builder's index of each row (for view())
+  bool inOrder = false;                   // row r is the builder's row r (rowIndex not written)
   std::vector<int> solverBody;            // Bullet's solver body of each system body
   Vector start;                           // applied impulses (warm start)
   Vector splitB;                          // b of the split-impulse problem (m_rhsPenetration)
