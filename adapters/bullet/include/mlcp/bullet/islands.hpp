@@ -31,6 +31,25 @@
 // its rows are island 0 in their own order, the island's arrays are copies, only the bodies are
 // numbered (by first use, as the general numbering does; tested equal bit for bit to it). The
 // split and numbering at 210 boxes ~42-46 us against ~53-56 us (stage timers, median per step).
+// Session 7 (round 4): the one-component case is decided and numbered in the graph pass itself:
+// bodies numbered by first use as the rows come (the same order), components counted as the
+// bodies the rows name less the unions that joined two (no find() per body afterwards); the
+// island takes the pass's rows and findex arrays by swap, and its rowIndex is not written
+// (Island::inOrder). Stage timers, mean per step, 3 runs alternated with the old code: at 55
+// boxes split 5.2-5.7 -> 4.3-4.4 us (numbering 1.5-1.6 -> 0.65, copies 0.5 -> 0.06, the
+// one-component check 0.2 -> 0, the graph pass 3.0-3.3 -> 3.3-3.4); at 210 boxes ~24-30 ->
+// ~19-24 us (numbering 6.4-8.1 -> 2.5-3.3, copies 2.0-2.4 -> 0.1). What is left is the graph
+// pass, bound by its first touch of each row's last line (without its prefetch 5.5 us at 55
+// boxes against 3.8-4.0). Tried and taken out: friction rows not linked when on their contact
+// row's bodies (a branch-free pass for them): the graph pass unchanged (3.0-3.4 us); the graph
+// pass fused into RowPgs' packing (speculatively, when last step had one group and it was one
+// component: bodies numbered as Bullet numbers its solver bodies, each row linked by view() as
+// the packing reads it, checked after the pass and rebuilt when it was several components):
+// split 4.5 -> 1.0-2.1 us at 55 boxes and ~22-35 -> 5-7 us at 210, but the packing grew by
+// more (+6-12 us at 55 boxes); 10 sweeps 15 / 55 / 210 boxes min 0.98x / 1.04x / 1.02x SI ->
+// 1.02x / 1.07x / 1.01-1.03x, median 1.00x / 1.12x / 1.07x -> 1.03-1.05x / 1.15x / 1.08-1.09x
+// (9 alternated runs, a busy machine). Bullet also calls a group with no rows every step in
+// the 55-box pyramid (a group gate of the fused path must not count those).
 #pragma once
 
 #include <BulletDynamics/ConstraintSolver/btSequentialImpulseConstraintSolver.h>
