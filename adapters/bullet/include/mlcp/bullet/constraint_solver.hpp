@@ -121,12 +121,13 @@
 // cost more than the sweeps save. (Round 4's timers below put the split at ~5 us: the two sets
 // were taken over Bullet's two solveGroup calls a step differently, one call has no rows; the
 // sum of round 3's matches the bench's "ours stages ms" column.) The first sweep fused into the
-// packing did not pay (rows.hpp). Session 7, round 4 (the one-component split numbered in its graph
-// pass, islands.hpp; runs alternated with round 3's code, min / median, 7 and 11 runs on a busy
-// machine): 10 sweeps 1.00x / 1.00-1.10x, 1.04x / 1.05-1.11x, 1.01-1.02x / 1.02-1.05x SI at 15 / 55
-// / 210 boxes against 1.02x / 1.02-1.10x, 1.05x / 1.09-1.13x, 1.02x / 1.04-1.08x. The split at 55
-// boxes is now ~4.4 us of a ~10 us gap (4% at the min); the graph pass (~3.3 us) is what is left of
-// it, and folding it into the packing cost the packing more than it saved (islands.hpp).
+// packing did not pay (rows.hpp).
+// Session 7, round 4 (the one-component split numbered in its graph pass, islands.hpp; runs
+// alternated with round 3's code, min / median, 7 and 11 runs on a busy machine): 10 sweeps 1.00x /
+// 1.00-1.10x, 1.04x / 1.05-1.11x, 1.01-1.02x / 1.02-1.05x SI at 15 / 55 / 210 boxes against 1.02x /
+// 1.02-1.10x, 1.05x / 1.09-1.13x, 1.02x / 1.04-1.08x. The split at 55 boxes is now ~4.4 us of a ~10
+// us gap (4% at the min); the graph pass (~3.3 us) is what is left of it, and folding it into the
+// packing cost the packing more than it saved (islands.hpp).
 //
 // "si" runs Bullet's own SI iterations instead (for side-by-side runs with the same statistics).
 #pragma once
