@@ -35,12 +35,8 @@ constexpr int kSmall = 8;
 
 // Projected Gauss-Seidel sweeps (pgs.hpp) over x; none when a diagonal entry is not positive.
 void preSweeps(const Problem& problem, int sweeps, Vector& x) {
-  Vector invDiag(problem.size());
-  for (int i = 0; i < problem.size(); ++i) {
-    const double d = problem.diagonal(i);
-    if (!(d > 0)) return;
-    invDiag[i] = 1.0 / d;
-  }
+  Vector invDiag;
+  if (detail::inverseDiagonal(problem, invDiag) >= 0) return;
   for (int k = 0; k < sweeps; ++k) detail::pgsSweep(problem, invDiag, 1.0, x);
 }
 

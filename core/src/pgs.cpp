@@ -17,6 +17,16 @@ void detail::pgsSweep(const Problem& problem, const Vector& invDiag, double omeg
   }
 }
 
+int detail::inverseDiagonal(const Problem& problem, Vector& invDiag) {
+  invDiag.resize(problem.size());
+  for (int i = 0; i < problem.size(); ++i) {
+    const double d = problem.diagonal(i);
+    if (!(d > 0)) return i;
+    invDiag[i] = 1.0 / d;
+  }
+  return -1;
+}
+
 std::string PgsSolver::refuse(const Problem&) const { return ""; }
 
 std::string GaussSeidelSolver::refuse(const Problem& problem) const {
@@ -40,18 +50,14 @@ void PgsSolver::run(const Problem& problem, Vector& x, Result& result) {
     result.message = why;
     return;
   }
-  Vector invDiag(n);
-  for (int i = 0; i < n; ++i) {
-    const double d = problem.diagonal(i);
-    if (!(d > 0)) {
-      std::ostringstream os;
-      os << "A(" << i << "," << i << ") = " << d << ": " << name()
-         << " needs a positive diagonal (use lemke or dantzig)";
-      result.status = Status::Failed;
-      result.message = os.str();
-      return;
-    }
-    invDiag[i] = 1.0 / d;
+  Vector invDiag;
+  if (const int i = detail::inverseDiagonal(problem, invDiag); i >= 0) {
+    std::ostringstream os;
+    os << "A(" << i << "," << i << ") = " << problem.diagonal(i) << ": " << name()
+       << " needs a positive diagonal (use lemke or dantzig)";
+    result.status = Status::Failed;
+    result.message = os.str();
+    return;
   }
   if (n == 0) {
     result.status = Status::Converged;

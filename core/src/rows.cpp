@@ -380,6 +380,22 @@ Result RowPgs::iteratePacked(int bodies, Vector& x, double bNorm, double t0) {
   return a.result(bNorm);
 }
 
+inline double RowPgs::update(const PackedRow& p, double* xs, int i, double jv) {
+  double lo = p.lo, hi = p.hi;
+  if (p.findex >= 0) {
+    const double normal = std::abs(xs[p.findex]);
+    lo *= normal;
+    hi *= normal;
+  }
+  // The new x is clamp(c - jv, lo, hi) with c = keep x - shift. The change that moves the
+  // velocities is clamped on its own, clamp((c - x) - jv, lo - x, hi - x) (the same up to
+  // round-off), so that the chain does not wait for the subtraction x_new - x.
+  const double xo = xs[i], c = p.keep * xo - p.shift;
+  const double dx = std::clamp((c - xo) - jv, lo - xo, hi - xo);
+  xs[i] = std::clamp(c - jv, lo, hi);
+  return dx;
+}
+
 // A function of its own: compiled apart from the checks and the stopping logic around it (the
 // sweep's code and speed moved with whatever else iterate() held).
 [[gnu::noinline]] void RowPgs::sweepOnce(double* xs) {

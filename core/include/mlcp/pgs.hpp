@@ -43,6 +43,9 @@ namespace detail {
 // One sweep (the update above) over the rows in order, with invDiag[i] = 1 / A_ii and omega the
 // relaxation; shared with dantzig's pre-sweeps (DantzigParams::blockPgsSweeps).
 void pgsSweep(const Problem& problem, const Vector& invDiag, double omega, Vector& x);
+// invDiag[i] = 1 / A_ii for the sweep; returns the first row whose A_ii is not positive (invDiag
+// then unusable), or -1.
+int inverseDiagonal(const Problem& problem, Vector& invDiag);
 }  // namespace detail
 
 }  // namespace mlcp

@@ -105,22 +105,6 @@ inline void setRow(RowSystem& s, Vector& start, int i, const RowPgs::RowView& r)
 // How many rows ahead pack() fetches the packed rows it will write.
 constexpr int kPackAhead = 8;
 
-inline double RowPgs::update(const PackedRow& p, double* xs, int i, double jv) {
-  double lo = p.lo, hi = p.hi;
-  if (p.findex >= 0) {
-    const double normal = std::abs(xs[p.findex]);
-    lo *= normal;
-    hi *= normal;
-  }
-  // The new x is clamp(c - jv, lo, hi) with c = keep x - shift. The change that moves the
-  // velocities is clamped on its own, clamp((c - x) - jv, lo - x, hi - x) (the same up to
-  // round-off), so that the chain does not wait for the subtraction x_new - x.
-  const double xo = xs[i], c = p.keep * xo - p.shift;
-  const double dx = std::clamp((c - xo) - jv, lo - xo, hi - xo);
-  xs[i] = std::clamp(c - jv, lo, hi);
-  return dx;
-}
-
 template <class RowAt>
 bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& rowAt, bool warm,
                   double* xOut, bool withBase) {
