@@ -373,6 +373,33 @@ TEST(RowPgs, EngineRowsWithFaultsGetTheRowSystemsAnswer) {
   EXPECT_EQ(cold.solve(s, xc).residual, r.residual);
 }
 
+// The packing checks a body side's Jacobian through A_ii (row_pack.hpp): NaN, +inf and -inf in
+// every entry of both sides, on a ground row and a row between two bodies, with body 0 moving
+// and static (M^-1 = 0, where a product with the entry is NaN), are refused by both paths.
+TEST(RowPgs, EveryNonFiniteJacobianEntryIsRefused) {
+  const double bad[] = {std::nan(""), kInf, -kInf};
+  for (const bool fixed : {false, true})
+    for (const int row : {0, 6})
+      for (int side = 0; side < 2; ++side)
+        for (int k = 0; k < 6; ++k)
+          for (const double value : bad) {
+            RowSystem s = stackRows(3, 4);
+            if (fixed) s.bodies[0] = BodyInverseMass();
+            (side ? s.rows[row].jB : s.rows[row].jA)[k] = value;
+            const Vector start = Vector::Constant(s.size(), 0.2);
+            RowPgs a, b;
+            Vector xa = start, xb;
+            const Result ra = a.solve(s, xa);
+            const Result rb = solveFromRows(b, s, start, start, xb);
+            const std::string what = "row " + std::to_string(row) + " has a non-finite Jacobian";
+            EXPECT_EQ(ra.status, Status::InvalidInput) << row << " " << side << " " << k;
+            EXPECT_NE(ra.message.find(what), std::string::npos) << ra.message;
+            EXPECT_EQ(rb.status, Status::InvalidInput) << row << " " << side << " " << k;
+            EXPECT_EQ(rb.message, ra.message);
+            EXPECT_EQ(xa, start);  // the caller's x is untouched
+          }
+}
+
 // A non-finite base (what the engine's bodies carry already): the same answer, but no per-body
 // velocity changes on offer (they would all be NaN).
 TEST(RowPgs, NonFiniteBaseOffersNoVelocityChanges) {

@@ -323,7 +323,8 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     for (int k = 0; k < count_; ++k) fillSystem(islands_[k]);
 }
 
-inline RowPgs::RowView IslandBuilder::view(Island& isl, int r, bool split, double* scratch) {
+[[gnu::always_inline]] inline RowPgs::RowView IslandBuilder::view(Island& isl, int r, bool split,
+                                                                  double* scratch) {
   const int i = isl.inOrder ? r : isl.rowIndex[r];
   const btSolverConstraint& c = *isl.rows[r];
   const int a = rowBodies_[i].first, b = rowBodies_[i].second;
@@ -408,7 +409,7 @@ inline RowPgs::RowView IslandBuilder::view(Island& isl, int r, bool split, doubl
   return out;
 }
 
-inline RowPgs::RowView IslandBuilder::Source::row(int r) {
+[[gnu::always_inline]] inline RowPgs::RowView IslandBuilder::Source::row(int r) {
   // Bullet's row r + kRowsAhead fetched: its 288 bytes start 16-byte aligned and span five or
   // six lines; the first five hold every field view() reads (bytes 0-264; m_rhsPenetration
   // among the fields past byte 224).

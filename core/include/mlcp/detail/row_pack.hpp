@@ -23,21 +23,20 @@ inline void jacobianOf(const double* lin, const double* ang, double* j) {
   }
 }
 
-// Every per-row rule of RowSystem::validate and Problem::validate (b, bounds, findex) for row i of
-// n as one predicate without copies, except that row findex's own findex must be -1 (the callers
-// check that against the other row): the fast path of RowSystem::validate, which the adapters
-// call every step, and the check RowPgs folds into its packing pass. When it says no, the checks
-// in RowSystem::validate find the row and say what is wrong (Problem::validate stays the one
-// statement of the bound rules' wording). A false alarm (a sum of finite Jacobian entries
-// overflowing) only costs the slow path. slots = bodies + 1; the array sizes are checked.
-inline bool rowValid(const RowPgs::RowView& r, const double* jA, const double* jB, int i, int n,
-                     unsigned slots) {
-  if (static_cast<unsigned>(r.bodyA + 1) >= slots || static_cast<unsigned>(r.bodyB + 1) >= slots)
-    return false;
-  // Any NaN or Inf entry makes the sum NaN or Inf.
+// Whether the 6 + 6 entries are all finite (any NaN or Inf entry makes the sum NaN or Inf).
+inline bool jacobiansFinite(const double* jA, const double* jB) {
   double sum = 0;
   for (int k = 0; k < 6; ++k) sum += jA[k] + jB[k];
-  if (!std::isfinite(sum)) return false;
+  return std::isfinite(sum);
+}
+
+// Every per-row rule of RowSystem::validate and Problem::validate except J's finiteness (b,
+// bounds, findex, body indices) for row i of n as one predicate without copies, except that row
+// findex's own findex must be -1 (the callers check that against the other row). slots = bodies
+// + 1; the array sizes are checked.
+inline bool rowRulesValid(const RowPgs::RowView& r, int i, int n, unsigned slots) {
+  if (static_cast<unsigned>(r.bodyA + 1) >= slots || static_cast<unsigned>(r.bodyB + 1) >= slots)
+    return false;
   if (!(r.cfm >= 0 && r.cfm < kInf)) return false;
   const double lo = r.lo, hi = r.hi;
   // !(lo <= hi) also catches NaN bounds.
@@ -46,6 +45,17 @@ inline bool rowValid(const RowPgs::RowView& r, const double* jA, const double* j
   if (f < 0) return f == -1;
   if (f >= n || f == i) return false;
   return hi >= 0 && std::isfinite(hi) && lo == -hi;
+}
+
+// Every per-row rule of RowSystem::validate and Problem::validate (J, b, bounds, findex): the fast
+// path of RowSystem::validate, which the adapters call every step. When it says no, the checks in
+// RowSystem::validate find the row and say what is wrong (Problem::validate stays the one
+// statement of the bound rules' wording). A false alarm (a sum of finite Jacobian entries
+// overflowing) only costs the slow path. RowPgs' packing checks rowRulesValid and J's
+// finiteness apart (pack()).
+inline bool rowValid(const RowPgs::RowView& r, const double* jA, const double* jB, int i, int n,
+                     unsigned slots) {
+  return jacobiansFinite(jA, jB) && rowRulesValid(r, i, n, slots);
 }
 
 // A finite, non-negative inverse mass and a finite inverse inertia.
@@ -148,7 +158,10 @@ bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& row
     double jA[6], jB[6];
     detail::jacobianOf(r.linA, r.angA, jA);
     detail::jacobianOf(r.linB, r.angB, jB);
-    if (!detail::rowValid(r, jA, jB, i, n, slots)) return stop(i, std::nan(""));
+    // J's finiteness: a world side's here, a body side's through A_ii (below).
+    if (!detail::rowRulesValid(r, i, n, slots) ||
+        ((r.bodyA < 0 || r.bodyB < 0) && !detail::jacobiansFinite(jA, jB)))
+      return stop(i, std::nan(""));
     PackedRow& p = packed_[i];
     // The packed rows written a few rows ahead are fetched for writing: after the engine's own
     // setup they are mostly out of L2, and ~30 stores a row waiting on their lines filled the
@@ -171,8 +184,8 @@ bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& row
       }
     }
     // "The world" (-1) becomes the zero-velocity slot (its J meets v = 0, its M^-1 J^T is 0).
-    if (i > 0 && r.bodyA == lastA && r.bodyB == lastB && r.bodyA != r.bodyB &&
-        runLength < kMaxRun) {
+    // (lastA starts at -2: no body, no world: row 0 starts a run.)
+    if (r.bodyA == lastA && r.bodyB == lastB && r.bodyA != r.bodyB && runLength < kMaxRun) {
       ++packed_[runStart].run;
       ++runLength;
     } else {
@@ -197,7 +210,11 @@ bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& row
     // A row joining a body to itself: A_ii = (jA + jB) M^-1 (jA + jB) has the cross terms too.
     if (r.bodyA == r.bodyB && r.bodyA >= 0)
       for (int k = 0; k < 6; ++k) d += jA[k] * mB[k] + jB[k] * mA[k];
-    if (!(d > 0 && d <= std::numeric_limits<double>::max())) return stop(i, d);  // NaN, inf too
+    // NaN and inf fail too. This is also the check that a body side's J is finite: a NaN or
+    // infinite entry j_k makes its term j_k (M^-1 j)_k NaN or infinite whatever the (finite)
+    // body (inf times anything is inf or NaN, the engine's invAng included), and no sum with
+    // such a term is finite (the rowValid sum of session 6 cost ~20 instructions a row).
+    if (!(d > 0 && d <= std::numeric_limits<double>::max())) return stop(i, d);
     const double step = options_.relaxation / d;
     for (int k = 0; k < 6; ++k) {
       p.sA[k] = step * jA[k];
@@ -295,7 +312,7 @@ Result RowPgs::solveFrom(const std::vector<BodyInverseMass>& bodies, int n, Sour
   double bNorm = 0;
   const bool packed = pack(
       bodies, n,
-      [&](int i) {
+      [&](int i) __attribute__((always_inline)) {
         const RowView r = source.row(i);
         bNorm = std::max(bNorm, std::abs(r.b));
         return r;
