@@ -9,6 +9,7 @@
 #include "dantzig_small.hpp"
 #include "mlcp/pgs.hpp"
 #include "mlcp/residual.hpp"
+#include "mlcp/rows.hpp"
 #include "sparse_pattern.hpp"
 
 namespace mlcp {
@@ -734,6 +735,7 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
   }
   blockSteps_ = 0;
   blockFactorizations_ = 0;
+  blockBodyFactorizations_ = 0;
   blockSettled_ = false;
   const bool warm = !x.isZero(0.0);
   if (!wantsBlockStage(problem)) {
@@ -759,8 +761,13 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
     result.message = blockMessage.empty() ? rep.message : blockMessage + "; " + rep.message;
   };
   bool symmetric = false;  // known after a first run of the block stage
+  // Body-space steps cost a fraction of an A_CC factorization: more of them before the hand-over.
+  const bool bodySpace =
+      params_.blockBodySpace && rows_ != nullptr && rows_->size() == problem.size();
+  const int maxSteps = std::max(1, bodySpace ? params_.maxBodyBlockSteps : params_.maxBlockSteps);
+  block_->setRows(params_.blockBodySpace ? rows_ : nullptr);
   block_->setLimits({params_.blockWoodburyRows, params_.blockUpdateRows, params_.blockDescentSteps,
-                     params_.blockBreakCycles});
+                     params_.blockBreakCycles, params_.blockBodyMinDiagonal});
   // Auto first tries a few full steps from the cold guess (every row clamped): resting piles
   // (ODE) settle in one step there, often sooner than from a warm guess whose sets are off by
   // a few rows; when they do not settle the trial is dropped (its iterate is a worse start than
@@ -782,12 +789,12 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
   }
   if (coldTrial) {
     Vector trial = Vector::Zero(problem.size());
-    const detail::BlockPivoting::Report rep =
-        block_->run(problem, trial, options(),
-                    std::max(1, std::min(params_.autoColdSteps, params_.maxBlockSteps)), true);
+    const detail::BlockPivoting::Report rep = block_->run(
+        problem, trial, options(), std::max(1, std::min(params_.autoColdSteps, maxSteps)), true);
     symmetric = rep.symmetric;
     blockSteps_ += rep.steps;
     blockFactorizations_ += rep.factorizations;
+    blockBodyFactorizations_ += rep.bodyFactorizations;
     coldMissed_ = rep.settled ? 0 : 1;
     coldMissedRows_ = problem.size();
     if (rep.settled) {
@@ -812,10 +819,11 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
     // block stage from a few projected Gauss-Seidel sweeps over it ("Pre-sweeps" in dantzig.hpp).
     if (warm && params_.blockPgsSweeps > 0 && guessResidual > params_.blockPgsResidual)
       preSweeps(problem, params_.blockPgsSweeps, x);
-    const detail::BlockPivoting::Report rep = block_->run(
-        problem, x, options(), std::max(1, params_.maxBlockSteps), false, symmetric, setsAtGuess);
+    const detail::BlockPivoting::Report rep =
+        block_->run(problem, x, options(), maxSteps, false, symmetric, setsAtGuess);
     blockSteps_ += rep.steps;
     blockFactorizations_ += rep.factorizations;
+    blockBodyFactorizations_ += rep.bodyFactorizations;
     if (rep.settled) {
       settle(rep);
       return;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "dantzig_body.hpp"
 #include "mlcp/residual.hpp"
 #include "mlcp/solver.hpp"
 
@@ -25,6 +26,9 @@ double signOf(double v) { return v < 0 ? -1.0 : 1.0; }
 // The value a non-clamped, uncoupled row is held at.
 double heldValue(double lo, double hi, bool atHi) { return atHi ? hi : lo; }
 }  // namespace
+
+BlockPivoting::BlockPivoting() : body_(std::make_unique<BodySpaceSystem>()) {}
+BlockPivoting::~BlockPivoting() = default;
 
 bool SymmetricPatternLu::factor(int m, const std::vector<int>& outer, const std::vector<int>& inner,
                                 const std::vector<double>& k, const std::vector<double>& kt,
@@ -263,7 +267,19 @@ bool BlockPivoting::solveClamped(const Problem& pb, Vector& x, const Vector& pre
     r[c] = -(pb.b[order_[c]] + A.row(order_[c]).dot(x)) + rho * prev[order_[c]];
   const int s = static_cast<int>(sliding_.size());
   useLu_ = s > limits_.woodburyRows && m > 0;
-  if (m > 0) {
+  useBody_ = false;
+  // Body space (dantzig_body.hpp) whenever it applies: a fresh factor there costs less than
+  // reusing one here (no base is kept for the bordered updates then).
+  if (m > 0 && bodyReady_) {
+    useBody_ = body_->factor(order_, pos_, sliding_, coeff_, problemFindex_, rho,
+                             limits_.bodyMinDiagonal * dMax_);
+    if (useBody_) {
+      haveBase_ = false;
+      ++factorizations_;
+      ++bodyFactorizations_;
+    }
+  }
+  if (m > 0 && !useBody_) {
     if (useLu_) {
       haveBase_ = false;
       ++factorizations_;
@@ -305,6 +321,10 @@ bool BlockPivoting::solveClamped(const Problem& pb, Vector& x, const Vector& pre
 }
 
 void BlockPivoting::applySolve(Vector& y) {
+  if (useBody_) {
+    body_->solve(y);
+    return;
+  }
   if (useLu_) {
     if (useSymLu_)
       symLu_.solve(y);
@@ -659,6 +679,9 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
   double dMax = 0;
   for (int i = 0; i < n; ++i) dMax = std::max(dMax, std::abs(pb.diagonal(i)));
   pivTol_ = opt.pivotTolerance * (dMax > 0 ? dMax : 1.0);
+  dMax_ = dMax;
+  bodyReady_ = rows_ != nullptr && body_->prepare(*rows_, n);
+  bodyFactorizations_ = 0;
   pivTolRelative_ = opt.pivotTolerance;
   eps_ = 0.01 * opt.tolerance * (1 + pb.b.lpNorm<Eigen::Infinity>());
   pos_.assign(n, -1);
@@ -801,6 +824,7 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
   }
   rep.message = os.str();
   rep.factorizations = factorizations_;
+  rep.bodyFactorizations = bodyFactorizations_;
   return rep;
 }
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/SparseLU>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -10,7 +11,13 @@
 #include "mlcp/result.hpp"
 #include "sparse_pattern.hpp"
 
+namespace mlcp {
+class RowSystem;
+}
+
 namespace mlcp::detail {
+
+class BodySpaceSystem;
 
 // K = L D U without pivoting (L unit lower, U unit upper) for a sparse square K whose pattern
 // is symmetric, in the given order: up-looking, row k of L and column k of U from two sparse
@@ -32,7 +39,8 @@ class SymmetricPatternLu {
   // nonzero (idx's reach in the elimination tree: L(r, i) != 0 only for ancestors r of i), in
   // increasing order. Costs the entries of L in those columns, not m.
   void forward(std::vector<int>& idx, Vector& y);
-  double pivot(int c) const { return d_[c]; }  // D's entry c
+  double pivot(int c) const { return d_[c]; }                         // D's entry c
+  int entries() const { return start_.empty() ? 0 : start_.back(); }  // L's off-diagonal entries
 
  private:
   bool run(int m, const std::vector<int>& outer, const std::vector<int>& inner,
@@ -49,11 +57,18 @@ class SymmetricPatternLu {
 
 class BlockPivoting {
  public:
+  BlockPivoting();
+  ~BlockPivoting();
+  // The rows the next run()'s problem was assembled from (nullptr: none): block steps may then be
+  // solved in body space (dantzig_body.hpp). Not owned; must outlive run().
+  void setRows(const RowSystem* rows) { rows_ = rows; }
+
   struct Report {
     bool settled = false;    // x solves the problem to Options::tolerance (checked by residual())
     int steps = 0;           // block steps (each one linear solve of the index sets' equations)
     bool symmetric = false;  // A passed the symmetry check (else the stage did not run)
     int factorizations = 0;  // of the steps, those that factored their clamped block afresh
+    int bodyFactorizations = 0;  // of those, the ones factored in body space
     std::string message;
   };
 
@@ -69,12 +84,14 @@ class BlockPivoting {
   // Most sliding rows handled by Woodbury on the symmetric factor (more: the LU), and most
   // unknowns by which a step's sets may differ from the last factored ones (joined, left and
   // sliding rows) for the step to reuse that factor. DantzigParams documents them.
-  // descentSteps and breakCycles: see DantzigParams::blockDescentSteps / blockBreakCycles.
+  // descentSteps and breakCycles: see DantzigParams::blockDescentSteps / blockBreakCycles;
+  // bodyMinDiagonal: DantzigParams::blockBodyMinDiagonal.
   struct Limits {
     int woodburyRows = 16;
     int updateRows = 40;
     int descentSteps = 8;
     bool breakCycles = true;
+    double bodyMinDiagonal = 1e-6;
   };
   void setLimits(const Limits& limits) { limits_ = limits; }
 
@@ -123,6 +140,12 @@ class BlockPivoting {
   // the same: a bordered system with a small dense Schur complement (buildCapacitance). Sliding
   // rows on the symmetric B = A_CC + rho I (K = B + U E^T, Woodbury) are bordered the same way.
   Limits limits_;
+  const RowSystem* rows_ = nullptr;
+  std::unique_ptr<BodySpaceSystem> body_;
+  bool bodyReady_ = false;  // body_ prepared for this run's rows
+  bool useBody_ = false;    // the current step's K is solved in body space
+  int bodyFactorizations_ = 0;
+  double dMax_ = 0;  // max |A_ii|
   int factorizations_ = 0;
   bool haveBase_ = false;
   double baseRho_ = 0;

@@ -191,7 +191,10 @@ Result RowSolver::run(const RowSystem& rows, const std::string& name, const Opti
   }
   Solver* solver = assembledSolver(island, name);
   solver->setOptions(o);
-  return solver->solveWithGuess(assembled_, start, x);
+  solver->useRows(&rows);
+  Result r = solver->solveWithGuess(assembled_, start, x);
+  solver->useRows(nullptr);
+  return r;
 }
 
 void RowSolver::assemble(const RowSystem& rows, bool sparse) {

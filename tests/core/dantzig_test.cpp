@@ -8,6 +8,7 @@
 #include <random>
 
 #include "../core/src/dantzig_block.hpp"  // SymmetricPatternLu (internal)
+#include "../core/src/dantzig_body.hpp"   // BodySpaceSystem (internal)
 #include "../core/src/dantzig_small.hpp"  // the tiny dense path (internal)
 #include "common/contact_scenes.hpp"
 #include "common/generators.hpp"
@@ -1071,6 +1072,108 @@ TEST(DantzigBlock, PreSweepsOverAFarGuess) {
     EXPECT_TRUE((x.array() == y.array()).all()) << "step " << step;
   }
   EXPECT_EQ(swept, 2);
+}
+
+// K = D + J_C W G_C^T solved in body space equals K built from the assembled A and solved densely:
+// random clamped sets with sliding rows, a body with a singular (locked-axis) inertia, a static
+// body; no sliding rows gives the symmetric case. cfm_c + rho below the limit declines.
+TEST(DantzigBody, SolvesTheClampedSystemOfTheAssembledProblem) {
+  test::BoxPyramid pyramid(slidingPyramid(4));
+  RowSystem rows = pyramid.rows();
+  // Box 0: rotation about a tilted axis locked (rank-2 inverse inertia); box 1: static.
+  const Eigen::Vector3d axis = Eigen::Vector3d(1, 2, 3).normalized();
+  const Eigen::Matrix3d lock = Eigen::Matrix3d::Identity() - axis * axis.transpose();
+  rows.bodies[0].invInertia = lock * rows.bodies[0].invInertia * lock;
+  rows.bodies[1] = BodyInverseMass{};
+  const Problem p = rows.assemble(false);
+  const DenseMatrix& A = p.denseA();
+  const int n = p.size();
+  detail::BodySpaceSystem body;
+  ASSERT_TRUE(body.prepare(rows, n));
+  EXPECT_EQ(body.size(), 6 * (pyramid.boxes() - 1));
+  std::mt19937 rng(5);
+  for (int trial = 0; trial < 6; ++trial) {
+    std::vector<int> order, pos(n, -1), sliding;
+    std::vector<double> coeff;
+    for (int i = 0; i < n; ++i)
+      if (p.findex[i] < 0 && rng() % 4 != 0) {
+        pos[i] = static_cast<int>(order.size());
+        order.push_back(i);
+      }
+    for (int t = 0; t < n; ++t) {
+      if (p.findex[t] < 0 || pos[p.findex[t]] < 0) continue;
+      if (trial > 0 && rng() % 3 == 0) {
+        sliding.push_back(t);
+        coeff.push_back((rng() % 2 ? 0.7 : -0.6));
+      } else if (rng() % 2 == 0) {
+        pos[t] = static_cast<int>(order.size());
+        order.push_back(t);
+      }
+    }
+    const int m = static_cast<int>(order.size());
+    const double rho = trial % 2 == 0 ? 1e-2 : 0.0;
+    DenseMatrix K(m, m);
+    for (int c = 0; c < m; ++c)
+      for (int d = 0; d < m; ++d) K(c, d) = A(order[c], order[d]) + (c == d ? rho : 0.0);
+    for (size_t k = 0; k < sliding.size(); ++k)
+      for (int c = 0; c < m; ++c)
+        K(c, pos[p.findex[sliding[k]]]) += coeff[k] * A(order[c], sliding[k]);
+    ASSERT_TRUE(body.factor(order, pos, sliding, coeff, p.findex, rho, 1e-9)) << trial;
+    Vector r(m);
+    for (int c = 0; c < m; ++c) r[c] = std::sin(1.0 + c + trial);
+    Vector y = r;
+    body.solve(y);
+    const Vector expected = K.fullPivLu().solve(r);
+    EXPECT_LE((y - expected).norm(), 1e-8 * expected.norm()) << trial;
+    // Conditioning ~ 1 / d: one step of refinement against K (as the block stage takes) restores
+    // a backward error near the dense factorization's.
+    Vector correction = r - K * y;
+    body.solve(correction);
+    y += correction;
+    EXPECT_LE((K * y - r).norm(), 1e-14 * K.norm() * y.norm()) << trial;
+    EXPECT_FALSE(body.factor(order, pos, sliding, coeff, p.findex, rho, 1.0)) << trial;
+  }
+}
+
+// The block stage with the problem's rows (Solver::useRows, as RowSolver passes them) factors in
+// body space and gives the answers of the same solver without them, step after step of a sliding
+// pyramid (damped and full steps: cfm > 0). With cfm = 0 the full steps fall back to A_CC.
+TEST(DantzigBody, RowsGiveTheAnswersOfTheProblemAlone) {
+  for (const double cfm : {1e-5 * 60, 0.0}) {
+    test::PyramidSpec spec = slidingPyramid(5);
+    spec.cfm = cfm;
+    test::BoxPyramid pyramid(spec);
+    DantzigSolver with = withStage(DantzigParams::BlockStage::Always);
+    DantzigSolver without = withStage(DantzigParams::BlockStage::Always);
+    Vector x, y;
+    int inBodySpace = 0, factorizations = 0;
+    for (int step = 0; step < 5; ++step) {
+      pyramid.nextStep(0.1);
+      const Problem p = pyramid.rows().assemble(true);
+      const Vector gx = x, gy = y;
+      with.useRows(&pyramid.rows());
+      const Result r = gx.size() == p.size() ? with.solveWithGuess(p, gx, x) : with.solve(p, x);
+      with.useRows(nullptr);
+      const Result ref =
+          gy.size() == p.size() ? without.solveWithGuess(p, gy, y) : without.solve(p, y);
+      ASSERT_TRUE(r.converged()) << cfm << " step " << step << ": " << r.message;
+      ASSERT_TRUE(ref.converged()) << cfm << " step " << step << ": " << ref.message;
+      EXPECT_LE(accuracy(p, x).residual, 1e-9) << step;
+      if (cfm > 0) {  // unique answer
+        EXPECT_LE((x - y).lpNorm<Eigen::Infinity>(), 1e-6 * (1 + y.lpNorm<Eigen::Infinity>()))
+            << step;
+      }
+      EXPECT_EQ(without.blockBodyFactorizations(), 0);
+      inBodySpace += with.blockBodyFactorizations();
+      factorizations += with.blockFactorizations();
+    }
+    EXPECT_GT(inBodySpace, 0) << cfm;
+    if (cfm > 0) {
+      EXPECT_EQ(inBodySpace, factorizations);
+    } else {
+      EXPECT_LT(inBodySpace, factorizations) << "full steps with cfm = 0 fall back";
+    }
+  }
 }
 
 }  // namespace

@@ -320,6 +320,26 @@
 // against 56), damped steps at once from it (no full steps: 144 against 138; CPU ms per step over
 // 20 steps, four alternated runs, 58.6-85.3 against 56.6-82.2: the noise).
 //
+// Body space (DantzigParams::blockBodySpace, maxBodyBlockSteps; session 8). A problem assembled
+// from rows (rows.hpp, handed over by Solver::useRows: RowSolver, hence the Bullet and ODE
+// adapters) has A = J W J^T + diag(cfm), so a block step's K = D + J_C W G_C^T (D = diag(cfm_c +
+// rho), G_c = J_c plus c_t J_t of c's sliding rows) is solved by Woodbury in body space: K^-1 r =
+// D^-1 (r - J_C R y), S y = R^T G_C^T D^-1 r, S = I + R^T G_C^T D^-1 J_C R (W = R R^T per body,
+// R from the eigen decomposition of invInertia: singular inertia allowed; static bodies left out),
+// S of size 6 x dynamic bodies, factored as a right-looking LU on 6 x 6 blocks in an AMD order of
+// the body graph with its block fill (core/src/dantzig_body.hpp). Every step (damped or full)
+// whose every d_c is at least blockBodyMinDiagonal max |A_ii| takes it (no factor is kept for the
+// bordered updates then: a fresh S costs less than a reuse); the others factor A_CC as above.
+// Conditioning ~ 1 / d: with 1e-9 the cfm = 0 pyramids' damped steps near the answer (rho ~ 1e-9)
+// lost the tolerance and a test's solve ended in the friction passes' MaxIterations; 1e-6 keeps
+// one refinement step enough. Bullet's 55-box pyramid after the switch (n = 1160, m ~ 550-700,
+// 57-105 sliding rows, S 330 x 330): one fresh factorization and solve ~0.16-0.21 ms against
+// ~0.86-1.08 ms for K's LU (5.2-5.3x; with S factored by the scalar SymmetricPatternLu instead of
+// 6 x 6 blocks only 1.8-2.0x: L ~10k entries against K's ~27k, but denser columns), relative
+// difference of the two solutions before refinement <= 5e-11. With steps that cheap, solves after
+// the switch settle in the block stage within 120 steps (iterations per step 138 -> 45: no pivoting
+// finish); maxBlockSteps 40 / 60 / 80 / 100 / 120 / 200 gave 138 / 96 / 81 / 82 / 45 / 45.
+//
 // Result::iterations counts pivots (direction computations: each row added or exchanged)
 // summed over all passes; Options::maxPivots (0: 50 n + 100) limits them per pass
 // (MaxIterations when exceeded). Options::timeBudget is checked between pivots.
@@ -352,6 +372,11 @@ struct DantzigParams {
   // Block steps (each a fresh factorization or a reuse of the last one) the block stage may take
   // before it hands over. Default 40.
   int maxBlockSteps = 40;
+  // The same for a solve whose steps factor in body space (blockBodySpace with the problem's
+  // rows): each costs a fraction of an A_CC factorization, so more of them pay before the
+  // incremental pivoting's finish (Bullet's pyramid after the switch: none needed beyond 120).
+  // Default 120.
+  int maxBodyBlockSteps = 120;
   // Auto: the smallest problem (rows) that gets the block stage. Default 100.
   int autoMinRows = 100;
   // Auto: the largest fraction of nonzero entries in A. Default 0.3.
@@ -403,6 +428,14 @@ struct DantzigParams {
   // after the switch from SI, 0.19-0.8, but not most of a falling pyramid's own last answers,
   // 0.01-0.3, which the sweeps make worse starts). Default 0.2.
   double blockPgsResidual = 0.2;
+  // Block steps of a problem that comes with its rows (Solver::useRows; RowSolver, hence the
+  // Bullet and ODE adapters) factor in body space where that applies (see "Body space" above).
+  // Default true.
+  bool blockBodySpace = true;
+  // Body space applies to a step whose every clamped row has cfm_c + rho at least this times
+  // max |A_ii| (its conditioning grows as 1 / d, and one step of refinement follows); other
+  // steps factor A_CC. Default 1e-6.
+  double blockBodyMinDiagonal = 1e-6;
 };
 
 class DantzigSolver : public Solver {
@@ -425,11 +458,17 @@ class DantzigSolver : public Solver {
   int blockSteps() const { return blockSteps_; }
   // Of those, the steps that factored their clamped block afresh (the others reused a factor).
   int blockFactorizations() const { return blockFactorizations_; }
+  // Of those, the ones factored in body space (DantzigParams::blockBodySpace).
+  int blockBodyFactorizations() const { return blockBodyFactorizations_; }
   bool blockSettled() const { return blockSettled_; }
 
  protected:
   void run(const Problem& problem, Vector& x, Result& result) override;
 
+ public:
+  void useRows(const RowSystem* rows) override { rows_ = rows; }
+
+ protected:
  private:
   struct Workspace;
   bool wantsBlockStage(const Problem& problem) const;
@@ -440,6 +479,8 @@ class DantzigSolver : public Solver {
   DantzigParams params_;
   int blockSteps_ = 0;
   int blockFactorizations_ = 0;
+  int blockBodyFactorizations_ = 0;
+  const RowSystem* rows_ = nullptr;
   bool blockSettled_ = false;
   int coldMissed_ = 0;      // solves since the last cold trial, which did not settle (0: it did)
   int coldMissedRows_ = 0;  // that trial's problem size: another size tries again

@@ -20,6 +20,8 @@
 
 namespace mlcp {
 
+class RowSystem;
+
 class Solver {
  public:
   virtual ~Solver() = default;
@@ -46,6 +48,12 @@ class Solver {
   Result solve(const Problem& problem, Vector& x);
   // Solve from the given guess (size n), whatever options().warmStart says.
   Result solveWithGuess(const Problem& problem, const Vector& guess, Vector& x);
+
+  // The rows (rows.hpp) the next solves' problem was assembled from, or nullptr (the default: a
+  // Problem alone). A solver may use them for the same answers at less cost (dantzig's block
+  // steps in body space); the default ignores them. Not owned: the caller clears it (nullptr)
+  // before the rows go away or describe another problem (RowSolver sets it around each solve).
+  virtual void useRows(const RowSystem* /*rows*/) {}
 
  protected:
   // The algorithm. x arrives sized n holding the start point; leave the answer in it. Set

@@ -1,0 +1,184 @@
+#include "dantzig_body.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/OrderingMethods>
+#include <algorithm>
+#include <cmath>
+
+namespace mlcp::detail {
+
+bool BodySpaceSystem::prepare(const RowSystem& rows, int n) {
+  if (rows.size() != n || rows.cfm.size() != n) return false;
+  const int nb = static_cast<int>(rows.bodies.size());
+  // R per body; bodies whose W is 0 (static) are left out of S.
+  std::vector<Eigen::Matrix3d> angular(nb);
+  std::vector<double> linear(nb);
+  std::vector<int> compact(nb, -1);
+  int dynamic = 0;
+  for (int k = 0; k < nb; ++k) {
+    const BodyInverseMass& body = rows.bodies[k];
+    linear[k] = std::sqrt(std::max(0.0, body.invMass));
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+    eig.computeDirect(body.invInertia);
+    angular[k] = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
+    if (linear[k] > 0 || !angular[k].isZero(0.0)) compact[k] = dynamic++;
+  }
+  // A fill-reducing order of the body graph (every row's pair), so S's factor stays sparse.
+  std::vector<Eigen::Triplet<double>> pairs;
+  for (int k = 0; k < dynamic; ++k) pairs.emplace_back(k, k, 1.0);
+  for (const ConstraintRow& r : rows.rows) {
+    const int a = r.bodyA >= 0 ? compact[r.bodyA] : -1, b = r.bodyB >= 0 ? compact[r.bodyB] : -1;
+    if (a >= 0 && b >= 0 && a != b) {
+      pairs.emplace_back(a, b, 1.0);
+      pairs.emplace_back(b, a, 1.0);
+    }
+  }
+  if (dynamic > kMaxBodies) return false;
+  Eigen::SparseMatrix<double, Eigen::ColMajor, int> graph(dynamic, dynamic);
+  graph.setFromTriplets(pairs.begin(), pairs.end());
+  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> perm;
+  Eigen::AMDOrdering<int>()(graph, perm);
+  // perm.indices()[k]: the body at rank k (as BlockPivoting's byRank_).
+  std::vector<int> rank(dynamic);
+  for (int k = 0; k < dynamic; ++k) rank[perm.indices()[k]] = k;
+  for (int k = 0; k < nb; ++k)
+    if (compact[k] >= 0) compact[k] = rank[compact[k]];
+  bodies_ = dynamic;
+  // The block pattern with its fill: eliminating body k joins every pair of its later neighbours.
+  const size_t nb2 = static_cast<size_t>(dynamic) * dynamic;
+  slot_.assign(nb2, -1);
+  for (int k = 0; k < dynamic; ++k) slot_[static_cast<size_t>(k) * dynamic + k] = 0;
+  for (int col = 0; col < graph.outerSize(); ++col)
+    for (Eigen::SparseMatrix<double, Eigen::ColMajor, int>::InnerIterator it(graph, col); it; ++it)
+      slot_[static_cast<size_t>(rank[it.index()]) * dynamic + rank[col]] = 0;
+  belowStart_.assign(1, 0);
+  below_.clear();
+  for (int k = 0; k < dynamic; ++k) {
+    const int first = static_cast<int>(below_.size());
+    for (int i = k + 1; i < dynamic; ++i)
+      if (slot_[static_cast<size_t>(i) * dynamic + k] >= 0) below_.push_back(i);
+    const int last = static_cast<int>(below_.size());
+    for (int a = first; a < last; ++a)
+      for (int b = first; b < last; ++b)
+        slot_[static_cast<size_t>(below_[a]) * dynamic + below_[b]] = 0;
+    belowStart_.push_back(last);
+  }
+  int count = 0;
+  for (int& e : slot_)
+    if (e >= 0) e = count++;
+  blocks_.resize(count);
+  inverse_.resize(dynamic);
+  rows_.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const ConstraintRow& r = rows.rows[i];
+    RowData& rd = rows_[i];
+    rd.a = r.bodyA >= 0 ? compact[r.bodyA] : -1;
+    rd.b = r.bodyB >= 0 ? compact[r.bodyB] : -1;
+    auto side = [&](int body, const Vector6& j, double* out) {
+      if (body < 0) {
+        std::fill(out, out + 6, 0.0);
+        return;
+      }
+      for (int l = 0; l < 3; ++l) out[l] = linear[body] * j[l];
+      const Eigen::Vector3d ang = angular[body].transpose() * j.tail<3>();
+      for (int l = 0; l < 3; ++l) out[3 + l] = ang[l];
+    };
+    side(rd.a >= 0 ? r.bodyA : -1, r.jA, rd.jr);
+    side(rd.b >= 0 ? r.bodyB : -1, r.jB, rd.jr + 6);
+  }
+  cfm_.assign(rows.cfm.data(), rows.cfm.data() + n);
+  return true;
+}
+
+bool BodySpaceSystem::factor(const std::vector<int>& order, const std::vector<int>& pos,
+                             const std::vector<int>& sliding, const std::vector<double>& coeff,
+                             const std::vector<int>& findex, double rho, double minDiagonal) {
+  const int m = static_cast<int>(order.size());
+  d_.resize(m);
+  gr_.resize(12 * static_cast<size_t>(m));
+  for (int c = 0; c < m; ++c) {
+    const int i = order[c];
+    d_[c] = cfm_[i] + rho;
+    if (!(d_[c] >= minDiagonal)) return false;
+    std::copy(rows_[i].jr, rows_[i].jr + 12, gr_.begin() + 12 * c);
+  }
+  for (size_t k = 0; k < sliding.size(); ++k) {
+    const RowData& t = rows_[sliding[k]];
+    const int i = findex[sliding[k]], c = pos[i];
+    if (t.a != rows_[i].a || t.b != rows_[i].b) return false;
+    for (int l = 0; l < 12; ++l) gr_[12 * c + l] += coeff[k] * t.jr[l];
+  }
+  for (Block& blk : blocks_) blk.setZero();
+  for (int q = 0; q < bodies_; ++q) at(q, q).setIdentity();
+  // S(p, q) += (G_c R_p)^T (J_c R_q) / d_c for the sides p, q of each clamped row c.
+  using Vec6 = Eigen::Matrix<double, 6, 1>;
+  for (int c = 0; c < m; ++c) {
+    const RowData& rd = rows_[order[c]];
+    const double inv = 1 / d_[c];
+    const int side[2] = {rd.a, rd.b};
+    for (int sp = 0; sp < 2; ++sp) {
+      if (side[sp] < 0) continue;
+      const Vec6 gp = Eigen::Map<const Vec6>(&gr_[12 * c + 6 * sp]) * inv;
+      for (int sq = 0; sq < 2; ++sq)
+        if (side[sq] >= 0)
+          at(side[sp], side[sq]).noalias() +=
+              gp * Eigen::Map<const Vec6>(rd.jr + 6 * sq).transpose();
+    }
+  }
+  rowOf_.assign(order.begin(), order.end());
+  // Right-looking block LU in the elimination order (no pivoting between blocks: S = I + V^T D^-1
+  // U is symmetric positive definite without sliding rows, near it with them).
+  constexpr double kPivot = 1e-12;
+  for (int k = 0; k < bodies_; ++k) {
+    const Eigen::PartialPivLU<Block> lu(at(k, k));
+    const double scale = std::max(1.0, at(k, k).cwiseAbs().maxCoeff());
+    if (!(lu.matrixLU().diagonal().cwiseAbs().minCoeff() > kPivot * scale)) return false;
+    inverse_[k] = lu.inverse();
+    const int first = belowStart_[k], last = belowStart_[k + 1];
+    for (int a = first; a < last; ++a) at(below_[a], k) = at(below_[a], k) * inverse_[k];
+    for (int a = first; a < last; ++a) {
+      const Block& lik = at(below_[a], k);
+      for (int b = first; b < last; ++b)
+        at(below_[a], below_[b]).noalias() -= lik * at(k, below_[b]);
+    }
+  }
+  return inverse_.empty() || inverse_.back().allFinite();
+}
+
+void BodySpaceSystem::solve(Vector& y) {
+  const int m = static_cast<int>(rowOf_.size());
+  Vector& z = z_;
+  z.setZero(6 * bodies_);
+  for (int c = 0; c < m; ++c) {
+    const RowData& rd = rows_[rowOf_[c]];
+    const double q = y[c] / d_[c];
+    const double* g = &gr_[12 * c];
+    if (rd.a >= 0)
+      for (int l = 0; l < 6; ++l) z[6 * rd.a + l] += g[l] * q;
+    if (rd.b >= 0)
+      for (int l = 0; l < 6; ++l) z[6 * rd.b + l] += g[6 + l] * q;
+  }
+  using Vec6 = Eigen::Matrix<double, 6, 1>;
+  for (int k = 0; k < bodies_; ++k) {
+    const Vec6 zk = z.segment<6>(6 * k);
+    for (int a = belowStart_[k]; a < belowStart_[k + 1]; ++a)
+      z.segment<6>(6 * below_[a]).noalias() -= at(below_[a], k) * zk;
+  }
+  for (int k = bodies_ - 1; k >= 0; --k) {
+    Vec6 t = z.segment<6>(6 * k);
+    for (int a = belowStart_[k]; a < belowStart_[k + 1]; ++a)
+      t.noalias() -= at(k, below_[a]) * z.segment<6>(6 * below_[a]);
+    z.segment<6>(6 * k) = inverse_[k] * t;
+  }
+  for (int c = 0; c < m; ++c) {
+    const RowData& rd = rows_[rowOf_[c]];
+    double u = 0;
+    if (rd.a >= 0)
+      for (int l = 0; l < 6; ++l) u += rd.jr[l] * z[6 * rd.a + l];
+    if (rd.b >= 0)
+      for (int l = 0; l < 6; ++l) u += rd.jr[6 + l] * z[6 * rd.b + l];
+    y[c] = (y[c] - u) / d_[c];
+  }
+}
+
+}  // namespace mlcp::detail

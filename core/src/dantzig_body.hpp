@@ -1,0 +1,64 @@
+// Block steps of DantzigSolver's block stage solved in body space (see "Body space" in
+// mlcp/dantzig.hpp). Internal to the library.
+//
+// For a problem assembled from rows (rows.hpp: A = J W J^T + diag(cfm), W = M^-1), a block step's
+// matrix on its clamped set C, with sliding rows t (x_t = c_t x_n(t)) substituted, is
+//
+//     K = D + J_C W G_C^T,   D = diag(cfm_c + rho),   G_c = J_c + sum_{t: n(t) = c} c_t J_t.
+//
+// With W = R R^T per body (R = sqrt(invMass) on the linear part, Q sqrt(Lambda) of the eigen
+// decomposition of invInertia on the angular part: singular inertia allowed) and U = J_C R,
+// V = G_C R, Woodbury gives
+//
+//     K^-1 r = D^-1 (r - U y),   S y = V^T D^-1 r,   S = I + V^T D^-1 U,
+//
+// S of size 6 x (dynamic bodies), 6 x 6 blocks on the body graph (symmetric pattern; symmetric
+// positive definite, eigenvalues >= 1, without sliding rows). Valid when every d_c is not tiny.
+#pragma once
+
+#include <Eigen/Dense>
+#include <vector>
+
+#include "mlcp/problem.hpp"
+#include "mlcp/rows.hpp"
+
+namespace mlcp::detail {
+
+class BodySpaceSystem {
+ public:
+  // Per solve: the rows A was assembled from. False when they do not fit a problem of n rows.
+  bool prepare(const RowSystem& rows, int n);
+  // Factors S for the clamped rows order (pos: row -> index in order, or -1) and the sliding rows
+  // with their coefficients (findex: each sliding row's normal). False when it does not apply
+  // (some cfm_c + rho below minDiagonal, a sliding row on other bodies than its normal's) or S
+  // is singular; the caller then factors K itself.
+  bool factor(const std::vector<int>& order, const std::vector<int>& pos,
+              const std::vector<int>& sliding, const std::vector<double>& coeff,
+              const std::vector<int>& findex, double rho, double minDiagonal);
+  // y <- K^-1 y (y indexed as order).
+  void solve(Vector& y);
+  int size() const { return 6 * bodies_; }
+  // The most dynamic bodies handled (the block table is bodies^2 entries).
+  static constexpr int kMaxBodies = 1024;
+
+ private:
+  using Block = Eigen::Matrix<double, 6, 6>;
+  struct RowData {
+    int a = -1, b = -1;  // dynamic bodies in elimination order, -1: none
+    double jr[12];       // [J_A R_A, J_B R_B]
+  };
+  Block& at(int p, int q) { return blocks_[slot_[static_cast<size_t>(p) * bodies_ + q]]; }
+  std::vector<RowData> rows_;
+  int bodies_ = 0;
+  // S and its factor S = L U on 6 x 6 blocks (L unit block-lower, U block-upper whose
+  // diagonal blocks are kept inverted, from a 6 x 6 LU with partial pivoting), on the block pattern
+  // of the body graph with its fill in the elimination order: below_[belowStart_[k] ..] the blocks
+  // (i, k), i > k, of L (and (k, i) of U); slot_ per block pair its index in blocks_, -1 outside.
+  std::vector<int> belowStart_, below_, slot_;
+  std::vector<Block, Eigen::aligned_allocator<Block>> blocks_, inverse_;  // inverse_: U's diagonal
+  std::vector<double> d_, gr_, cfm_;
+  Vector z_;
+  std::vector<int> rowOf_;  // per clamped index c: its row
+};
+
+}  // namespace mlcp::detail
