@@ -166,6 +166,22 @@ class RowSystem {
 // is the packing's throughput, and the update's chain (dot, clamp, velocities) adds about what a
 // sweep of the row costs. A packed row padded from 240 to 304 bytes cost the 210-box stages ~2%:
 // bytes streamed are not what bounds the sweep either (so a smaller row format would gain ~1-2%).
+// Session 8 (a throwaway harness: one 55-box island after the switch, 1160 rows, packed and
+// checked 200 times, min of 7; callgrind instruction counts of the same, deterministic): the
+// packing ~573 instructions a row (623 before), the check ~94, a sweep ~88. The Bullet source's
+// row() and view() are now inlined into pack() (forced: GCC kept a call per row returning the
+// view through memory: -27 instructions), and a body side's J is checked finite through A_ii's
+// test (row_pack.hpp: -21). Packing ~41 -> ~38-39 ns a row in the harness on a quiet machine
+// (~80 -> ~61-70 on a busy one; the check ~7, a sweep ~8.4 quiet). 10 sweeps, 8 runs
+// alternated with the code before: 15 / 55 / 210 boxes min 1.00x / 1.05x / 1.00x -> 0.94x /
+// 1.04x / 0.99x SI, median 1.06x / 1.08x / 1.03x -> 1.00x / 1.04x / 0.99x (a busy machine, SI
+// 0.22-0.24 ms a step at 55 boxes; the residual columns identical); ODE's pgs (ode_pgs_bench,
+// 5 alternated runs) the same (pgs / QuickStep min 0.87x / 0.79x / 0.69x -> 0.88x / 0.76x /
+// 0.70x, residuals identical). Tried without gain:
+// gapTimes without the branch on w's sign (the check 94 -> 107 instructions, ~7.4 -> ~8.3 ns a
+// row in the harness, which replays one island's branch pattern); std::max of three written as
+// two (the same code). Not tried: the check's finiteness tests folded into one sum, the
+// packing's J copies and runM's scattered stores (~50 instructions a row together).
 class RowPgs {
  public:
   Options& options() { return options_; }

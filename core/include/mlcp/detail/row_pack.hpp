@@ -1,7 +1,9 @@
 // mlcp/detail/row_pack.hpp: RowPgs' packing pass and its engine entry point as templates
 // (rows.hpp), for engines whose row source the compiler should see: RowPgs::solveFrom with a
 // final source class inlines the source's row() into the packing loop (no view written to
-// memory and read back, no call per row). Include it only where solveFrom is instantiated.
+// memory and read back, no call per row; forced on solveFrom's lambda, as GCC otherwise kept
+// it a call: a large row() should be always_inline too). Include it only where solveFrom is
+// instantiated.
 #pragma once
 
 #include <algorithm>
