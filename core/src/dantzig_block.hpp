@@ -91,7 +91,7 @@ class BlockPivoting {
     int updateRows = 40;
     int descentSteps = 8;
     bool breakCycles = true;
-    double bodyMinDiagonal = 1e-6;
+    double bodyMinDiagonal = 1e-11;
   };
   void setLimits(const Limits& limits) { limits_ = limits; }
 

@@ -330,10 +330,12 @@
 // the body graph with its block fill (core/src/dantzig_body.hpp). Every step (damped or full)
 // whose every d_c is at least blockBodyMinDiagonal max |A_ii| takes it (no factor is kept for the
 // bordered updates then: a fresh S costs less than a reuse); the others factor A_CC as above.
-// Conditioning ~ 1 / d: with 1e-9 the cfm = 0 pyramids' damped steps near the answer (rho ~ 1e-9)
-// lost the tolerance and a test's solve ended in the friction passes' MaxIterations; 1e-6 keeps
-// one refinement step enough. Bullet's 55-box pyramid after the switch (n = 1160, m ~ 550-700,
-// 57-105 sliding rows, S 330 x 330): one fresh factorization and solve ~0.16-0.21 ms against
+// Conditioning ~ 1 / d: body-space steps take two steps of refinement against the true K (the
+// others one). With one step and a limit of 1e-9 a test's cfm = 0 pyramid (damped steps near the
+// answer: rho -> 0) ended in the friction passes' MaxIterations; with two, 1e-11 also takes ODE's
+// full steps (cfm 1e-8, max A_ii 64: d = 1.6e-10 max A_ii; 1e-6 left them to A_CC).
+// Bullet's 55-box pyramid after the switch (n = 1160, m ~ 550-700, 57-105 sliding rows, S 330 x
+// 330): one fresh factorization and solve ~0.16-0.21 ms against
 // ~0.86-1.08 ms for K's LU (5.2-5.3x; with S factored by the scalar SymmetricPatternLu instead of
 // 6 x 6 blocks only 1.8-2.0x: L ~10k entries against K's ~27k, but denser columns), relative
 // difference of the two solutions before refinement <= 5e-11. With steps that cheap, solves after
@@ -433,9 +435,9 @@ struct DantzigParams {
   // Default true.
   bool blockBodySpace = true;
   // Body space applies to a step whose every clamped row has cfm_c + rho at least this times
-  // max |A_ii| (its conditioning grows as 1 / d, and one step of refinement follows); other
-  // steps factor A_CC. Default 1e-6.
-  double blockBodyMinDiagonal = 1e-6;
+  // max |A_ii| (its conditioning grows as 1 / d; two steps of refinement follow); other steps
+  // factor A_CC. Default 1e-11.
+  double blockBodyMinDiagonal = 1e-11;
 };
 
 class DantzigSolver : public Solver {
