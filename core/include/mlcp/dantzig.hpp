@@ -335,12 +335,24 @@
 // answer: rho -> 0) ended in the friction passes' MaxIterations; with two, 1e-11 also takes ODE's
 // full steps (cfm 1e-8, max A_ii 64: d = 1.6e-10 max A_ii; 1e-6 left them to A_CC).
 // Bullet's 55-box pyramid after the switch (n = 1160, m ~ 550-700, 57-105 sliding rows, S 330 x
-// 330): one fresh factorization and solve ~0.16-0.21 ms against
-// ~0.86-1.08 ms for K's LU (5.2-5.3x; with S factored by the scalar SymmetricPatternLu instead of
-// 6 x 6 blocks only 1.8-2.0x: L ~10k entries against K's ~27k, but denser columns), relative
-// difference of the two solutions before refinement <= 5e-11. With steps that cheap, solves after
-// the switch settle in the block stage within 120 steps (iterations per step 138 -> 45: no pivoting
-// finish); maxBlockSteps 40 / 60 / 80 / 100 / 120 / 200 gave 138 / 96 / 81 / 82 / 45 / 45.
+// 330; prototype, per damped step, 104 steps): one fresh factorization and solve ~0.16-0.21 ms
+// against ~0.86-1.08 ms for K's LU (5.2-5.3x; with S factored by the scalar SymmetricPatternLu
+// instead of 6 x 6 blocks only 1.8-2.0x: L ~10k entries against K's ~27k, but denser columns),
+// relative difference of the two solutions before refinement <= 5e-11. With steps that cheap,
+// solves after the switch settle in the block stage within 120 steps (iterations per step 138 ->
+// 45: no pivoting finish); maxBlockSteps 40 / 60 / 80 / 100 / 120 / 200 gave 138 / 96 / 81 / 82 /
+// 45 / 45, hence maxBodyBlockSteps (maxBlockSteps stays 40 for steps that factor A_CC). Ours-only
+// CPU ms per step, session 8's start against this, alternated, two runs each: after the switch
+// 61-69 -> 19-21, the demo's first 300 steps 14.0-14.9 -> 3.8-5.6, steady state (--settle
+// 300) 6.1-7.4 -> 2.7-2.9, at rest after SI 3.0-4.3 -> 1.3-1.7; ODE (ode_bench 10 5) 11.1-11.5x
+// -> 15.7-19.0x dWorldStep at 588 rows, 88-110x -> 175-178x at 1728 (residuals 4.5e-12 -> 1.2e-14).
+// Whole bullet_bench runs with stock in the same run (CPU ms per step): after the switch 30.6
+// / 27.7 against 535 / 496 (17.5x / 17.9x: the 20x goal is not met yet), first 300 steps 3.6
+// against 306 (85x), steady state 2.9 against 298 (104x), at rest 2.0 against 267 (135x). perf
+// after the switch: S's assembly and factorization 23%, the block stage's merits and line search
+// 16%, the clamped rows' A x (three sparse row sweeps per step: right-hand side and two
+// refinements) 18% (a plain loop over the storage instead of Eigen's sparse-row dot: the same
+// share), S's solves 9%.
 //
 // Result::iterations counts pivots (direction computations: each row added or exchanged)
 // summed over all passes; Options::maxPivots (0: 50 n + 100) limits them per pass
