@@ -130,10 +130,6 @@ bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& row
                                // their 4-byte stores stalled store forwarding)
   int lastA = -2, lastB = -2;  // the previous row's bodies
   int runLength = 0;
-  // The run's M^-1 J^T so far (for its couplings), entry j of row k at runM[j][k]: the
-  // couplings of one row are then computed two rows k at a time (below). Zeroed once: the lane
-  // past the run's last row is computed and dropped, and must hold a number.
-  alignas(16) double runM[12][kMaxRun] = {};
   std::size_t coupled = 0;  // couplings written
   if (coupling_.size() < static_cast<std::size_t>(n) * (kMaxRun - 1))
     coupling_.resize(static_cast<std::size_t>(n) * (kMaxRun - 1));
@@ -148,13 +144,22 @@ bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& row
     for (BodyVelocity& v : base_) v.v.setZero();
   }
   bad_ = -1;
-  const bool unitRelaxation = options_.relaxation == 1;
+  const double relaxation = options_.relaxation;
+  const bool unitRelaxation = relaxation == 1;
   auto stop = [&](int i, double d) {
     bad_ = i;
     badDiagonal_ = d;
     return false;
   };
   int later = -1;  // the first row whose findex points forward (checked after the pass)
+  // The arrays' starts in locals: the pairs' stores (memcpy) may alias anything, and the
+  // vectors' own pointers were loaded again after each.
+  PackedRow* const packed = packed_.data();
+  int* const findexOf = findexOf_.data();
+  double* const scale = scale_.data();
+  double* const coupling = coupling_.data();
+  BodyVelocity* const velocity = velocity_.data();
+  BodyVelocity* const base = withBase ? base_.data() : nullptr;
   for (int i = 0; i < n; ++i) {
     const RowView r = rowAt(i);
     double jA[6], jB[6];
@@ -164,12 +169,12 @@ bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& row
     if (!detail::rowRulesValid(r, i, n, slots) ||
         ((r.bodyA < 0 || r.bodyB < 0) && !detail::jacobiansFinite(jA, jB)))
       return stop(i, std::nan(""));
-    PackedRow& p = packed_[i];
+    PackedRow& p = packed[i];
     // The packed rows written a few rows ahead are fetched for writing: after the engine's own
     // setup they are mostly out of L2, and ~30 stores a row waiting on their lines filled the
     // store buffer.
     if (i + kPackAhead < n) {
-      const char* ahead = reinterpret_cast<const char*>(&packed_[i + kPackAhead]);
+      const char* ahead = reinterpret_cast<const char*>(&packed[i + kPackAhead]);
       for (int line = 0; line < static_cast<int>(sizeof(PackedRow)); line += 64)
         __builtin_prefetch(ahead + line, 1);
     }
@@ -177,18 +182,18 @@ bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& row
     // Each row's findex again in a compact array, for the check that a friction row's normal
     // row has none: reading it from the normal's packed row (thousands of rows back, out of L1)
     // stalled on a cache miss per friction row (~5% of the packing at 210 boxes, perf).
-    findexOf_[i] = r.findex;
+    findexOf[i] = r.findex;
     if (r.findex >= 0) {
       if (r.findex > i) {
         if (later < 0) later = i;
-      } else if (findexOf_[r.findex] >= 0) {
+      } else if (findexOf[r.findex] >= 0) {
         return stop(i, std::nan(""));
       }
     }
     // "The world" (-1) becomes the zero-velocity slot (its J meets v = 0, its M^-1 J^T is 0).
     // (lastA starts at -2: no body, no world: row 0 starts a run.)
     if (r.bodyA == lastA && r.bodyB == lastB && r.bodyA != r.bodyB && runLength < kMaxRun) {
-      ++packed_[runStart].run;
+      ++packed[runStart].run;
       ++runLength;
     } else {
       runStart = i;
@@ -217,67 +222,72 @@ bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& row
     // body (inf times anything is inf or NaN, the engine's invAng included), and no sum with
     // such a term is finite (the rowValid sum of session 6 cost ~20 instructions a row).
     if (!(d > 0 && d <= std::numeric_limits<double>::max())) return stop(i, d);
-    const double step = options_.relaxation / d;
-    for (int k = 0; k < 6; ++k) {
-      p.sA[k] = step * jA[k];
-      p.sB[k] = step * jB[k];
+    const double step = relaxation / d;
+    // step J and M^-1 J^T in pairs of entries (j, j + 1) of [A; B] (12 each), stored as pairs:
+    // the couplings of later rows read a row's M^-1 J^T back in pairs from its packed row, and a
+    // 16-byte load of two 8-byte stores still in flight would stall store forwarding.
+    using Pair = double __attribute__((vector_size(16)));
+    const Pair steps = {step, step};
+    Pair sJ[6], mJ[6];
+    for (int q = 0; q < 3; ++q) {
+      sJ[q] = steps * Pair{jA[2 * q], jA[2 * q + 1]};
+      sJ[3 + q] = steps * Pair{jB[2 * q], jB[2 * q + 1]};
+      mJ[q] = Pair{mA[2 * q], mA[2 * q + 1]};
+      mJ[3 + q] = Pair{mB[2 * q], mB[2 * q + 1]};
+      std::memcpy(p.sA.data() + 2 * q, &sJ[q], sizeof(Pair));
+      std::memcpy(p.sB.data() + 2 * q, &sJ[3 + q], sizeof(Pair));
+      std::memcpy(p.mA.data() + 2 * q, &mJ[q], sizeof(Pair));
+      std::memcpy(p.mB.data() + 2 * q, &mJ[3 + q], sizeof(Pair));
     }
     // Couplings to the run's earlier rows k: step J_i M^-1 J_k^T on the run's two bodies, i.e.
-    // sA . mA_k + sB . mB_k (scalars from locals: no reading back of what was just stored).
-    // step J_i in scalars once (the products the sums used, so the same couplings to the bit).
-    double sJ[12];
-    for (int j = 0; j < 6; ++j) {
-      sJ[j] = step * jA[j];
-      sJ[6 + j] = step * jB[j];
-    }
-    // Two couplings in the two lanes of one vector halve the instructions (the largest part of
-    // packing a row of a long run: a box face's 8 friction rows take 28 couplings). Each sum in
-    // four partial sums (j mod 4), then two levels: the row's instructions wait on a chain of
-    // 5 additions instead of 12 before they retire (with A_ii's shorter sums, 10 sweeps went
-    // from ~1.17-1.20x to ~1.07-1.14x SI at 15 and 55 boxes; the iterates move by round-off).
-    using Pair = double __attribute__((vector_size(16)));
+    // sA . mA_k + sB . mB_k, over entries j = 0 .. 11 of [A; B] in four partial sums (j mod 4),
+    // then two levels: the row's instructions wait on a chain of 5 additions instead of 12
+    // before they retire (with A_ii's shorter sums, 10 sweeps went from ~1.17-1.20x to
+    // ~1.07-1.14x SI at 15 and 55 boxes; the iterates move by round-off). Sums j mod 4 = 0, 1
+    // in the lanes of one vector (pairs 0, 2, 4), 2, 3 in another (pairs 1, 3, 5). M^-1 J_k^T is
+    // read from row k's packed row (mA and mB are adjacent there), stored a row or more ago.
     const int earlier = runLength - 1;
-    for (int k = 0; k < earlier; k += 2) {
-      Pair part[4] = {};
-      for (int j = 0; j < 12; ++j) {
-        const Pair s = {sJ[j], sJ[j]};
-        Pair m;
-        std::memcpy(&m, &runM[j][k], sizeof m);
-        part[j % 4] += s * m;
-      }
-      const Pair c = (part[0] + part[1]) + (part[2] + part[3]);
-      coupling_[coupled + k] = c[0];
-      if (k + 1 < earlier) coupling_[coupled + k + 1] = c[1];
+    for (int k = 0; k < earlier; ++k) {
+      const double* mk = packed[runStart + k].mA.data();
+      Pair m[6];
+      std::memcpy(m, mk, sizeof m);
+      Pair low = Pair{0, 0} + sJ[0] * m[0], high = Pair{0, 0} + sJ[1] * m[1];
+      low += sJ[2] * m[2];
+      high += sJ[3] * m[3];
+      low += sJ[4] * m[4];
+      high += sJ[5] * m[5];
+      coupling[coupled + k] = (low[0] + low[1]) + (high[0] + high[1]);
     }
     coupled += earlier;
-    for (int j = 0; j < 6; ++j) {
-      runM[j][earlier] = mA[j];
-      runM[6 + j][earlier] = mB[j];
-    }
     p.keep = 1 - step * r.cfm;
     p.shift = step * r.b;
-    scale_[i] = unitRelaxation ? d : d / options_.relaxation;  // d / 1 = d: no second division
-    // v = M^-1 J^T x of the start (from mA, mB, not from p.mA, p.mB just stored: see above).
+    scale[i] = unitRelaxation ? d : d / relaxation;  // d / 1 = d: no second division
+    // v = M^-1 J^T x of the start (from the pairs in registers, not from p.mA, p.mB just
+    // stored), a pair at a time.
     const double xi = warm ? r.start : 0.0;
     if (xOut) xOut[i] = xi;
-    double* va = velocity_[runA].v.data();
-    double* vb = velocity_[runB].v.data();
-    for (int k = 0; k < 6; ++k) {
-      p.mA[k] = mA[k];
-      p.mB[k] = mB[k];
-    }
+    double* va = velocity[runA].v.data();
+    double* vb = velocity[runB].v.data();
     if (xi != 0) {
-      for (int k = 0; k < 6; ++k) {
-        va[k] += mA[k] * xi;
-        vb[k] += mB[k] * xi;
+      const Pair xs = {xi, xi};
+      // va and vb are the same for a row joining a body to itself: each stored before the other
+      // is read.
+      for (int q = 0; q < 3; ++q) {
+        Pair v;
+        std::memcpy(&v, va + 2 * q, sizeof v);
+        v += mJ[q] * xs;
+        std::memcpy(va + 2 * q, &v, sizeof v);
+        std::memcpy(&v, vb + 2 * q, sizeof v);
+        v += mJ[3 + q] * xs;
+        std::memcpy(vb + 2 * q, &v, sizeof v);
       }
     }
     // base_ holds M^-1 J^T (base - start) here; the start's velocities are added after the
     // pass (an engine's base is mostly its start: no second 12-wide update per row).
     if (withBase && r.base != xi) {
       const double extra = r.base - xi;
-      double* ba = base_[runA].v.data();
-      double* bb = base_[runB].v.data();
+      double* ba = base[runA].v.data();
+      double* bb = base[runB].v.data();
       for (int k = 0; k < 6; ++k) {
         ba[k] += mA[k] * extra;
         bb[k] += mB[k] * extra;
