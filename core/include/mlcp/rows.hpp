@@ -180,8 +180,24 @@ class RowSystem {
 // 0.70x, residuals identical). Tried without gain:
 // gapTimes without the branch on w's sign (the check 94 -> 107 instructions, ~7.4 -> ~8.3 ns a
 // row in the harness, which replays one island's branch pattern); std::max of three written as
-// two (the same code). Not tried: the check's finiteness tests folded into one sum, the
-// packing's J copies and runM's scattered stores (~50 instructions a row together).
+// two (the same code).
+// Session 8, round 6 (the same harness and callgrind): packing 573 -> 535 instructions a row,
+// pack + check ~44.0 -> ~39.9 ns a row (min of 5, harness): a run's M^-1 J^T read back from
+// its packed rows (stored as 16-byte pairs, so the pair loads forward) instead of a runM copy
+// (-24), the arrays' starts in locals (the pairs' memcpy stores may alias anything: -11), one
+// coupling at a time with the sums j mod 4 in the lanes of two vectors (the same sums, so the
+// same bits; no fewer instructions than two couplings at a time). 10 sweeps, 8 runs alternated
+// with the code before: 15 / 55 / 210 boxes min 0.94x / 1.03x / 0.99x -> 0.93x / 1.02x /
+// 0.97x SI, median 1.00x / 1.04x / 1.005x -> 0.98x / 1.03x / 0.98x (residual columns and the
+// 55-box harness iterates and check identical); ODE pgs the same or faster (min 0.88x / 0.79x /
+// 0.70x -> 0.85x / 0.76x / 0.68x QuickStep, 3 runs). 55 boxes is still above SI. Tried without
+// gain: J read in place instead of copied (+41 instructions: every store may alias the
+// engine's rows, so each use loaded again); M^-1 J^T formed as pairs in registers (+14
+// instructions, the same time); the couplings' partial sums without their +0 start and a
+// final + 0.0 (the same bits, -0.4 instructions: GCC kept the same code); rowRulesValid as one
+// branch over & of its tests (+4 instructions, the same time); the check's two finiteness
+// tests a row folded into one sum checked after the pass, with an exact second pass when it is
+// not finite (check 94 -> 92 instructions, ~7.4 -> ~7.3 ns a row: not worth the second path).
 class RowPgs {
  public:
   Options& options() { return options_; }
