@@ -233,7 +233,6 @@ void BlockPivoting::guess(const Problem& pb, const Vector& x0, const Vector& w0,
 bool BlockPivoting::solveClamped(const Problem& pb, Vector& x, const Vector& prev, double rho,
                                  std::string& why) {
   const int n = pb.size();
-  const SparseMatrix& A = *a_;
   order_.clear();
   for (int k = 0; k < n; ++k) {
     const int i = byRank_[k];
@@ -263,8 +262,8 @@ bool BlockPivoting::solveClamped(const Problem& pb, Vector& x, const Vector& pre
 
   const int m = static_cast<int>(order_.size());
   Vector r(m);
-  for (int c = 0; c < m; ++c)
-    r[c] = -(pb.b[order_[c]] + A.row(order_[c]).dot(x)) + rho * prev[order_[c]];
+  clampedTimes(x, ax_);
+  for (int c = 0; c < m; ++c) r[c] = -(pb.b[order_[c]] + ax_[c]) + rho * prev[order_[c]];
   const int s = static_cast<int>(sliding_.size());
   useLu_ = s > limits_.woodburyRows && m > 0;
   useBody_ = false;
@@ -311,8 +310,9 @@ bool BlockPivoting::solveClamped(const Problem& pb, Vector& x, const Vector& pre
   // Iterative refinement: the clamped rows' w is the residual of K y = r. One step; two in body
   // space, whose error grows as 1 / min d_c.
   for (int pass = 0; pass < (useBody_ ? 2 : 1); ++pass) {
+    clampedTimes(x, ax_);
     for (int c = 0; c < m; ++c)
-      y[c] = -(pb.b[order_[c]] + A.row(order_[c]).dot(x)) - rho * (x[order_[c]] - prev[order_[c]]);
+      y[c] = -(pb.b[order_[c]] + ax_[c]) - rho * (x[order_[c]] - prev[order_[c]]);
     applySolve(y);
     place(y, true);
   }
@@ -321,6 +321,22 @@ bool BlockPivoting::solveClamped(const Problem& pb, Vector& x, const Vector& pre
     return false;
   }
   return true;
+}
+
+void BlockPivoting::times(const Vector& x, Vector& out) {
+  if (factoredProducts_)
+    body_->multiply(x, out);
+  else
+    out.noalias() = *a_ * x;
+}
+
+void BlockPivoting::clampedTimes(const Vector& x, Vector& out) {
+  if (factoredProducts_) {
+    body_->multiply(x, order_, out);
+    return;
+  }
+  out.resize(order_.size());
+  for (size_t c = 0; c < order_.size(); ++c) out[c] = a_->row(order_[c]).dot(x);
 }
 
 void BlockPivoting::applySolve(Vector& y) {
@@ -684,6 +700,12 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
   pivTol_ = opt.pivotTolerance * (dMax > 0 ? dMax : 1.0);
   dMax_ = dMax;
   bodyReady_ = rows_ != nullptr && body_->prepare(*rows_, n);
+  // The rows must be A's (A = J W J^T + diag(cfm)): checked on the diagonal.
+  for (int i = 0; bodyReady_ && i < n; ++i)
+    bodyReady_ = std::abs(body_->diagonal(i) - pb.diagonal(i)) <= 1e-10 * std::max(dMax, 1e-300);
+  // Factored products only with every cfm > 0: on a singular A (cfm = 0, coplanar contacts) their
+  // round-off differences sent a test's sliding pyramid from settling to 120 unsettled steps.
+  factoredProducts_ = bodyReady_ && rows_->cfm.size() > 0 && rows_->cfm.minCoeff() > 0;
   bodyFactorizations_ = 0;
   pivTolRelative_ = opt.pivotTolerance;
   eps_ = 0.01 * opt.tolerance * (1 + pb.b.lpNorm<Eigen::Infinity>());
@@ -691,7 +713,9 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
   haveBase_ = false;  // A's values are new
   factorizations_ = 0;
   const bool cold = x.isZero(0.0);
-  Vector w = *a_ * x + pb.b, xOld(n), wOld(n), wNew(n);
+  Vector w(n), xOld(n), wOld(n), wNew(n);
+  times(x, w);
+  w += pb.b;
   guess(pb, x, w, cold, atGuess);
 
   // Full steps (block principal pivoting) while they keep finding new lowest merits
@@ -714,7 +738,8 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
   setPrev2_.clear();
   auto toDamped = [&] {
     x = fullBestX;
-    w = *a_ * x + pb.b;
+    times(x, w);
+    w += pb.b;
     merit = fullBest;
     damped = true;
   };
@@ -731,7 +756,9 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
         if (!isFriction(pb, i)) p[i] = std::clamp(p[i], pb.lo[i], pb.hi[i]);
       for (int t = 0; t < n; ++t)
         if (isFriction(pb, t)) p[t] = std::clamp(p[t], pb.effectiveLo(t, p), pb.effectiveHi(t, p));
-      Vector wp = *a_ * p + pb.b;
+      Vector wp(n);
+      times(p, wp);
+      wp += pb.b;
       const double resP = accuracy(pb, p, wp).residual;
       if (resP <= opt.tolerance) {
         x = p;
@@ -778,7 +805,7 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
       x = bestX;
       break;
     }
-    wNew.noalias() = *a_ * x;
+    times(x, wNew);
     wNew += pb.b;
     if (!damped) {
       // Block principal pivoting: full steps; the merit may rise for a step or two.

@@ -104,6 +104,10 @@ class BlockPivoting {
   bool solveClamped(const Problem& pb, Vector& x, const Vector& prev, double rho, std::string& why);
   bool factorCoupled(double rho, bool coupled, std::string& why);
   void applySolve(Vector& y);
+  // out = A x, and out[c] = (A x)_{order_[c]}: in factored form when the rows are given and every
+  // cfm > 0 (BodySpaceSystem::multiply), else from A's rows.
+  void times(const Vector& x, Vector& out);
+  void clampedTimes(const Vector& x, Vector& out);
   int setsAt(const Problem& pb, const Vector& x, const Vector& w);
   double meritAt(const Problem& pb, const Vector& x, const Vector& w) const;
   double frictionBound(const Problem& pb, int t, Set s, const Vector& x) const;
@@ -142,8 +146,9 @@ class BlockPivoting {
   Limits limits_;
   const RowSystem* rows_ = nullptr;
   std::unique_ptr<BodySpaceSystem> body_;
-  bool bodyReady_ = false;  // body_ prepared for this run's rows
-  bool useBody_ = false;    // the current step's K is solved in body space
+  bool bodyReady_ = false;         // body_ prepared for this run's rows
+  bool useBody_ = false;           // the current step's K is solved in body space
+  bool factoredProducts_ = false;  // times() and clampedTimes() from the rows
   int bodyFactorizations_ = 0;
   double dMax_ = 0;  // max |A_ii|
   int factorizations_ = 0;
@@ -152,7 +157,7 @@ class BlockPivoting {
   std::vector<int> basePos_, baseOrder_, extraRow_, extraOf_, reach_;
   std::vector<int> gStart_, gIdx_, hStart_, hIdx_;
   std::vector<double> gVal_, hVal_;
-  Vector work_;
+  Vector work_, ax_;
   Eigen::FullPivLU<DenseMatrix> capacitance_;
   double pivTolRelative_ = 0;
   double eps_ = 0, pivTol_ = 0;

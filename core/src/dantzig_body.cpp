@@ -181,4 +181,32 @@ void BodySpaceSystem::solve(Vector& y) {
   }
 }
 
+void BodySpaceSystem::bodyForces(const Vector& x) {
+  v_.setZero(6 * bodies_);
+  const int n = static_cast<int>(rows_.size());
+  for (int i = 0; i < n; ++i) {
+    const double xi = x[i];
+    if (xi == 0) continue;
+    const RowData& rd = rows_[i];
+    if (rd.a >= 0)
+      for (int l = 0; l < 6; ++l) v_[6 * rd.a + l] += rd.jr[l] * xi;
+    if (rd.b >= 0)
+      for (int l = 0; l < 6; ++l) v_[6 * rd.b + l] += rd.jr[6 + l] * xi;
+  }
+}
+
+void BodySpaceSystem::multiply(const Vector& x, Vector& out) {
+  bodyForces(x);
+  const int n = static_cast<int>(rows_.size());
+  out.resize(n);
+  for (int i = 0; i < n; ++i) out[i] = rowTimes(i, x[i]);
+}
+
+void BodySpaceSystem::multiply(const Vector& x, const std::vector<int>& which, Vector& out) {
+  bodyForces(x);
+  const int m = static_cast<int>(which.size());
+  out.resize(m);
+  for (int c = 0; c < m; ++c) out[c] = rowTimes(which[c], x[which[c]]);
+}
+
 }  // namespace mlcp::detail
