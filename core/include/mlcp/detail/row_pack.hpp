@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <limits>
 
@@ -247,6 +248,8 @@ bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& row
     // in the lanes of one vector (pairs 0, 2, 4), 2, 3 in another (pairs 1, 3, 5). M^-1 J_k^T is
     // read from row k's packed row (mA and mB are adjacent there), stored a row or more ago.
     const int earlier = runLength - 1;
+    static_assert(offsetof(PackedRow, mB) == offsetof(PackedRow, mA) + sizeof(Vector6),
+                  "the couplings read mA and mB as one array of 12");
     for (int k = 0; k < earlier; ++k) {
       const double* mk = packed[runStart + k].mA.data();
       Pair m[6];
