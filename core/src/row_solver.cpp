@@ -191,10 +191,14 @@ Result RowSolver::run(const RowSystem& rows, const std::string& name, const Opti
   }
   Solver* solver = assembledSolver(island, name);
   solver->setOptions(o);
+  // The rows for this solve only, cleared on every way out (a throw included): the solver is
+  // kept per island and must not hold them past this call.
+  struct Rows {
+    Solver* solver;
+    ~Rows() { solver->useRows(nullptr); }
+  } scope{solver};
   solver->useRows(&rows);
-  Result r = solver->solveWithGuess(assembled_, start, x);
-  solver->useRows(nullptr);
-  return r;
+  return solver->solveWithGuess(assembled_, start, x);
 }
 
 void RowSolver::assemble(const RowSystem& rows, bool sparse) {
