@@ -59,9 +59,14 @@ class BlockPivoting {
  public:
   BlockPivoting();
   ~BlockPivoting();
-  // The rows the next run()'s problem was assembled from (nullptr: none): block steps may then be
-  // solved in body space (dantzig_body.hpp). Not owned; must outlive run().
-  void setRows(const RowSystem* rows) { rows_ = rows; }
+  // The rows the next runs' problem was assembled from (nullptr: none): block steps may then be
+  // solved in body space (dantzig_body.hpp). Not owned; must outlive the runs. Prepared once, at
+  // the first run after this call (DantzigSolver's cold trial and warm stage share it): call it
+  // again for another problem.
+  void setRows(const RowSystem* rows) {
+    rows_ = rows;
+    rowsPrepared_ = false;
+  }
 
   struct Report {
     bool settled = false;    // x solves the problem to Options::tolerance (checked by residual())
@@ -146,7 +151,8 @@ class BlockPivoting {
   Limits limits_;
   const RowSystem* rows_ = nullptr;
   std::unique_ptr<BodySpaceSystem> body_;
-  bool bodyReady_ = false;         // body_ prepared for this run's rows
+  bool rowsPrepared_ = false;      // bodyReady_ and factoredProducts_ decided for rows_
+  bool bodyReady_ = false;         // body_ prepared for rows_
   bool useBody_ = false;           // the current step's K is solved in body space
   bool factoredProducts_ = false;  // times() and clampedTimes() from the rows
   int bodyFactorizations_ = 0;
