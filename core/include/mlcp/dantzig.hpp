@@ -360,8 +360,9 @@
 // after the switch 32.3 / 21.1 -> 22.8 / 15.9; first 300 steps (--warmup 0 --steps 300) 5.2 / 4.2
 // -> 2.8 / 3.1; --settle 300 1.4 / 1.9 -> 1.8 / 1.8 (noise); ODE 588 rows 3.9 / 4.2 -> 3.1 / 3.5
 // ms, 1728 rows 13.5 / 10.8 -> 10.3 / 8.9 ms. With stock in the same run after the
-// switch: 24.4x, 24.4x, 20.4x (a run beside ctest: 20.1x). The dense bodies^2 block table
-// (kMaxBodies) and S's per-run assembly are not yet replaced.
+// switch: 24.4x, 24.4x, 20.4x (a run beside ctest: 20.1x; the lead's two runs at session 8's
+// final code 25.1x / 25.9x: the 20x goal is met after the switch too). The dense bodies^2 block
+// table (kMaxBodies) and S's per-run assembly are not yet replaced.
 //
 // Result::iterations counts pivots (direction computations: each row added or exchanged)
 // summed over all passes; Options::maxPivots (0: 50 n + 100) limits them per pass
