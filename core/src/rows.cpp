@@ -7,6 +7,7 @@
 #include "mlcp/detail/row_pack.hpp"
 #include "mlcp/residual.hpp"
 #include "mlcp/solver.hpp"
+#include "row_sweep.hpp"
 #include "sweep_monitor.hpp"
 
 namespace mlcp {
@@ -353,109 +354,21 @@ Result RowPgs::iteratePacked(int bodies, Vector& x, double bNorm, double t0) {
 
 // Not inlined into iterate(): its loops there changed how the sweep loop was compiled (our
 // stages ~20% slower at 210 boxes).
-[[gnu::noinline]] Accuracy RowPgs::packedAccuracy(const Vector& x, double bNorm) const {
-  // step_i w_i = (1 - keep) x_i + shift + sA va + sB vb, the sweep's own terms (rows.hpp),
-  // scaled back by scale_i = 1 / step_i; the bounds with findex applied at x. In blocks of rows
-  // that stay in L1 (w in a small buffer, the rows read twice): one loop for both spilled the
-  // accumulators to the stack and chained every row through a store and a load (perf).
-  constexpr int kBlock = 64;
-  const int n = static_cast<int>(packed_.size());
-  const double* xs = x.data();
-  AccuracyAccumulator a;
-  double w[kBlock];
-  for (int first = 0; first < n; first += kBlock) {
-    const int count = std::min(kBlock, n - first);
-    const PackedRow* rows = packed_.data() + first;
-    for (int k = 0; k < count; ++k) {
-      const PackedRow& p = rows[k];
-      const double jv =
-          (p.sA.cwiseProduct(velocity_[p.a].v) + p.sB.cwiseProduct(velocity_[p.b].v)).sum();
-      w[k] = scale_[first + k] * ((1 - p.keep) * xs[first + k] + p.shift + jv);
-    }
-    for (int k = 0; k < count; ++k) {
-      const PackedRow& p = rows[k];
-      if (!a.add(xs[first + k], w[k], p.lo, p.hi, p.findex, xs)) return a.result(bNorm);
-    }
-  }
-  return a.result(bNorm);
-}
-
-inline double RowPgs::update(const PackedRow& p, double* xs, int i, double jv) {
-  double lo = p.lo, hi = p.hi;
-  if (p.findex >= 0) {
-    const double normal = std::abs(xs[p.findex]);
-    lo *= normal;
-    hi *= normal;
-  }
-  // The new x is clamp(c - jv, lo, hi) with c = keep x - shift. The change that moves the
-  // velocities is clamped on its own, clamp((c - x) - jv, lo - x, hi - x) (the same up to
-  // round-off), so that the chain does not wait for the subtraction x_new - x.
-  const double xo = xs[i], c = p.keep * xo - p.shift;
-  const double dx = std::clamp((c - xo) - jv, lo - xo, hi - xo);
-  xs[i] = std::clamp(c - jv, lo, hi);
-  return dx;
+[[gnu::noinline, gnu::flatten]] Accuracy RowPgs::packedAccuracy(const Vector& x,
+                                                                double bNorm) const {
+#if MLCP_CPU_DISPATCH
+  if (detail::avx2Active()) return checkAvx2(x, bNorm);
+#endif
+  return checkRows(x, bNorm);
 }
 
 // A function of its own: compiled apart from the checks and the stopping logic around it (the
 // sweep's code and speed moved with whatever else iterate() held).
-[[gnu::noinline]] void RowPgs::sweepOnce(double* xs) {
-  const int n = static_cast<int>(packed_.size());
-  auto update = [&](const PackedRow& p, int i, double jv) { return RowPgs::update(p, xs, i, jv); };
-  const double* coupling = coupling_.data();
-  for (int i = 0; i < n;) {
-    const PackedRow& first = packed_[i];
-    if (first.a == first.b) {
-      // A row joining a body to itself: va and vb are the same object.
-      Vector6& v = velocity_[first.a].v;
-      const double dx =
-          update(first, i, (first.sA.cwiseProduct(v) + first.sB.cwiseProduct(v)).sum());
-      v += first.mA * dx;
-      v += first.mB * dx;
-      ++i;
-      continue;
-    }
-    // A run on two bodies: each row's step J v is its product with the velocities at the
-    // run's start plus its couplings to the changes of the run's earlier rows, so the chain
-    // from one row to the next is a multiply-add instead of the 12-wide dot after a 12-wide
-    // velocity update; the velocities take the run's changes at its end. Unrolled per length
-    // so that the changes stay in registers (reading them back from a stack array in pairs
-    // stalled store forwarding on every coupling).
-    const int length = first.run;
-    auto sweepRun = [&](auto size) {
-      constexpr int L = decltype(size)::value;
-      const Vector6 va = velocity_[first.a].v, vb = velocity_[first.b].v;
-      double dxs[L];
-#pragma GCC unroll 8
-      for (int k = 0; k < L; ++k) {
-        const PackedRow& p = packed_[i + k];
-        double jv = (p.sA.cwiseProduct(va) + p.sB.cwiseProduct(vb)).sum();
-#pragma GCC unroll 8
-        for (int m = 0; m < k; ++m) jv += coupling[m] * dxs[m];
-        coupling += k;
-        dxs[k] = update(p, i + k, jv);
-      }
-      Vector6 da = Vector6::Zero(), db = Vector6::Zero();
-#pragma GCC unroll 8
-      for (int k = 0; k < L; ++k) {
-        da += packed_[i + k].mA * dxs[k];
-        db += packed_[i + k].mB * dxs[k];
-      }
-      velocity_[first.a].v = va + da;
-      velocity_[first.b].v = vb + db;
-    };
-    static_assert(kMaxRun == 8, "one case per run length");
-    switch (length) {
-      case 1: sweepRun(std::integral_constant<int, 1>()); break;
-      case 2: sweepRun(std::integral_constant<int, 2>()); break;
-      case 3: sweepRun(std::integral_constant<int, 3>()); break;
-      case 4: sweepRun(std::integral_constant<int, 4>()); break;
-      case 5: sweepRun(std::integral_constant<int, 5>()); break;
-      case 6: sweepRun(std::integral_constant<int, 6>()); break;
-      case 7: sweepRun(std::integral_constant<int, 7>()); break;
-      default: sweepRun(std::integral_constant<int, 8>()); break;
-    }
-    i += length;
-  }
+[[gnu::noinline, gnu::flatten]] void RowPgs::sweepOnce(double* xs) {
+#if MLCP_CPU_DISPATCH
+  if (detail::avx2Active()) return sweepAvx2(xs);
+#endif
+  sweepRows(xs);
 }
 
 Result RowPgs::iterate(Vector& x, double bNorm, double t0) {

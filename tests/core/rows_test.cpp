@@ -8,6 +8,7 @@
 #include <limits>
 #include <random>
 
+#include "common/row_fill.hpp"
 #include "mlcp/pgs.hpp"
 #include "mlcp/residual.hpp"
 
@@ -241,21 +242,7 @@ TEST(RowPgs, RejectsBadRows) {
 // The engine entry point (RowPgs::solve with a row fill) must pack what solve(RowSystem) packs
 // from the same values: the same iterates bit for bit, the same result, and the velocity change
 // M^-1 J^T (x - base) per body.
-RowPgs::Row rowOf(const RowSystem& s, int i, double start, double base) {
-  RowPgs::Row r;
-  r.bodyA = s.rows[i].bodyA;
-  r.bodyB = s.rows[i].bodyB;
-  r.jA = s.rows[i].jA;
-  r.jB = s.rows[i].jB;
-  r.b = s.b[i];
-  r.cfm = s.cfm[i];
-  r.lo = s.lo[i];
-  r.hi = s.hi[i];
-  r.findex = s.findex.empty() ? -1 : s.findex[i];
-  r.start = start;
-  r.base = base;
-  return r;
-}
+using test::rowOf;
 
 Result solveFromRows(RowPgs& pgs, const RowSystem& s, const Vector& start, const Vector& base,
                      Vector& x) {

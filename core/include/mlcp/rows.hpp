@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "mlcp/cpu.hpp"
 #include "mlcp/problem.hpp"
 #include "mlcp/residual.hpp"
 #include "mlcp/result.hpp"
@@ -309,9 +310,24 @@ class RowPgs {
   static constexpr int kMaxRun = 8;
   // Fills packed_ and velocity_ from rowAt(i) (detail/row_pack.hpp); false at the first invalid row
   // or non-positive A_ii (bad_, badDiagonal_ say which).
+  // pack(), sweepOnce() and packedAccuracy() run their body (packRows, sweepRows, checkRows) as
+  // compiled for the baseline or, where cpuPath() says so, its AVX2 variant (mlcp/cpu.hpp): the
+  // same source, the same bits.
   template <class RowAt>
   bool pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& rowAt, bool warm, double* x,
             bool withBase);
+  template <class RowAt>
+  bool packRows(const std::vector<BodyInverseMass>& bodies, int n, RowAt& rowAt, bool warm,
+                double* x, bool withBase);
+#if MLCP_CPU_DISPATCH
+  template <class RowAt>
+  MLCP_AVX2_VARIANT bool packAvx2(const std::vector<BodyInverseMass>& bodies, int n, RowAt& rowAt,
+                                  bool warm, double* x, bool withBase);
+  MLCP_AVX2_VARIANT void sweepAvx2(double* x);
+  MLCP_AVX2_VARIANT Accuracy checkAvx2(const Vector& x, double bNorm) const;
+#endif
+  void sweepRows(double* x);
+  Accuracy checkRows(const Vector& x, double bNorm) const;
   // One row's update from jv = step J_i v (x[i] takes its new value); returns the change of x_i
   // that moves the velocities.
   static double update(const PackedRow& p, double* x, int i, double jv);

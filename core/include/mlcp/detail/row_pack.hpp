@@ -121,6 +121,24 @@ constexpr int kPackAhead = 8;
 template <class RowAt>
 bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& rowAt, bool warm,
                   double* xOut, bool withBase) {
+#if MLCP_CPU_DISPATCH
+  if (detail::avx2Active()) return packAvx2(bodies, n, rowAt, warm, xOut, withBase);
+#endif
+  return packRows(bodies, n, rowAt, warm, xOut, withBase);
+}
+
+#if MLCP_CPU_DISPATCH
+template <class RowAt>
+bool RowPgs::packAvx2(const std::vector<BodyInverseMass>& bodies, int n, RowAt& rowAt, bool warm,
+                      double* xOut, bool withBase) {
+  return packRows(bodies, n, rowAt, warm, xOut, withBase);
+}
+#endif
+
+template <class RowAt>
+[[gnu::always_inline]] inline bool RowPgs::packRows(const std::vector<BodyInverseMass>& bodies,
+                                                    int n, RowAt& rowAt, bool warm, double* xOut,
+                                                    bool withBase) {
   const int world = static_cast<int>(bodies.size());  // the first zero-velocity slot
   const unsigned slots = static_cast<unsigned>(world) + 1;
   // Ground rows take the world slots in turn (per run of rows on the same bodies): one shared

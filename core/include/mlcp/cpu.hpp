@@ -1,0 +1,58 @@
+// mlcp/cpu.hpp: which machine code RowPgs' hot loops run.
+//
+// RowPgs (rows.hpp) spends a fixed-sweep solve in three loops: the packing of the engine's rows,
+// the sweeps and the residual check. On x86-64 with GCC each of them is compiled twice, for the
+// baseline x86-64 (SSE2, what a distribution's packages target) and with AVX2, and the AVX2 code
+// runs where the CPU has it. Both are the same source: the same operations in the same order,
+// no fused multiply-adds (every target of this project is compiled with -ffp-contract=off), so
+// they give the same answers bit for bit (tests/core/cpu_test.cpp); only the time differs. The
+// AVX2 code uses the VEX encodings and wider registers where GCC vectorizes. Measured
+// (bullet_bench --pgs-vs-si, 10 sweeps, the stages of ours at 55 boxes): ~0.138 -> ~0.128 ms a
+// step with the whole library built for x86-64-v3, which is what this dispatch gives at run time
+// without building for one machine (README).
+//
+// The choice is made once, at first use: AVX2 when the CPU has AVX2, FMA, BMI1 and BMI2 and the
+// environment variable MLCP_CPU_PATH is not "baseline". setCpuPath() changes it for the whole
+// process (for comparisons; the solvers read it once per loop, so change it between solves).
+// Builds without the dispatch (another compiler or architecture, or -DMLCP_NO_CPU_DISPATCH)
+// always run the baseline.
+#pragma once
+
+namespace mlcp {
+
+enum class CpuPath {
+  Baseline,  // the code as compiled for the build's own target
+  Avx2,      // the same code compiled with AVX2 (x86-64 with GCC only)
+};
+
+const char* toString(CpuPath path);
+// The path the hot loops take now.
+CpuPath cpuPath();
+// Whether this build and this CPU can run the path (Baseline: always).
+bool cpuPathAvailable(CpuPath path);
+// Switches the hot loops to `path`; false, and no change, when it is not available.
+bool setCpuPath(CpuPath path);
+
+}  // namespace mlcp
+
+// For the solvers' sources: MLCP_CPU_DISPATCH is 1 where an AVX2 variant is compiled, and
+// MLCP_AVX2_VARIANT marks its functions (noinline: a variant is one function with the shared
+// body inlined into it).
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && \
+    !defined(MLCP_NO_CPU_DISPATCH)
+#define MLCP_CPU_DISPATCH 1
+#define MLCP_AVX2_VARIANT __attribute__((noinline, flatten, target("avx2,fma,bmi,bmi2")))
+#else
+#define MLCP_CPU_DISPATCH 0
+#endif
+
+namespace mlcp::detail {
+// 1 = Avx2, 0 = Baseline, -1 = not decided yet.
+int decideCpuPath();
+extern int cpuPathState;
+// Whether the hot loops take their AVX2 variant (decided at the first call).
+inline bool avx2Active() {
+  const int s = __atomic_load_n(&cpuPathState, __ATOMIC_RELAXED);
+  return (s < 0 ? decideCpuPath() : s) == 1;
+}
+}  // namespace mlcp::detail

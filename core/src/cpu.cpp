@@ -1,0 +1,57 @@
+#include "mlcp/cpu.hpp"
+
+#include <cstdlib>
+#include <cstring>
+
+namespace mlcp {
+
+namespace detail {
+
+int cpuPathState = -1;
+
+namespace {
+
+bool cpuHasAvx2() {
+#if MLCP_CPU_DISPATCH
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
+         __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2");
+#else
+  return false;
+#endif
+}
+
+}  // namespace
+
+int decideCpuPath() {
+  const char* env = std::getenv("MLCP_CPU_PATH");
+  const bool baseline = env && std::strcmp(env, "baseline") == 0;
+  const int s = !baseline && cpuHasAvx2() ? 1 : 0;
+  int expected = -1;
+  // A concurrent first use decides the same; setCpuPath's choice wins over the default.
+  __atomic_compare_exchange_n(&cpuPathState, &expected, s, false, __ATOMIC_RELAXED,
+                              __ATOMIC_RELAXED);
+  return __atomic_load_n(&cpuPathState, __ATOMIC_RELAXED);
+}
+
+}  // namespace detail
+
+const char* toString(CpuPath path) {
+  switch (path) {
+    case CpuPath::Baseline: return "baseline";
+    case CpuPath::Avx2: return "avx2";
+  }
+  return "unknown";
+}
+
+CpuPath cpuPath() { return detail::avx2Active() ? CpuPath::Avx2 : CpuPath::Baseline; }
+
+bool cpuPathAvailable(CpuPath path) { return path == CpuPath::Baseline || detail::cpuHasAvx2(); }
+
+bool setCpuPath(CpuPath path) {
+  if (!cpuPathAvailable(path)) return false;
+  __atomic_store_n(&detail::cpuPathState, path == CpuPath::Avx2 ? 1 : 0, __ATOMIC_RELAXED);
+  return true;
+}
+
+}  // namespace mlcp

@@ -1,0 +1,114 @@
+// mlcp/cpu.hpp: the CPU path can be read and set, and RowPgs' baseline and AVX2 variants of the
+// packing, sweeps and check give the same answers bit for bit, through the RowSystem entry point
+// and through the engine entry point (rows read in place).
+#include "mlcp/cpu.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <vector>
+
+#include "common/contact_scenes.hpp"
+#include "common/row_fill.hpp"
+#include "mlcp/rows.hpp"
+
+namespace mlcp {
+namespace {
+
+// Restores the process's CPU path when a test ends.
+class CpuPathGuard {
+ public:
+  CpuPathGuard() : saved_(cpuPath()) {}
+  ~CpuPathGuard() { setCpuPath(saved_); }
+
+ private:
+  CpuPath saved_;
+};
+
+bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+TEST(CpuPath, NamesAvailabilityAndSwitching) {
+  CpuPathGuard guard;
+  EXPECT_STREQ(toString(CpuPath::Baseline), "baseline");
+  EXPECT_STREQ(toString(CpuPath::Avx2), "avx2");
+  EXPECT_TRUE(cpuPathAvailable(CpuPath::Baseline));
+  ASSERT_TRUE(setCpuPath(CpuPath::Baseline));
+  EXPECT_EQ(cpuPath(), CpuPath::Baseline);
+  // Asking for AVX2 succeeds exactly where it is available, and a refusal changes nothing.
+  EXPECT_EQ(setCpuPath(CpuPath::Avx2), cpuPathAvailable(CpuPath::Avx2));
+  EXPECT_EQ(cpuPath(), cpuPathAvailable(CpuPath::Avx2) ? CpuPath::Avx2 : CpuPath::Baseline);
+#if !MLCP_CPU_DISPATCH
+  EXPECT_FALSE(cpuPathAvailable(CpuPath::Avx2));
+#endif
+}
+
+struct Answer {
+  Vector x;
+  Result result;
+  std::vector<Vector6> velocityChanges;  // engine entry point only
+};
+
+// 10 sweeps from a warm start on a sliding 55-box pyramid (1200 rows, friction with findex),
+// through solve(RowSystem) or through the engine entry point with a per-row base.
+Answer solveOn(const RowSystem& s, const Vector& start, bool engine) {
+  RowPgs pgs;
+  pgs.options().maxIterations = 10;
+  Answer out;
+  if (!engine) {
+    out.x = start;
+    out.result = pgs.solve(s, out.x);
+    return out;
+  }
+  const RowPgs::RowFill fill = [&](int first, int count, RowPgs::Row* rows) {
+    for (int k = 0; k < count; ++k) {
+      const int i = first + k;
+      rows[k] = test::rowOf(s, i, start[i], i % 3 ? start[i] : 0.5 * start[i]);
+    }
+  };
+  out.result = pgs.solve(s.bodies, s.size(), fill, out.x);
+  EXPECT_TRUE(pgs.velocityChanges());
+  if (pgs.velocityChanges())
+    for (int k = 0; k < static_cast<int>(s.bodies.size()); ++k)
+      out.velocityChanges.push_back(pgs.velocityChange(k));
+  return out;
+}
+
+TEST(CpuPath, BaselineAndAvx2GiveTheSameBits) {
+  if (!cpuPathAvailable(CpuPath::Avx2)) GTEST_SKIP() << "no AVX2 variant on this build or CPU";
+  CpuPathGuard guard;
+  test::PyramidSpec spec;
+  spec.levels = 10;
+  spec.sideVelocity = 0.3;  // sliding contacts: friction rows at their bounds and inside
+  test::BoxPyramid pyramid(spec);
+  const RowSystem& s = pyramid.rows();
+  // A start that is not the answer: a few sweeps from zero.
+  Vector start;
+  {
+    RowPgs warmup;
+    warmup.options().maxIterations = 3;
+    ASSERT_NE(warmup.solve(s, start).status, Status::InvalidInput);
+  }
+  for (bool engine : {false, true}) {
+    ASSERT_TRUE(setCpuPath(CpuPath::Baseline));
+    const Answer a = solveOn(s, start, engine);
+    ASSERT_TRUE(setCpuPath(CpuPath::Avx2));
+    const Answer b = solveOn(s, start, engine);
+    EXPECT_EQ(a.result.status, b.result.status);
+    EXPECT_EQ(a.result.iterations, b.result.iterations);
+    EXPECT_TRUE(sameBits(a.result.residual, b.result.residual))
+        << a.result.residual << " " << b.result.residual;
+    EXPECT_GT(a.result.residual, 0);  // not converged in 10 sweeps: the check saw real work
+    ASSERT_EQ(a.x.size(), s.size());
+    ASSERT_EQ(b.x.size(), s.size());
+    int differ = 0;
+    for (int i = 0; i < s.size(); ++i) differ += !sameBits(a.x[i], b.x[i]);
+    EXPECT_EQ(differ, 0) << "engine entry point: " << engine;
+    ASSERT_EQ(a.velocityChanges.size(), b.velocityChanges.size());
+    for (std::size_t k = 0; k < a.velocityChanges.size(); ++k)
+      for (int j = 0; j < 6; ++j)
+        EXPECT_TRUE(sameBits(a.velocityChanges[k][j], b.velocityChanges[k][j])) << k << "/" << j;
+  }
+}
+
+}  // namespace
+}  // namespace mlcp
