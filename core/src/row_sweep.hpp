@@ -9,11 +9,13 @@
 #include <cmath>
 #include <type_traits>
 
+#include "mlcp/detail/row_simd.hpp"
 #include "mlcp/residual.hpp"
 #include "mlcp/rows.hpp"
 
 namespace mlcp {
 
+template <bool Wide>
 [[gnu::always_inline]] inline Accuracy RowPgs::checkRows(const Vector& x, double bNorm) const {
   // step_i w_i = (1 - keep) x_i + shift + sA va + sB vb, the sweep's own terms (rows.hpp),
   // scaled back by scale_i = 1 / step_i; the bounds with findex applied at x. In blocks of rows
@@ -30,7 +32,8 @@ namespace mlcp {
     for (int k = 0; k < count; ++k) {
       const PackedRow& p = rows[k];
       const double jv =
-          (p.sA.cwiseProduct(velocity_[p.a].v) + p.sB.cwiseProduct(velocity_[p.b].v)).sum();
+          detail::dot12(p.sA.data(), p.sB.data(), detail::load6<Wide>(velocity_[p.a].v.data()),
+                        detail::load6<Wide>(velocity_[p.b].v.data()));
       w[k] = scale_[first + k] * ((1 - p.keep) * xs[first + k] + p.shift + jv);
     }
     for (int k = 0; k < count; ++k) {
@@ -58,6 +61,7 @@ namespace mlcp {
   return dx;
 }
 
+template <bool Wide>
 [[gnu::always_inline]] inline void RowPgs::sweepRows(double* xs) {
   const int n = static_cast<int>(packed_.size());
   auto update = [&](const PackedRow& p, int i, double jv) __attribute__((always_inline)) {
@@ -85,25 +89,27 @@ namespace mlcp {
     const int length = first.run;
     auto sweepRun = [&](auto size) __attribute__((always_inline)) {
       constexpr int L = decltype(size)::value;
-      const Vector6 va = velocity_[first.a].v, vb = velocity_[first.b].v;
+      double* const pa = velocity_[first.a].v.data();
+      double* const pb = velocity_[first.b].v.data();
+      const detail::Six<Wide> va = detail::load6<Wide>(pa), vb = detail::load6<Wide>(pb);
       double dxs[L];
 #pragma GCC unroll 8
       for (int k = 0; k < L; ++k) {
         const PackedRow& p = packed_[i + k];
-        double jv = (p.sA.cwiseProduct(va) + p.sB.cwiseProduct(vb)).sum();
+        double jv = detail::dot12(p.sA.data(), p.sB.data(), va, vb);
 #pragma GCC unroll 8
         for (int m = 0; m < k; ++m) jv += coupling[m] * dxs[m];
         coupling += k;
         dxs[k] = update(p, i + k, jv);
       }
-      Vector6 da = Vector6::Zero(), db = Vector6::Zero();
+      detail::Six<Wide> da{}, db{};
 #pragma GCC unroll 8
       for (int k = 0; k < L; ++k) {
-        da += packed_[i + k].mA * dxs[k];
-        db += packed_[i + k].mB * dxs[k];
+        da = detail::addScaled(da, packed_[i + k].mA.data(), dxs[k]);
+        db = detail::addScaled(db, packed_[i + k].mB.data(), dxs[k]);
       }
-      velocity_[first.a].v = va + da;
-      velocity_[first.b].v = vb + db;
+      detail::store6(pa, detail::add(va, da));
+      detail::store6(pb, detail::add(vb, db));
     };
     static_assert(kMaxRun == 8, "one case per run length");
     switch (length) {

@@ -359,7 +359,7 @@ Result RowPgs::iteratePacked(int bodies, Vector& x, double bNorm, double t0) {
 #if MLCP_CPU_DISPATCH
   if (detail::avx2Active()) return checkAvx2(x, bNorm);
 #endif
-  return checkRows(x, bNorm);
+  return checkRows<false>(x, bNorm);
 }
 
 // A function of its own: compiled apart from the checks and the stopping logic around it (the
@@ -368,7 +368,7 @@ Result RowPgs::iteratePacked(int bodies, Vector& x, double bNorm, double t0) {
 #if MLCP_CPU_DISPATCH
   if (detail::avx2Active()) return sweepAvx2(xs);
 #endif
-  sweepRows(xs);
+  sweepRows<false>(xs);
 }
 
 Result RowPgs::iterate(Vector& x, double bNorm, double t0) {

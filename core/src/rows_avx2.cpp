@@ -7,9 +7,11 @@
 
 namespace mlcp {
 
-void RowPgs::sweepAvx2(double* xs) { sweepRows(xs); }
+void RowPgs::sweepAvx2(double* xs) { sweepRows<true>(xs); }
 
-Accuracy RowPgs::checkAvx2(const Vector& x, double bNorm) const { return checkRows(x, bNorm); }
+Accuracy RowPgs::checkAvx2(const Vector& x, double bNorm) const {
+  return checkRows<true>(x, bNorm);
+}
 
 }  // namespace mlcp
 #endif

@@ -326,7 +326,10 @@ class RowPgs {
   MLCP_AVX2_VARIANT void sweepAvx2(double* x);
   MLCP_AVX2_VARIANT Accuracy checkAvx2(const Vector& x, double bNorm) const;
 #endif
+  // Wide: with 4-wide vectors (the AVX2 variants), else in pairs (mlcp/detail/row_simd.hpp).
+  template <bool Wide>
   void sweepRows(double* x);
+  template <bool Wide>
   Accuracy checkRows(const Vector& x, double bNorm) const;
   // One row's update from jv = step J_i v (x[i] takes its new value); returns the change of x_i
   // that moves the velocities.
