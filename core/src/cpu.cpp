@@ -1,5 +1,6 @@
 #include "mlcp/cpu.hpp"
 
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 
@@ -24,8 +25,11 @@ bool cpuHasAvx2() {
 }  // namespace
 
 int decideCpuPath() {
+  // MLCP_CPU_PATH: "baseline", or "auto" / "avx2" / unset for the best the CPU has.
   const char* env = std::getenv("MLCP_CPU_PATH");
   const bool baseline = env && std::strcmp(env, "baseline") == 0;
+  if (env && !baseline && *env && std::strcmp(env, "auto") != 0 && std::strcmp(env, "avx2") != 0)
+    std::fprintf(stderr, "mlcp: MLCP_CPU_PATH=%s is not baseline, avx2 or auto; using auto\n", env);
   const int s = !baseline && cpuHasAvx2() ? 1 : 0;
   int expected = -1;
   // A concurrent first use decides the same; setCpuPath's choice wins over the default.

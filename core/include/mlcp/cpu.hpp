@@ -5,17 +5,20 @@
 // baseline x86-64 (SSE2, what a distribution's packages target) and with AVX2, and the AVX2 code
 // runs where the CPU has it. Both are the same source: the same operations in the same order,
 // no fused multiply-adds (every target of this project is compiled with -ffp-contract=off), so
-// they give the same answers bit for bit (tests/core/cpu_test.cpp); only the time differs. The
-// AVX2 code uses the VEX encodings and wider registers where GCC vectorizes. Measured
-// (bullet_bench --pgs-vs-si, 10 sweeps, the stages of ours at 55 boxes): ~0.138 -> ~0.128 ms a
-// step with the whole library built for x86-64-v3, which is what this dispatch gives at run time
-// without building for one machine (README).
+// they give the same answers bit for bit (tests/core/cpu_test.cpp, and a Bullet pyramid stepped
+// under both in tests/bullet/plumbing_test.cpp); only the time differs. The AVX2 code uses the
+// VEX encodings throughout and 4-wide vectors for the sweep's and the check's 12-wide row
+// products and velocity updates (mlcp/detail/row_simd.hpp). Measured (bullet_bench --pgs-vs-si,
+// 10 sweeps, session 9; ratios to SI in the same run): 15 / 55 / 210 boxes 0.93x / 0.97x / 0.92x
+// with AVX2, 0.95x / 1.00x / 0.96x with the baseline (1.00x / 1.03-1.04x / 0.97-0.99x before
+// either change).
 //
-// The choice is made once, at first use: AVX2 when the CPU has AVX2, FMA, BMI1 and BMI2 and the
-// environment variable MLCP_CPU_PATH is not "baseline". setCpuPath() changes it for the whole
-// process (for comparisons; the solvers read it once per loop, so change it between solves).
-// Builds without the dispatch (another compiler or architecture, or -DMLCP_NO_CPU_DISPATCH)
-// always run the baseline.
+// The choice is made once, at first use: AVX2 when the CPU has AVX2, FMA, BMI1 and BMI2, unless
+// the environment variable MLCP_CPU_PATH is "baseline" ("auto" and "avx2" mean the default; any
+// other value is named on stderr and ignored). setCpuPath() changes it for the whole process (for
+// comparisons; the solvers read it once per loop, so change it between solves). Builds without
+// the dispatch (another compiler or architecture, or CMake's -DMLCP_CPU_DISPATCH=OFF, which
+// defines MLCP_NO_CPU_DISPATCH) always run the baseline.
 #pragma once
 
 namespace mlcp {
