@@ -13,7 +13,8 @@ echo "== Format check"
 "$repo/tools/format.sh" --check
 
 echo "== Release build and tests"
-"$repo/tools/build.sh" "$repo/build"
+# MLCP_BULLET_FLOAT_CHECK: the Bullet adapter compiled against single-precision Bullet too.
+"$repo/tools/build.sh" "$repo/build" -DMLCP_BULLET_FLOAT_CHECK=ON
 ctest --test-dir "$repo/build" --output-on-failure -j "$jobs"
 
 if [ "${1:-}" != "--fast" ]; then

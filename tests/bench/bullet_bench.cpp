@@ -31,6 +31,7 @@
 #include <fstream>
 #include <map>
 
+#include "mlcp/cpu.hpp"
 #include "mlcp/solver.hpp"
 #include "scenes.hpp"
 
@@ -258,6 +259,8 @@ int main(int argc, char** argv) {
   app.add_option("--sweeps", sweeps, "sweep counts of --pgs-vs-si")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   if (pair) {
+    // Which machine code RowPgs runs (MLCP_CPU_PATH=baseline forces the baseline).
+    std::printf("RowPgs cpu path: %s\n", mlcp::toString(mlcp::cpuPath()));
     std::printf(
         "| boxes | rows | sweeps | SI ms/step | ours pgs ms/step | pgs / SI | SI residual "
         "worst (median) | pgs residual worst (median) | pgs from the cached impulses | "

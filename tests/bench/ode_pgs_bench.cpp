@@ -54,6 +54,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "mlcp/cpu.hpp"
 #include "mlcp/ode/stepper.hpp"
 #include "mlcp/residual.hpp"
 #include "ode/feedback_lambda.hpp"
@@ -146,6 +147,8 @@ int main(int argc, char** argv) {
   const int only = argc > 5 ? std::atoi(argv[5]) : 0;
   const dReal h = 0.01;
 
+  // Which machine code RowPgs runs (MLCP_CPU_PATH=baseline forces the baseline).
+  std::printf("RowPgs cpu path: %s\n", mlcp::toString(mlcp::cpuPath()));
   std::printf(
       "| base | rows | sweeps | QuickStep ms | ours pgs ms | pgs / QuickStep | QuickStep max |dv| "
       "| pgs max |dv| | QuickStep residual worst (median) | pgs residual worst (median) "

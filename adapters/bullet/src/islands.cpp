@@ -51,7 +51,18 @@ bool allOnes(const btVector3& v) { return v[0] == 1 && v[1] == 1 && v[2] == 1; }
 // J of a side without a dynamic body (ignored by the solver; zeros as a RowSystem would hold).
 constexpr double kZeros[3] = {0, 0, 0};
 
-static_assert(sizeof(btScalar) == sizeof(double), "rows are read in place as doubles");
+// Bullet's 3-vector as 3 contiguous doubles: in place with double-precision Bullet; copied to
+// `own` with single precision (MLCP_BULLET_FLOAT).
+inline const double* doubles(const btVector3& v, double* own) {
+#ifdef BT_USE_DOUBLE_PRECISION
+  static_assert(sizeof(btScalar) == sizeof(double), "rows are read in place as doubles");
+  (void)own;
+  return v;
+#else
+  for (int k = 0; k < 3; ++k) own[k] = v[k];
+  return own;
+#endif
+}
 
 }  // namespace
 
@@ -331,20 +342,26 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
   const int findex = isl.system.findex[r];
   RowPgs::RowView out;
   // One side's J = [n * linearFactor; r x n] and M^-1's angular part, read in place (see
-  // islands.hpp).
+  // islands.hpp); own: 6 doubles for what is not (with single-precision Bullet: J, copied, and no
+  // angular part of M^-1: Bullet's own is rounded to float, not what our products give).
   auto side = [&](int body, const btVector3& normal, const btVector3& torqueAxis,
                   const btVector3& invAngular, const double*& lin, const double*& ang,
                   const double*& invAng, double* own) {
     const unsigned char unit = unit_[body];
     if (unit & kUnitLinear) {
-      lin = normal;
+      lin = doubles(normal, own);
     } else {
       const btVector3& linearFactor = (*in_.bodies)[body].m_linearFactor;
       for (int k = 0; k < 3; ++k) own[k] = normal[k] * linearFactor[k];
       lin = own;
     }
-    ang = torqueAxis;
-    invAng = (unit & kUnitAngular) ? static_cast<const double*>(invAngular) : nullptr;
+    ang = doubles(torqueAxis, own + 3);
+#ifdef BT_USE_DOUBLE_PRECISION
+    invAng = (unit & kUnitAngular) ? doubles(invAngular, nullptr) : nullptr;
+#else
+    (void)invAngular;
+    invAng = nullptr;
+#endif
   };
   if (a >= 0) {
     side(a, c.m_contactNormal1, c.m_relpos1CrossNormal, c.m_angularComponentA, out.linA, out.angA,
@@ -354,7 +371,7 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
   }
   if (b >= 0) {
     side(b, c.m_contactNormal2, c.m_relpos2CrossNormal, c.m_angularComponentB, out.linB, out.angB,
-         out.invAngB, scratch + 3);
+         out.invAngB, scratch + 6);
   } else {
     out.linB = out.angB = kZeros;
   }
@@ -435,7 +452,7 @@ void IslandBuilder::fillSystem(Island& isl) {
   RowPgs::toSystem(bodies, m, rows, isl.system, isl.start);
   isl.splitB.resize(m);
   isl.splitStart.resize(m);
-  double scratch[6];
+  double scratch[12];
   for (int r = 0; r < m; ++r) {
     const RowPgs::RowView push = view(isl, r, true, scratch);
     isl.splitB[r] = push.b;

@@ -199,6 +199,17 @@ class RowSystem {
 // branch over & of its tests (+4 instructions, the same time); the check's two finiteness
 // tests a row folded into one sum checked after the pass, with an exact second pass when it is
 // not finite (check 94 -> 92 instructions, ~7.4 -> ~7.3 ns a row: not worth the second path).
+// Session 9: the packing, sweeps and check are compiled twice, for the baseline and for AVX2, and
+// the CPU picks (mlcp/cpu.hpp; the same bits). The sweep's and the check's row products
+// sA . va + sB . vb and the run's velocity updates are generic vectors (detail/row_simd.hpp): 4 +
+// 2 wide in the AVX2 variant, three pairs in the baseline, in the order Eigen's Vector6
+// expressions summed them (the iterates did not move: bullet_bench's residual columns identical).
+// Callgrind before, 55 boxes: a sweep ~71 instructions a row, the packing ~553. Stage time at 55
+// boxes, 10 sweeps: ~0.136 -> ~0.124 ms (AVX2), ~0.129 ms (baseline pairs: explicit pairs beat
+// Eigen's for the run's velocity stores too). Tried without gain: the packing's couplings as one
+// 4-wide sum (the same bits, sA/sB and mA/mB stored 4-wide so the loads forward; within the
+// noise); 4-wide generic vectors in the baseline (GCC compiles them without AVX through the stack:
+// the sweeps 1.6x slower).
 class RowPgs {
  public:
   Options& options() { return options_; }

@@ -128,6 +128,15 @@
 // 1.02-1.10x, 1.05x / 1.09-1.13x, 1.02x / 1.04-1.08x. The split at 55 boxes is now ~4.4 us of a ~10
 // us gap (4% at the min); the graph pass (~3.3 us) is what is left of it, and folding it into the
 // packing cost the packing more than it saved (islands.hpp).
+// Session 9 (mlcp/cpu.hpp, rows.hpp): the packing, sweeps and check compiled for AVX2 too and
+// chosen at run time, and the sweep's and check's 12-wide products and velocity updates written as
+// generic vectors (4 + 2 wide with AVX2, pairs in the baseline; Eigen's order, the same iterates
+// bit for bit). Two runs, ours stages / SI's iterations at 55 boxes, 10 sweeps: 0.124 / 0.126-0.128
+// ms (0.135-0.137 / 0.126-0.128 before); 10 sweeps 0.93x / 0.97x / 0.92x SI at 15 / 55 / 210
+// boxes in both runs (AVX2), 0.95x / 1.00x / 0.96x with MLCP_CPU_PATH=baseline; 20 sweeps
+// 0.75x / 0.75-0.76x / 0.75-0.77x, 50 sweeps 0.54-0.56x / 0.59-0.60x / 0.59-0.60x. The whole
+// library built for x86-64-v3 instead gained about what the dispatch gains (55 boxes ~1.00x,
+// before the generic vectors), so no other code of ours is held back by the baseline target.
 //
 // "si" runs Bullet's own SI iterations instead (for side-by-side runs with the same statistics).
 #pragma once

@@ -154,7 +154,7 @@ class IslandBuilder {
     IslandBuilder& builder_;
     Island& island_;
     bool split_;
-    double scratch_[6];  // J's linear parts for bodies with other linear factors
+    double scratch_[12];  // J's parts not read in place (6 a side; view())
   };
   // RowPgs' engine path on the island's rows read in place (Source, inlined into the packing).
   Result solvePgs(RowPgs& pgs, Island& island, bool split, Vector& x);
@@ -185,8 +185,8 @@ class IslandBuilder {
 
  private:
   int find(int k);
-  // The island's row r; split: the split-impulse problem's b, start and base. scratch: 6
-  // doubles for J's linear parts when they are not Bullet's normals themselves.
+  // The island's row r; split: the split-impulse problem's b, start and base. scratch: 12
+  // doubles for J's parts that are not read in place (6 a side; see view()).
   RowPgs::RowView view(Island& island, int r, bool split, double* scratch);
 
   std::vector<Island> islands_;
