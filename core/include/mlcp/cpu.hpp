@@ -18,7 +18,9 @@
 // other value is named on stderr and ignored). setCpuPath() changes it for the whole process (for
 // comparisons; the solvers read it once per loop, so change it between solves). Builds without
 // the dispatch (another compiler or architecture, or CMake's -DMLCP_CPU_DISPATCH=OFF, which
-// defines MLCP_NO_CPU_DISPATCH) always run the baseline.
+// defines MLCP_NO_CPU_DISPATCH) always run the baseline. A program that instantiates
+// RowPgs::solveFrom itself (mlcp/detail/row_pack.hpp) compiles that packing with its own flags:
+// it keeps the guarantee with -ffp-contract=off (GCC contracts by default in its GNU modes).
 #pragma once
 
 namespace mlcp {
