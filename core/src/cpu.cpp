@@ -8,15 +8,15 @@ namespace mlcp {
 
 namespace detail {
 
-int cpuPathState = -1;
+std::atomic<int> cpuPathState{-1};
 
 namespace {
 
 bool cpuHasAvx2() {
 #if MLCP_CPU_DISPATCH
   __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
-         __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2");
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("bmi") &&
+         __builtin_cpu_supports("bmi2");
 #else
   return false;
 #endif
@@ -33,9 +33,8 @@ int decideCpuPath() {
   const int s = !baseline && cpuHasAvx2() ? 1 : 0;
   int expected = -1;
   // A concurrent first use decides the same; setCpuPath's choice wins over the default.
-  __atomic_compare_exchange_n(&cpuPathState, &expected, s, false, __ATOMIC_RELAXED,
-                              __ATOMIC_RELAXED);
-  return __atomic_load_n(&cpuPathState, __ATOMIC_RELAXED);
+  cpuPathState.compare_exchange_strong(expected, s, std::memory_order_relaxed);
+  return cpuPathState.load(std::memory_order_relaxed);
 }
 
 }  // namespace detail
@@ -54,7 +53,7 @@ bool cpuPathAvailable(CpuPath path) { return path == CpuPath::Baseline || detail
 
 bool setCpuPath(CpuPath path) {
   if (!cpuPathAvailable(path)) return false;
-  __atomic_store_n(&detail::cpuPathState, path == CpuPath::Avx2 ? 1 : 0, __ATOMIC_RELAXED);
+  detail::cpuPathState.store(path == CpuPath::Avx2 ? 1 : 0, std::memory_order_relaxed);
   return true;
 }
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "common/broken_solvers.hpp"
+#include "common/cpu_path_guard.hpp"
 #include "mlcp/bullet/constraint_solver.hpp"
 #include "mlcp/bullet/mlcp_bridge.hpp"
 #include "mlcp/cpu.hpp"
@@ -378,7 +379,7 @@ TEST(BulletPlumbing, PackedPgsImpulsesEqualTheRowSolversBitForBit) {
 // steps of a 15-box pyramid knocked sideways (packing, sweeps and check in each variant).
 TEST(BulletPlumbing, PgsStepsTheSameOnBothCpuPaths) {
   if (!mlcp::cpuPathAvailable(mlcp::CpuPath::Avx2)) GTEST_SKIP() << "no AVX2 variant here";
-  const mlcp::CpuPath saved = mlcp::cpuPath();
+  const mlcp::test::CpuPathGuard guard;
   std::vector<std::vector<double>> states;
   for (mlcp::CpuPath path : {mlcp::CpuPath::Baseline, mlcp::CpuPath::Avx2}) {
     ASSERT_TRUE(mlcp::setCpuPath(path));
@@ -396,7 +397,6 @@ TEST(BulletPlumbing, PgsStepsTheSameOnBothCpuPaths) {
         for (int c = 0; c < 3; ++c) state.push_back(v[c]);
     states.push_back(state);
   }
-  mlcp::setCpuPath(saved);
   ASSERT_EQ(states[0].size(), states[1].size());
   int differ = 0;
   for (std::size_t k = 0; k < states[0].size(); ++k)

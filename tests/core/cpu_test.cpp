@@ -5,30 +5,29 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdlib>
 #include <cstring>
+#include <random>
+#include <type_traits>
 #include <vector>
 
 #include "common/contact_scenes.hpp"
+#include "common/cpu_path_guard.hpp"
 #include "common/row_fill.hpp"
+#include "mlcp/detail/row_simd.hpp"
 #include "mlcp/rows.hpp"
 
 namespace mlcp {
 namespace {
 
-// Restores the process's CPU path when a test ends.
-class CpuPathGuard {
- public:
-  CpuPathGuard() : saved_(cpuPath()) {}
-  ~CpuPathGuard() { setCpuPath(saved_); }
-
- private:
-  CpuPath saved_;
-};
+using test::CpuPathGuard;
 
 bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 TEST(CpuPath, NamesAvailabilityAndSwitching) {
-  CpuPathGuard guard;
+  CpuPathGuard guard;  // decides the default path if nothing has yet (tests restore it)
+  const CpuPath byDefault = cpuPath();
   EXPECT_STREQ(toString(CpuPath::Baseline), "baseline");
   EXPECT_STREQ(toString(CpuPath::Avx2), "avx2");
   EXPECT_TRUE(cpuPathAvailable(CpuPath::Baseline));
@@ -37,9 +36,53 @@ TEST(CpuPath, NamesAvailabilityAndSwitching) {
   // Asking for AVX2 succeeds exactly where it is available, and a refusal changes nothing.
   EXPECT_EQ(setCpuPath(CpuPath::Avx2), cpuPathAvailable(CpuPath::Avx2));
   EXPECT_EQ(cpuPath(), cpuPathAvailable(CpuPath::Avx2) ? CpuPath::Avx2 : CpuPath::Baseline);
-#if !MLCP_CPU_DISPATCH
+#if MLCP_CPU_DISPATCH
+  // A build with the dispatch offers AVX2 on every CPU that has what the variant uses, and takes
+  // it by default.
+  __builtin_cpu_init();
+  const bool cpu = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("bmi") &&
+                   __builtin_cpu_supports("bmi2");
+  EXPECT_EQ(cpuPathAvailable(CpuPath::Avx2), cpu);
+  if (cpu && !std::getenv("MLCP_CPU_PATH")) {
+    EXPECT_EQ(byDefault, CpuPath::Avx2);
+  }
+#else
   EXPECT_FALSE(cpuPathAvailable(CpuPath::Avx2));
 #endif
+}
+
+// row_simd.hpp's products against the Eigen expressions whose order they keep, on random values
+// of mixed sizes: the same bits, in both widths.
+TEST(CpuPath, RowProductsSumInEigensOrder) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1, 1);
+  auto value = [&] { return u(rng) * std::pow(10.0, 6 * u(rng)); };
+  int differ = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    Vector6 sA, sB, va, vb, m0, m1;
+    for (Vector6* v : {&sA, &sB, &va, &vb, &m0, &m1})
+      for (int k = 0; k < 6; ++k) (*v)[k] = value();
+    const double d0 = value(), d1 = value();
+    const double dot = (sA.cwiseProduct(va) + sB.cwiseProduct(vb)).sum();
+    Vector6 acc = Vector6::Zero();
+    acc += m0 * d0;
+    acc += m1 * d1;
+    const Vector6 moved = va + acc;
+    auto check = [&](auto wide) {
+      constexpr bool Wide = decltype(wide)::value;
+      const auto a = detail::load6<Wide>(va.data()), b = detail::load6<Wide>(vb.data());
+      differ += !sameBits(detail::dot12<Wide>(sA.data(), sB.data(), a, b), dot);
+      detail::Six<Wide> da{};
+      da = detail::addScaled<Wide>(da, m0.data(), d0);
+      da = detail::addScaled<Wide>(da, m1.data(), d1);
+      double out[6];
+      detail::store6<Wide>(out, detail::add<Wide>(a, da));
+      for (int k = 0; k < 6; ++k) differ += !sameBits(out[k], moved[k]);
+    };
+    check(std::false_type());
+    check(std::true_type());
+  }
+  EXPECT_EQ(differ, 0);
 }
 
 struct Answer {

@@ -4,7 +4,8 @@
 // the sweeps and the residual check. On x86-64 with GCC each of them is compiled twice, for the
 // baseline x86-64 (SSE2, what a distribution's packages target) and with AVX2, and the AVX2 code
 // runs where the CPU has it. Both are the same source: the same operations in the same order,
-// no fused multiply-adds (every target of this project is compiled with -ffp-contract=off), so
+// and no fused multiply-adds (the AVX2 variant does not enable FMA, and every target of this
+// project is compiled with -ffp-contract=off, so no a * b + c is fused anywhere), so
 // they give the same answers bit for bit (tests/core/cpu_test.cpp, and a Bullet pyramid stepped
 // under both in tests/bullet/plumbing_test.cpp); only the time differs. The AVX2 code uses the
 // VEX encodings throughout and 4-wide vectors for the sweep's and the check's 12-wide row
@@ -13,15 +14,18 @@
 // with AVX2, 0.95x / 1.00x / 0.96x with the baseline (1.00x / 1.03-1.04x / 0.97-0.99x before
 // either change).
 //
-// The choice is made once, at first use: AVX2 when the CPU has AVX2, FMA, BMI1 and BMI2, unless
+// The choice is made once, at first use: AVX2 when the CPU has AVX2, BMI1 and BMI2, unless
 // the environment variable MLCP_CPU_PATH is "baseline" ("auto" and "avx2" mean the default; any
 // other value is named on stderr and ignored). setCpuPath() changes it for the whole process (for
 // comparisons; the solvers read it once per loop, so change it between solves). Builds without
 // the dispatch (another compiler or architecture, or CMake's -DMLCP_CPU_DISPATCH=OFF, which
 // defines MLCP_NO_CPU_DISPATCH) always run the baseline. A program that instantiates
 // RowPgs::solveFrom itself (mlcp/detail/row_pack.hpp) compiles that packing with its own flags:
-// it keeps the guarantee with -ffp-contract=off (GCC contracts by default in its GNU modes).
+// with FMA enabled (-mfma, -march=native) GCC fuses a * b + c in C++ unless -ffp-contract=off,
+// so such a program keeps the guarantee with that flag.
 #pragma once
+
+#include <atomic>
 
 namespace mlcp {
 
@@ -46,7 +50,7 @@ bool setCpuPath(CpuPath path);
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && \
     !defined(MLCP_NO_CPU_DISPATCH)
 #define MLCP_CPU_DISPATCH 1
-#define MLCP_AVX2_VARIANT __attribute__((noinline, flatten, target("avx2,fma,bmi,bmi2")))
+#define MLCP_AVX2_VARIANT __attribute__((noinline, flatten, target("avx2,bmi,bmi2")))
 #else
 #define MLCP_CPU_DISPATCH 0
 #endif
@@ -54,10 +58,10 @@ bool setCpuPath(CpuPath path);
 namespace mlcp::detail {
 // 1 = Avx2, 0 = Baseline, -1 = not decided yet.
 int decideCpuPath();
-extern int cpuPathState;
+extern std::atomic<int> cpuPathState;
 // Whether the hot loops take their AVX2 variant (decided at the first call).
 inline bool avx2Active() {
-  const int s = __atomic_load_n(&cpuPathState, __ATOMIC_RELAXED);
+  const int s = cpuPathState.load(std::memory_order_relaxed);
   return (s < 0 ? decideCpuPath() : s) == 1;
 }
 }  // namespace mlcp::detail
