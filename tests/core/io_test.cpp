@@ -2,6 +2,7 @@
 #include "mlcp/io.hpp"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -118,7 +119,8 @@ TEST(Siconos, ReadsKnownValues) {
 }
 
 TEST(Siconos, TruncatedAndGarbledFiles) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "mlcp_io_test";
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("mlcp_io_test_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   auto attempt = [&](const std::string& text) -> std::string {
     const std::string path = (dir / "bad.dat").string();

@@ -5,6 +5,7 @@
 #include "mlcp/scene/scene.hpp"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -747,7 +748,8 @@ TEST(SceneErrors, FilesNameThemselves) {
         }
       },
       FormatError);
-  const auto path = std::filesystem::temp_directory_path() / "mlcp_scene_test_bad.json";
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("mlcp_scene_test_bad_" + std::to_string(::getpid()) + ".json");
   {
     std::ofstream out(path);
     out << withBodies(R"({"name": "b", "shape": {"type": "box", "size": [1, 1, 1]},

@@ -3,10 +3,12 @@
 #include "trajectory.hpp"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <string>
 
 namespace mlcp::cli {
 namespace {
@@ -39,7 +41,11 @@ TEST(Deviation, OrientationIsTheAngleBetween) {
 class TrajectoryFile : public ::testing::Test {
  protected:
   std::string write(const std::string& text) {
-    path_ = ::testing::TempDir() + "trajectory_test.csv";
+    // A file of this test's own: ctest runs the tests of this suite in parallel processes, and
+    // one shared name let one test's TearDown remove or overwrite another's file (a red CI run).
+    const ::testing::TestInfo* test = ::testing::UnitTest::GetInstance()->current_test_info();
+    path_ = ::testing::TempDir() + "trajectory_test_" + test->name() + "_" +
+            std::to_string(::getpid()) + ".csv";
     std::ofstream(path_) << text;
     return path_;
   }
