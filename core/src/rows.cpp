@@ -354,8 +354,7 @@ Result RowPgs::iteratePacked(int bodies, Vector& x, double bNorm, double t0) {
 
 // Not inlined into iterate(): its loops there changed how the sweep loop was compiled (our
 // stages ~20% slower at 210 boxes).
-[[gnu::noinline, gnu::flatten]] Accuracy RowPgs::packedAccuracy(const Vector& x,
-                                                                double bNorm) const {
+[[gnu::noinline]] Accuracy RowPgs::packedAccuracy(const Vector& x, double bNorm) const {
 #if MLCP_CPU_DISPATCH
   if (detail::avx2Active()) return checkAvx2(x, bNorm);
 #endif
@@ -364,7 +363,7 @@ Result RowPgs::iteratePacked(int bodies, Vector& x, double bNorm, double t0) {
 
 // A function of its own: compiled apart from the checks and the stopping logic around it (the
 // sweep's code and speed moved with whatever else iterate() held).
-[[gnu::noinline, gnu::flatten]] void RowPgs::sweepOnce(double* xs) {
+[[gnu::noinline]] void RowPgs::sweepOnce(double* xs) {
 #if MLCP_CPU_DISPATCH
   if (detail::avx2Active()) return sweepAvx2(xs);
 #endif

@@ -242,22 +242,7 @@ TEST(RowPgs, RejectsBadRows) {
 // The engine entry point (RowPgs::solve with a row fill) must pack what solve(RowSystem) packs
 // from the same values: the same iterates bit for bit, the same result, and the velocity change
 // M^-1 J^T (x - base) per body.
-using test::rowOf;
-
-Result solveFromRows(RowPgs& pgs, const RowSystem& s, const Vector& start, const Vector& base,
-                     Vector& x) {
-  int calls = 0;
-  const Result r = pgs.solve(
-      s.bodies, s.size(),
-      [&](int first, int count, RowPgs::Row* out) {
-        ++calls;
-        for (int k = 0; k < count; ++k)
-          out[k] = rowOf(s, first + k, start[first + k], base[first + k]);
-      },
-      x);
-  EXPECT_GE(calls, (s.size() + 63) / 64);
-  return r;
-}
+using test::solveFromRows;
 
 // Rows in reverse order: every friction row's findex points forward (checked after the pass).
 RowSystem reversed(const RowSystem& s) {

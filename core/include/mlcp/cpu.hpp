@@ -46,7 +46,8 @@ bool setCpuPath(CpuPath path);
 
 // For the solvers' sources: MLCP_CPU_DISPATCH is 1 where an AVX2 variant is compiled, and
 // MLCP_AVX2_VARIANT marks its functions (noinline: a variant is one function with the shared
-// body inlined into it).
+// body inlined into it; flatten: with everything that body calls inlined as well: without it GCC
+// compiled the Bullet packing's variant to other code than the one measured).
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && \
     !defined(MLCP_NO_CPU_DISPATCH)
 #define MLCP_CPU_DISPATCH 1
