@@ -135,8 +135,10 @@
 // ms (0.135-0.137 / 0.126-0.128 before); 10 sweeps 0.93x / 0.97x / 0.92x SI at 15 / 55 / 210
 // boxes in both runs (AVX2), 0.95x / 1.00x / 0.96x with MLCP_CPU_PATH=baseline; 20 sweeps
 // 0.75x / 0.75-0.76x / 0.75-0.77x, 50 sweeps 0.54-0.56x / 0.59-0.60x / 0.59-0.60x. The whole
-// library built for x86-64-v3 instead gained about what the dispatch gains (55 boxes ~1.00x,
-// before the generic vectors), so no other code of ours is held back by the baseline target.
+// library built for x86-64-v3 instead (tools/build.sh DIR -DCMAKE_CXX_FLAGS="-march=x86-64-v3
+// -ffp-contract=off", before the generic vectors) gained about what the dispatch alone gained
+// (55 boxes ~1.00x against 1.01-1.02x, alternated runs), so the rest of our stages gain little
+// from AVX2.
 //
 // "si" runs Bullet's own SI iterations instead (for side-by-side runs with the same statistics).
 #pragma once
