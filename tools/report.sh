@@ -96,6 +96,11 @@ if [ -d "$siconos/lcp" ]; then
   "$mlcp" table --markdown "$repo/tests/data/seed_lemke.json" "$repo/tests/data/spd.json" \
     "$repo/tests/data/boxed.json" "$repo/tests/data/findex.json" "$siconos"/lcp/*.dat \
     --solvers pgs,lemke,dantzig,auto > "$out/table.md"
+  if [ -d "$siconos/mlcp" ]; then
+    printf '\nSiconos MLCP files (free rows for the equalities), tolerance 1e-9:\n\n' >> "$out/table.md"
+    "$mlcp" table --markdown "$siconos"/mlcp/*.dat --solvers pgs,lemke,dantzig,auto --tol 1e-9 \
+      >> "$out/table.md"
+  fi
   echo "$((SECONDS - t0)) s"
 else
   notes+=("No Siconos table: $siconos/lcp is missing (set MLCP_SICONOS_DIR).")

@@ -1,9 +1,11 @@
 #include "mlcp/io.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <utility>
 
 namespace mlcp::io {
 
@@ -246,18 +248,22 @@ long long checkedSize(Tokens& t, const char* what, long long maxValue) {
   return v;
 }
 
+// Siconos writes its column-major storage in sequence (NM_write_in_file), so each printed
+// line is a column; the block files agree only when read this way.
+DenseMatrix readColumnMajor(Tokens& t, int rows, int cols, const char* what) {
+  DenseMatrix M(rows, cols);
+  for (int j = 0; j < cols; ++j)
+    for (int i = 0; i < rows; ++i) M(i, j) = t.real(what);
+  return M;
+}
+
 DenseMatrix readSiconosDense(Tokens& t, int n) {
   const long long rows = t.integer("matrix rows"), cols = t.integer("matrix cols");
   const long long rows2 = t.integer("matrix rows"), cols2 = t.integer("matrix cols");
   if (rows != n || cols != n || rows2 != n || cols2 != n)
     fail(t.source(), "dense matrix is " + std::to_string(rows) + "x" + std::to_string(cols) +
                          ", expected " + std::to_string(n) + "x" + std::to_string(n));
-  // Siconos writes its column-major storage in sequence (NM_write_in_file), so each printed
-  // line is a column; the block files agree only when read this way.
-  DenseMatrix M(n, n);
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) M(i, j) = t.real("a matrix entry");
-  return M;
+  return readColumnMajor(t, n, n, "a matrix entry");
 }
 
 // Siconos' SparseBlockStructuredMatrix text form: size0 size1 nbblocks blocknumber0
@@ -331,11 +337,127 @@ Problem readSiconosLcp(const std::string& path) {
   return p;
 }
 
+namespace {
+
+// Storage 1's row blocks: starts 0 = r_0 < r_1 < ... < r_K = size, then one flag per block
+// (0: equality rows, 1: complementarity rows). Rows of an equality block are free in our form.
+void readMlcpBlocks(Tokens& t, long long size, Problem& p) {
+  std::vector<long long> starts{t.integer("the first block row")};
+  if (starts[0] != 0) fail(t.source(), "the first block row is not 0");
+  while (starts.back() < size) {
+    starts.push_back(t.integer("a block row"));
+    if (starts.back() <= starts[starts.size() - 2])
+      fail(t.source(), "block rows are not increasing");
+  }
+  if (starts.back() != size) fail(t.source(), "block rows do not end at n + m");
+  p.lo.resize(size);
+  for (std::size_t k = 0; k + 1 < starts.size(); ++k) {
+    const long long flag = t.integer("a block's complementarity flag");
+    if (flag != 0 && flag != 1) fail(t.source(), "a block's complementarity flag is not 0 or 1");
+    p.lo.segment(starts[k], starts[k + 1] - starts[k]).setConstant(flag ? 0.0 : -kInf);
+  }
+}
+
+// Storage 1's M = [[A, C], [D, B]] (a NumericsMatrix: dense or sparse block) and q = [a; b].
+void readMlcpStorage1(Tokens& t, long long size, Problem& p) {
+  const long long storage = t.integer("M's storage type");
+  if (storage == 0) {
+    // size0 size1, then the dense block's own "rows cols".
+    const long long rows = t.integer("M's rows"), cols = t.integer("M's columns");
+    if (t.integer("M's rows") != rows || t.integer("M's columns") != cols)
+      fail(t.source(), "M's two size lines differ");
+    if (rows != cols)
+      throw UnsupportedProblem(t.source() + ": M is " + std::to_string(rows) + " x " +
+                               std::to_string(cols) +
+                               ": a rectangular MLCP has no square canonical form");
+    if (rows != size) fail(t.source(), "M's size does not match n + m");
+    p.setA(readColumnMajor(t, static_cast<int>(size), static_cast<int>(size), "an entry of M"));
+  } else if (storage == 1) {
+    p.setA(readSiconosBlock(t, static_cast<int>(size)));
+  } else {
+    fail(t.source(), "M's storage type is not 0 (dense) or 1 (sparse block)");
+  }
+  p.b.resize(size);
+  for (long long i = 0; i < size; ++i) p.b[i] = t.real("an entry of q");
+}
+
+// Storage 2's blocks A (n x n), B (m x m), C (n x m), D (m x n), each row by row (Siconos
+// prints and reads them with the row index outermost), then a (n) and b (m), assembled into
+// M = [[A, C], [D, B]] and q = [a; b].
+DenseMatrix readRowMajor(Tokens& t, int rows, int cols, const char* what) {
+  DenseMatrix M(rows, cols);
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < cols; ++j) M(i, j) = t.real(what);
+  return M;
+}
+
+std::pair<DenseMatrix, Vector> readMlcpStorage2(Tokens& t, int n, int m) {
+  DenseMatrix M(n + m, n + m);
+  M.topLeftCorner(n, n) = readRowMajor(t, n, n, "an entry of A");
+  M.bottomRightCorner(m, m) = readRowMajor(t, m, m, "an entry of B");
+  M.topRightCorner(n, m) = readRowMajor(t, n, m, "an entry of C");
+  M.bottomLeftCorner(m, n) = readRowMajor(t, m, n, "an entry of D");
+  Vector q(n + m);
+  for (int i = 0; i < n + m; ++i) q[i] = t.real(i < n ? "an entry of a" : "an entry of b");
+  return {std::move(M), std::move(q)};
+}
+
+// Both storages in one file must describe one problem (to rounding in the printed digits).
+void checkStoragesAgree(const Problem& p, const DenseMatrix& M, const Vector& q, int n,
+                        const std::string& source) {
+  const DenseMatrix A = p.toDense();
+  const double scale = 1 + std::max(A.cwiseAbs().maxCoeff(), p.b.cwiseAbs().maxCoeff());
+  if ((A - M).cwiseAbs().maxCoeff() > 1e-12 * scale ||
+      (p.b - q).cwiseAbs().maxCoeff() > 1e-12 * scale)
+    fail(source, "storage 1 (M, q) and storage 2 (A, B, C, D, a, b) describe different problems");
+  for (int i = 0; i < p.size(); ++i)
+    if ((p.lo[i] == 0) != (i >= n))
+      fail(source, "storage 1's blocks do not put the n equalities before the m complementarities");
+}
+
+}  // namespace
+
+Problem readSiconosMlcp(const std::string& path) {
+  Tokens t(slurp(path), path);
+  const long long storage1 = t.integer("storage 1 flag"), storage2 = t.integer("storage 2 flag");
+  if ((storage1 != 0 && storage1 != 1) || (storage2 != 0 && storage2 != 1) ||
+      storage1 + storage2 == 0)
+    fail(path, "the storage flags are not 0/1 with at least one set");
+  const int n = static_cast<int>(checkedSize(t, "n", 10000000));
+  const int m = static_cast<int>(checkedSize(t, "m", 10000000 - n));
+  Problem p;
+  if (storage1) {
+    readMlcpBlocks(t, n + m, p);
+    readMlcpStorage1(t, n + m, p);
+  }
+  if (storage2) {
+    auto [M, q] = readMlcpStorage2(t, n, m);
+    if (storage1) {
+      checkStoragesAgree(p, M, q, n, path);
+    } else {
+      p.setA(std::move(M));
+      p.b = std::move(q);
+      p.lo = Vector::Constant(n + m, 0.0);
+      p.lo.head(n).setConstant(-kInf);
+    }
+  }
+  p.hi = Vector::Constant(n + m, kInf);
+  checkValid(p, path);
+  return p;
+}
+
+bool isSiconosMlcpName(const std::string& path) {
+  const std::string suffix = "mlcp.dat";
+  return path.size() >= suffix.size() &&
+         path.compare(path.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
 Problem readProblem(const std::string& path) {
   auto endsWith = [&](const char* suffix) {
     const std::string s(suffix);
     return path.size() >= s.size() && path.compare(path.size() - s.size(), s.size(), s) == 0;
   };
+  if (isSiconosMlcpName(path)) return readSiconosMlcp(path);
   if (endsWith(".dat")) return readSiconosLcp(path);
   return readProblemJson(path);
 }

@@ -140,5 +140,73 @@ TEST(Siconos, TruncatedAndGarbledFiles) {
   std::filesystem::remove_all(dir);
 }
 
+// deudeu_mlcp: n = m = 1, M = [[1, -1], [0, 1]] (printed column by column), q = (-1, 1), and
+// storage 2 with the same blocks printed row by row.
+TEST(SiconosMlcp, ReadsKnownValuesAndBounds) {
+  const Problem p = io::readSiconosMlcp(kSiconos + "/mlcp/deudeu_mlcp.dat");
+  ASSERT_EQ(p.size(), 2);
+  const DenseMatrix A = p.toDense();
+  EXPECT_EQ(A(0, 0), 1);
+  EXPECT_EQ(A(0, 1), -1);
+  EXPECT_EQ(A(1, 0), 0);
+  EXPECT_EQ(A(1, 1), 1);
+  EXPECT_EQ(p.b[0], -1);
+  EXPECT_EQ(p.b[1], 1);
+  EXPECT_EQ(p.lo[0], -kInf);  // the equality row is free
+  EXPECT_EQ(p.lo[1], 0);
+  EXPECT_EQ(p.hi[1], kInf);
+}
+
+// Every file with both storages is checked against itself by the reader; the asymmetric
+// circuit matrices tell row-by-row from column-by-column reading apart.
+TEST(SiconosMlcp, EveryCorpusFileReadsOrIsUnsupported) {
+  int read = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(kSiconos + "/mlcp")) {
+    const std::string path = entry.path().string();
+    ASSERT_TRUE(io::isSiconosMlcpName(path)) << path;
+    if (entry.path().stem() == "Rectangular_mlcp") {
+      EXPECT_THROW(io::readProblem(path), io::UnsupportedProblem);
+      continue;
+    }
+    const Problem p = io::readProblem(path);
+    EXPECT_TRUE(p.validate().empty()) << path;
+    EXPECT_GT((p.lo.array() == -kInf).count(), 0) << path;
+    ++read;
+  }
+  EXPECT_EQ(read, 15);
+}
+
+TEST(SiconosMlcp, StorageTwoAloneAndDisagreeingStorages) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("mlcp_mlcp_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "case_mlcp.dat").string();
+  auto attempt = [&](const std::string& text) -> std::string {
+    std::ofstream(path) << text;
+    try {
+      io::readProblem(path);
+    } catch (const io::FormatError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  // Storage 2 only: A = 2, B = 3, C = 1, D = -1, a = 4, b = 5.
+  EXPECT_EQ(attempt("0 1 1 1\n2\n3\n1\n-1\n4\n5\n"), "");
+  const Problem p = io::readProblem(path);
+  EXPECT_EQ(p.toDense(), (DenseMatrix(2, 2) << 2, 1, -1, 3).finished());
+  EXPECT_EQ(p.b, (Vector(2) << 4, 5).finished());
+  EXPECT_EQ(p.lo[0], -kInf);
+  EXPECT_EQ(p.lo[1], 0);
+  // Both storages, C and D exchanged in storage 2.
+  EXPECT_NE(attempt("1 1 1 1\n0 1 2\n0 1\n0 2 2 2 2\n2 -1 1 3\n4 5\n2\n3\n-1\n1\n4\n5\n")
+                .find("describe different problems"),
+            std::string::npos);
+  EXPECT_NE(attempt("1 0 1 1\n0 1 2\n0 7\n").find("flag is not 0 or 1"), std::string::npos);
+  EXPECT_NE(attempt("1 0 2 1\n0 2 1\n").find("not increasing"), std::string::npos);
+  EXPECT_NE(attempt("0 0 1 1\n").find("storage flags"), std::string::npos);
+  EXPECT_NE(attempt("1 0 1 1\n0 1 2\n0 1\n0 3 2 3 2\n").find("rectangular"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace mlcp

@@ -73,6 +73,16 @@ int runTable(const TableArgs& args) {
     Problem problem;
     try {
       problem = io::readProblem(file);
+    } catch (const io::UnsupportedProblem& e) {
+      // A well-formed problem outside the canonical form: a row per solver saying why.
+      for (const std::string& name : names) {
+        Result unsupported;
+        unsupported.status = Status::Unsupported;
+        unsupported.message = e.what();
+        rows.push_back({baseName(file), 0, name, unsupported});
+        ++unsolved;
+      }
+      continue;
     } catch (const io::FormatError& e) {
       std::fprintf(stderr, "mlcp table: %s\n", e.what());
       return kInvalidInput;
