@@ -3,7 +3,8 @@
 #  1. configures, builds and runs the consumer project with find_package(mlcp CONFIG
 #     COMPONENTS core bullet ode) (C++ and C programs; see CMakeLists.txt);
 #  2. builds the C program again with pkg-config alone (mlcp-ode.pc) and runs it;
-#  3. checks that asking for a component the installation lacks fails at configure time,
+#  3. imports the installed Python package (when the build has one) and solves with it;
+#  4. checks that asking for a component the installation lacks fails at configure time,
 #     naming it, and that a newer version than installed is refused.
 set -euo pipefail
 build_dir=$1 source_dir=$2 generator=${3:-Ninja}
@@ -26,6 +27,17 @@ export PKG_CONFIG_PATH=$pc_dir
 cc -std=c99 -o "$work/consumer_pc" "$source_dir/main.c" "$source_dir/ode_drop.c" \
   $(pkg-config --cflags --libs mlcp-ode)
 "$work/consumer_pc" | sed 's/^c:/pkg-config c:/'
+
+site=$(find "$prefix" -path '*site-packages/mlcp' -type d | head -1)
+if [ -n "$site" ]; then
+  python=$(cd "$source_dir/../.." && pwd)/.venv/bin/python
+  (cd "$work" && PYTHONPATH=$(dirname "$site") "$python" -c '
+import mlcp
+r = mlcp.solve([[2.0, 1.0], [1.0, 2.0]], [-1.0, -1.0], solver="lemke")
+assert r.converged and abs(r.x[0] - 1 / 3) < 1e-12, r
+assert mlcp.__file__.startswith("'"$prefix"'"), mlcp.__file__
+print("python: installed mlcp solves,", r.status)')
+fi
 
 # A component that is not there, and a version that is not there.
 mkdir -p "$work/probe"
