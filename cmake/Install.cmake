@@ -9,6 +9,7 @@
 #                   engine-finding modules the config shares with this build
 #   lib/pkgconfig/mlcp-ode.pc   (the C API: cc app.c $(pkg-config --cflags --libs mlcp-ode))
 #   bin/mlcp
+#   lib/python3.X/site-packages/mlcp   (the Python package, when built: python/CMakeLists.txt)
 # The scene loaders (mlcp::scene, the engines' scene_loader.hpp) are not installed: they serve
 # the mlcp program and the tests.
 include(GNUInstallDirs)
