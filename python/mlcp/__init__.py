@@ -231,6 +231,11 @@ class Run:
     energy: np.ndarray  # J
     momentum: np.ndarray  # kg m/s
     max_speed: np.ndarray  # m/s
+    bodies: List[str]  # every scene body's name, static ones included, in scene order
+    # With run(..., states=True), per step and body (shape steps x bodies x k), else None:
+    positions: Optional[np.ndarray]  # centre of mass, world, m (k = 3)
+    orientations: Optional[np.ndarray]  # body to world quaternion w, x, y, z (k = 4)
+    velocities: Optional[np.ndarray]  # m/s (k = 3)
 
     @property
     def steps(self) -> int:
@@ -255,13 +260,14 @@ class Run:
 def run(scene: "str | os.PathLike[str]", engine: str, solver: Optional[str] = None,
         steps: Optional[int] = None, iterations: Optional[int] = None,
         tol: Optional[float] = None, warm_start: bool = True, fallback: Optional[str] = "pgs",
-        fallback_residual: Optional[float] = None) -> Run:
+        fallback_residual: Optional[float] = None, states: bool = False) -> Run:
     """Steps a scene file (mlcp-scene/1) in an engine ("bullet" or "ode", see engines()).
 
     solver: a core solver name (through our adapters) or an engine's stock one ("bullet-si",
     "ode-world", ...); None, steps, iterations and tol None: the scene's own settings; fallback:
     the core solver run when an answer is rejected (None: none); fallback_residual: the scaled
     residual above which an answer is rejected (None: 1e-3). The same rules as `mlcp run`.
+    states: also record every body's position, orientation and velocity after each step.
     """
     for name, value in (("steps", steps), ("iterations", iterations), ("tol", tol),
                         ("fallback_residual", fallback_residual)):
@@ -270,7 +276,7 @@ def run(scene: "str | os.PathLike[str]", engine: str, solver: Optional[str] = No
     d = _mlcp.run(os.fspath(scene), engine, solver or "", -1 if steps is None else int(steps),
                   -1 if iterations is None else int(iterations), -1.0 if tol is None else tol,
                   bool(warm_start), fallback or "",
-                  -1.0 if fallback_residual is None else fallback_residual)
+                  -1.0 if fallback_residual is None else fallback_residual, bool(states))
     d["status"] = np.array(d["status"], dtype=str)
     d["choice"] = np.array(d["choice"], dtype=str)
     return Run(**d)

@@ -80,6 +80,10 @@ class Run:
     energy: npt.NDArray[np.float64]
     momentum: npt.NDArray[np.float64]
     max_speed: npt.NDArray[np.float64]
+    bodies: List[str]
+    positions: Optional[npt.NDArray[np.float64]]
+    orientations: Optional[npt.NDArray[np.float64]]
+    velocities: Optional[npt.NDArray[np.float64]]
     def __init__(self, scene: str, engine: str, solver: str, time_step: float, finite: bool,
                  solver_ms: npt.NDArray[np.float64], step_ms: npt.NDArray[np.float64],
                  residual: npt.NDArray[np.float64], iterations: npt.NDArray[np.int32],
@@ -88,7 +92,10 @@ class Run:
                  max_penetration: npt.NDArray[np.float64],
                  joint_error: npt.NDArray[np.float64], energy: npt.NDArray[np.float64],
                  momentum: npt.NDArray[np.float64],
-                 max_speed: npt.NDArray[np.float64]) -> None: ...
+                 max_speed: npt.NDArray[np.float64], bodies: List[str],
+                 positions: Optional[npt.NDArray[np.float64]],
+                 orientations: Optional[npt.NDArray[np.float64]],
+                 velocities: Optional[npt.NDArray[np.float64]]) -> None: ...
     @property
     def steps(self) -> int: ...
     def columns(self) -> Dict[str, np.ndarray]: ...
@@ -96,6 +103,7 @@ class Run:
 
 def run(scene: _Path, engine: str, solver: Optional[str] = None, steps: Optional[int] = None,
         iterations: Optional[int] = None, tol: Optional[float] = None, warm_start: bool = True,
-        fallback: Optional[str] = "pgs", fallback_residual: Optional[float] = None) -> Run: ...
+        fallback: Optional[str] = "pgs", fallback_residual: Optional[float] = None,
+        states: bool = False) -> Run: ...
 def solvers() -> List[str]: ...
 def engines() -> List[str]: ...

@@ -7,6 +7,7 @@
 #include <nanobind/ndarray.h>
 
 #include <cstddef>
+#include <initializer_list>
 #include <utility>
 #include <vector>
 
@@ -52,6 +53,14 @@ inline Array2 toNumpy(DenseMatrix&& m) {
   const std::size_t shape[2] = {static_cast<std::size_t>(heap->rows()),
                                 static_cast<std::size_t>(heap->cols())};
   return Array2(heap->data(), 2, shape, owner);
+}
+
+// A flat vector as a C-ordered array of the given shape (the product of which is v.size()).
+inline nb::ndarray<nb::numpy, double> toNumpy(std::vector<double>&& v,
+                                              std::initializer_list<std::size_t> shape) {
+  auto* heap = new std::vector<double>(std::move(v));
+  nb::capsule owner(heap, [](void* p) noexcept { delete static_cast<std::vector<double>*>(p); });
+  return nb::ndarray<nb::numpy, double>(heap->data(), shape, owner);
 }
 
 inline Eigen::Map<const Vector> view(const InVector& v) {

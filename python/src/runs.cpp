@@ -27,6 +27,7 @@ struct RunArgs {
   bool warmStart = true;
   std::string fallback = "pgs";  // "" : none
   double fallbackResidual = -1;
+  bool states = false;  // record every body's position, orientation and velocity per step
 };
 
 // The columns of one run, filled step by step.
@@ -35,6 +36,8 @@ struct Columns {
       maxSpeed;
   std::vector<int> iterations, fallbacks, contacts;
   std::vector<std::string> status, choice;
+  // With RunArgs::states, per step and scene body: x y z, w x y z, vx vy vz (flat, C order).
+  std::vector<double> positions, orientations, velocities;
 
   void add(const scene::StepMeasures& m) {
     solverMs.push_back(m.solverMs);
@@ -50,6 +53,15 @@ struct Columns {
     contacts.push_back(m.contacts);
     status.push_back(m.status);
     choice.push_back(m.choice);
+  }
+
+  void addStates(const std::vector<scene::BodyState>& bodies) {
+    for (const scene::BodyState& b : bodies) {
+      positions.insert(positions.end(), b.position.begin(), b.position.end());
+      orientations.insert(orientations.end(),
+                          {b.orientation.w, b.orientation.x, b.orientation.y, b.orientation.z});
+      velocities.insert(velocities.end(), b.velocity.begin(), b.velocity.end());
+    }
   }
 };
 
@@ -82,7 +94,10 @@ nb::dict run(const std::string& path, const std::string& engine, const RunArgs& 
   cli::RunSummary sum;
   {
     nb::gil_scoped_release unlocked;
-    sum = cli::runWorld(*world, steps, [&](const scene::World& w, int) { c.add(w.last()); });
+    sum = cli::runWorld(*world, steps, [&](const scene::World& w, int) {
+      c.add(w.last());
+      if (args.states) c.addStates(w.states());
+    });
   }
   nb::dict out;
   out["scene"] = s.name;
@@ -90,6 +105,9 @@ nb::dict run(const std::string& path, const std::string& engine, const RunArgs& 
   out["solver"] = settings.solver;
   out["time_step"] = s.settings.timeStep;
   out["finite"] = sum.finite;
+  std::vector<std::string> names;
+  for (const scene::Body& b : s.bodies) names.push_back(b.name);
+  out["bodies"] = std::move(names);
   out["solver_ms"] = toNumpy(std::move(c.solverMs));
   out["step_ms"] = toNumpy(std::move(c.stepMs));
   out["residual"] = toNumpy(std::move(c.residual));
@@ -103,6 +121,14 @@ nb::dict run(const std::string& path, const std::string& engine, const RunArgs& 
   out["energy"] = toNumpy(std::move(c.energy));
   out["momentum"] = toNumpy(std::move(c.momentum));
   out["max_speed"] = toNumpy(std::move(c.maxSpeed));
+  const std::size_t taken = static_cast<std::size_t>(sum.steps), bodies = s.bodies.size();
+  if (args.states) {
+    out["positions"] = toNumpy(std::move(c.positions), {taken, bodies, 3});
+    out["orientations"] = toNumpy(std::move(c.orientations), {taken, bodies, 4});
+    out["velocities"] = toNumpy(std::move(c.velocities), {taken, bodies, 3});
+  } else {
+    out["positions"] = out["orientations"] = out["velocities"] = nb::none();
+  }
   return out;
 }
 
@@ -113,13 +139,14 @@ void bindRuns(nb::module_& m) {
       "run",
       [](const std::string& path, const std::string& engine, const std::string& solver, int steps,
          int iterations, double tol, bool warmStart, const std::string& fallback,
-         double fallbackResidual) {
-        return run(path, engine,
-                   RunArgs{solver, steps, iterations, tol, warmStart, fallback, fallbackResidual});
+         double fallbackResidual, bool states) {
+        return run(
+            path, engine,
+            RunArgs{solver, steps, iterations, tol, warmStart, fallback, fallbackResidual, states});
       },
       nb::arg("path"), nb::arg("engine"), nb::arg("solver"), nb::arg("steps"),
       nb::arg("iterations"), nb::arg("tol"), nb::arg("warm_start"), nb::arg("fallback"),
-      nb::arg("fallback_residual"));
+      nb::arg("fallback_residual"), nb::arg("states"));
   m.def("engine_names", &cli::engineList);
 }
 

@@ -29,6 +29,20 @@ def test_stack_with_dantzig(engine):
     assert all(c.startswith("dantzig:") for c in run.choice)
 
 
+def test_states_follow_the_bodies():
+    """A box resting on the ground stays where it was put (0, 0, 0.5), upright."""
+    run = mlcp.run(SCENES / "resting_box.json", "ode", solver="dantzig", steps=60, states=True)
+    assert run.positions.shape == (60, len(run.bodies), 3)
+    assert run.orientations.shape == (60, len(run.bodies), 4)
+    np.testing.assert_allclose(np.linalg.norm(run.orientations, axis=2), 1.0, atol=1e-9)
+    box = run.bodies.index("box")
+    np.testing.assert_allclose(run.positions[:, box], [[0, 0, 0.5]] * 60, atol=2e-3)
+    np.testing.assert_allclose(np.abs(run.orientations[:, box, 0]), 1.0, atol=1e-6)
+    assert np.abs(run.velocities[:, box]).max() < 0.05
+    plain = mlcp.run(SCENES / "resting_box.json", "ode", solver="dantzig", steps=2)
+    assert plain.positions is None and plain.bodies == run.bodies
+
+
 def test_stock_solver_residual_not_measured():
     run = mlcp.run(SCENES / "stack_10.json", "bullet", solver="bullet-si", steps=5)
     assert np.all(np.isnan(run.residual))
