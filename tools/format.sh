@@ -9,7 +9,7 @@ if ! command -v clang-format >/dev/null; then
   echo "tools/format.sh: clang-format not found (tools/setup.sh installs it)" >&2
   exit 2
 fi
-mapfile -t files < <(find core adapters scenes tools tests \
+mapfile -t files < <(find core adapters scenes tools tests python \
   \( -name '*.cpp' -o -name '*.hpp' -o -name '*.h' \) -type f | sort)
 if [ "${1:-}" = "--check" ]; then
   bad=()

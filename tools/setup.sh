@@ -15,6 +15,9 @@ packages=(
 
 sudo_if_needed() { if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi; }
 
+# Python's headers, for the bindings (python/, built with nanobind from the venv below).
+packages+=(python3-dev)
+
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -55,5 +58,12 @@ if [ -f "$repo/tools/requirements.txt" ]; then
     "$venv/bin/pip" install -q --disable-pip-version-check -r "$repo/tools/requirements.txt"
     cp "$repo/tools/requirements.txt" "$stamp"
   fi
+fi
+# The Python package mlcp (python/) is built into build/python by tools/build.sh; the venv finds
+# it there through a .pth file (another build tree: PYTHONPATH=<build>/python).
+if [ -x "$repo/.venv/bin/python" ]; then
+  site=$("$repo/.venv/bin/python" -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
+  pth="$site/mlcp-build.pth"
+  [ "$(cat "$pth" 2>/dev/null)" = "$repo/build/python" ] || echo "$repo/build/python" > "$pth"
 fi
 echo "setup: ok"
