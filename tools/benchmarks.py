@@ -7,7 +7,6 @@ Every table sits between `<!-- table:NAME -->` and `<!-- /table:NAME -->`; a tab
 only when OUT_DIR holds what it is made from, and then starts with the command lines, the commit
 and the date of the run. The machine line (`<!-- table:machine -->`) is rewritten on every run.
 """
-import datetime
 import json
 import os
 import re
@@ -24,27 +23,21 @@ def sh(*cmd):
         return ""
 
 
-def commit():
-    rev = sh("git", "rev-parse", "--short", "HEAD").strip() or "unknown"
-    dirty = sh("git", "status", "--porcelain", "--untracked-files=no").strip()
-    return rev + (" + uncommitted changes" if dirty else "")
-
-
-def machine():
+def machine(out):
     info = {}
     for line in sh("lscpu").splitlines():
         key, _, value = line.partition(":")
         info[key.strip()] = value.strip()
-    load = os.getloadavg()
+    load = (read(out, "load", "") or "").strip() or f"{os.getloadavg()[0]:.1f}"
     return (f"{info.get('Model name', 'unknown CPU')}, {info.get('CPU(s)', '?')} cores "
             f"({info.get('Hypervisor vendor', 'no') + ' guest' if 'Hypervisor vendor' in info else 'bare metal'}), "
-            f"L2 {info.get('L2 cache', '?')}; load average {load[0]:.1f} when the run ended. "
+            f"L2 {info.get('L2 cache', '?')}; load average {load} when the run ended. "
             "The machine is shared with other builds and tests and is noisy: compare numbers "
             "within one table (measured side by side in one run), not across tables.")
 
 
 def read(out, name, ext="txt"):
-    path = os.path.join(out, f"{name}.{ext}")
+    path = os.path.join(out, f"{name}.{ext}" if ext else name)
     if not os.path.exists(path):
         return None
     with open(path) as f:
@@ -53,9 +46,9 @@ def read(out, name, ext="txt"):
 
 def command(out, name):
     cmd = read(out, name, "cmd").strip()
+    build = os.path.dirname(os.path.abspath(out))
+    cmd = cmd.replace(build + "/", os.path.relpath(build, REPO) + "/")
     cmd = cmd.replace(REPO + "/", "")
-    build = os.path.dirname(os.path.dirname(out))
-    cmd = cmd.replace(build + "/", "build/")
     cmd = re.sub(r"^env ", "", cmd)
     # The Siconos files as the glob that named them.
     cmd = re.sub(r"(\S+/lcp/\S+\.dat ?)+", "../shared/data/siconos/lcp/*.dat ", cmd)
@@ -64,8 +57,12 @@ def command(out, name):
 
 def stamp(out, names):
     cmds = "\n".join(command(out, n) for n in names)
-    date = datetime.datetime.utcnow().strftime("%Y-%m-%d %H:%M UTC")
-    return f"```sh\n{cmds}\n```\n\nCommit {commit()}, {date}.\n\n"
+    # tools/benchmarks.sh's record of the run: the commit, "+ uncommitted changes" when the
+    # measured code differed from it, the date.
+    run = (read(out, "run", "") or "unknown commit\n").strip().splitlines()
+    code = " ".join(run[:-1]) or "unknown"
+    date = run[-1] if len(run) > 1 else "date unknown"
+    return f"```sh\n{cmds}\n```\n\nCommit {code}, run {date}.\n\n"
 
 
 def markdown_tables(text):
@@ -73,12 +70,12 @@ def markdown_tables(text):
     return "\n".join(l for l in text.splitlines() if l.startswith("|")) + "\n"
 
 
-def program_output(out, name):
+def program_output(out, name, indent="    "):
     text = read(out, name)
     if text is None:
         return None
     extra = [l for l in text.splitlines() if l and not l.startswith("|")]
-    notes = "".join(f"    {l}\n" for l in extra)
+    notes = "".join(f"{indent}{l}\n" for l in extra)
     body = markdown_tables(text)
     if notes:
         body += "\nThe program's other lines:\n\n" + notes
@@ -90,16 +87,18 @@ def core(out):
     if text is None:
         return None
     data = json.loads(text)
-    rows = ["| benchmark | CPU ms per solve | residual | iterations | converged |",
-            "|---|---|---|---|---|"]
+    rows = ["| benchmark | n | CPU ms per solve (per step) | residual (pyramids: worst) | "
+            "iterations (last solve) | converged (pyramids: share of steps) |",
+            "|---|---|---|---|---|---|"]
     for b in data["benchmarks"]:
         unit = {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}[b.get("time_unit", "ns")]
-        res = b.get("residual")
-        it = b.get("iterations_counter", b.get("iterations"))
-        rows.append(f"| {b['name']} | {b['cpu_time'] * unit:.4g} | "
-                    f"{'' if res is None else f'{res:.1e}'} | "
-                    f"{'' if 'iterations' not in b else int(b.get('iterations'))} | "
-                    f"{'' if 'converged' not in b else ('yes' if b['converged'] else 'no')} |")
+        res = b.get("residual", b.get("worst_residual"))
+        conv = b.get("converged", b.get("converged_fraction"))
+        # Google Benchmark's own loop count shares the key "iterations" with the counter; the
+        # counter comes last in the JSON, so json.loads keeps it.
+        rows.append(f"| {b['name'].split('/iterations:')[0]} | {int(b.get('n', 0))} | "
+                    f"{b['cpu_time'] * unit:.3g} | {'' if res is None else f'{res:.0e}'} | "
+                    f"{int(b.get('iterations', 0))} | {'' if conv is None else f'{conv:g}'} |")
     return stamp(out, ["core"]) + "\n".join(rows) + "\n"
 
 
@@ -191,11 +190,11 @@ def main():
     out, path = sys.argv[1], sys.argv[2]
     with open(path) as f:
         doc = f.read()
-    doc = replace(doc, "machine", machine() + "\n")
+    doc = replace(doc, "machine", machine(out) + "\n")
     for name, make in [("core", core), ("bullet", bullet), ("pgs-vs-si", pgs_vs_si),
                        ("ode-dantzig", lambda o: program_output(o, "ode-dantzig")),
                        ("ode-pgs", lambda o: program_output(o, "ode-pgs")),
-                       ("siconos", lambda o: program_output(o, "siconos"))]:
+                       ("siconos", lambda o: program_output(o, "siconos", indent=""))]:
         content = make(out)
         if content is not None:
             doc = replace(doc, name, content)

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs the benchmark programs and rewrites the tables of docs/benchmarks.md from their output.
-#   tools/benchmarks.sh [--full] [BUILD_DIR]      (default build/; a few minutes on 2 cores)
+#   tools/benchmarks.sh [--full] [BUILD_DIR]      (default build/; 4-8 minutes on 2 cores)
 # --full adds the long Bullet runs (a demo's first 300 steps, its steady state, 210 boxes:
 # about 10 more minutes, mostly the stock btMLCPSolver's Dantzig). Each table in the file is
 # replaced only when its benchmark ran, and carries the commit and date of its own run. The raw
@@ -14,9 +14,17 @@ if [[ ${1:-} == --full ]]; then
   shift
 fi
 build=${1:-$repo/build}
+mkdir -p "$build/benchmarks"
+build=$(cd "$build" && pwd)
 out=$build/benchmarks
-mkdir -p "$out"
-rm -f "$out"/*.txt "$out"/*.json
+rm -f "$out"/*.txt "$out"/*.cmd
+# The code measured: HEAD, and whether files other than these documents differ from it.
+{
+  git -C "$repo" rev-parse --short HEAD
+  git -C "$repo" status --porcelain --untracked-files=no -- . ':!docs' ':!README.md' \
+    ':!tools/benchmarks.sh' ':!tools/benchmarks.py' | grep -q . && echo "+ uncommitted changes"
+  date -u '+%Y-%m-%d %H:%M UTC'
+} > "$out/run" || true
 siconos=${MLCP_SICONOS_DIR:-$repo/../shared/data/siconos}
 
 cmake --build "$build" --target mlcp core_bench bullet_bench ode_bench ode_pgs_bench > /dev/null
@@ -56,5 +64,6 @@ if [[ -d $siconos/lcp ]]; then
   run siconos "$bin/mlcp" table --markdown "$siconos"/lcp/*.dat --solvers pgs,lemke,dantzig,auto
 fi
 
+cut -d' ' -f1 /proc/loadavg > "$out/load"
 python3 "$repo/tools/benchmarks.py" "$out" "$repo/docs/benchmarks.md"
 echo "benchmarks: docs/benchmarks.md rewritten from $out" >&2
