@@ -91,7 +91,8 @@ class RowSystem {
 //     every row has passed. Engines that hold their rows in their own form pack them straight
 //     from there (solve with a RowFill, a RowSource or solveFrom: no RowSystem copy in between;
 //     same packing, same validation).
-//  2. sweep: Options::maxIterations sweeps over the packed rows, in row order.
+//  2. sweep: up to Options::maxIterations sweeps over the packed rows in row order (fewer when a
+//     check meets Options::tolerance).
 //  3. check: every Options::checkEvery sweeps, the natural-map residual of residual.hpp at the
 //     current x, with w = J v + cfm x + b taken from the velocities the sweeps maintain (v changes
 //     by M^-1 J_i^T dx_i with every change dx_i of x, so w = A x + b up to round-off). It reads
@@ -104,10 +105,10 @@ class RowSystem {
 //     stack, chaining every row through a store and a load.
 //
 // Cost: O(rows) to pack (a division, M^-1 J^T and the couplings: a row costs several sweeps of
-// it), O(rows) per sweep, O(rows) per check; memory 240 bytes a packed row plus one cache line a
-// body. The sweep is bound by the latency chain through the velocities of bodies shared by
-// consecutive rows (load v, dot, clamp, update v, store), not by memory bandwidth, and four
-// things keep that chain short:
+// it), O(rows) per sweep, O(rows) per check; memory 240 bytes a packed row (plus its check
+// scale and couplings) and one cache line a body. The sweep is bound by the latency chain through
+// the velocities of bodies shared by consecutive rows (load v, dot, clamp, update v, store), not by
+// memory bandwidth, and four things keep that chain short:
 //  - ground rows take kWorldSlots zero-velocity world slots in turn (one shared slot would chain
 //    every ground row through its store and load);
 //  - a run of up to kMaxRun consecutive rows on the same two bodies (a manifold's normals, its
