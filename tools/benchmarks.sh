@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs the benchmark programs and rewrites the tables of docs/benchmarks.md from their output.
-#   tools/benchmarks.sh [--full] [BUILD_DIR]      (default build/; 4-8 minutes on 2 cores)
+#   tools/benchmarks.sh [--full] [BUILD_DIR]      (default build/; ~10 minutes on 2 loaded cores)
 # --full adds the long Bullet runs (a demo's first 300 steps, its steady state, 210 boxes:
 # about 10 more minutes, mostly the stock btMLCPSolver's Dantzig). Each table in the file is
 # replaced only when its benchmark ran, and carries the commit and date of its own run. The raw
