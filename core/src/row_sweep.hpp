@@ -9,9 +9,9 @@
 #include <cmath>
 #include <type_traits>
 
-#include "mlcp/detail/row_simd.hpp"
 #include "mlcp/residual.hpp"
 #include "mlcp/rows.hpp"
+#include "row_simd.hpp"
 
 namespace mlcp {
 

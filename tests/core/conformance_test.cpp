@@ -161,7 +161,7 @@ TEST_P(Conformance, Deterministic) {
 
 // Which Siconos LCP files each solver must solve to the tolerance; every other (file, solver)
 // pair is still checked for honesty. Reasons for the files a solver is not expected to solve
-// are in the README's table.
+// are in docs/benchmarks.md's Siconos table.
 const std::set<std::string> kLemkeSolves = {
     "lcp_CPS_1",     "lcp_CPS_2",        "lcp_CPS_4",
     "lcp_CPS_4bis",  "lcp_CPS_5",        "lcp_Pang_isolated_sol",
@@ -174,7 +174,8 @@ const std::map<std::string, std::set<std::string>> kSiconosSolves = {
      {"lcp_CPS_1", "lcp_CPS_5", "lcp_deudeu", "lcp_deudeu_block", "lcp_exp_murty", "lcp_exp_murty2",
       "lcp_mmc", "lcp_ortiz", "lcp_ortiz_block", "lcp_trivial", "lcp_trivial_block"}},
     // Every file but lcp_CPS_3 (no solution is reachable: Lemke ends on a ray, as Siconos' does)
-    // and lcp_Pang_isolated_sol_perturbed (ray termination; see the README's table).
+    // and lcp_Pang_isolated_sol_perturbed (ray termination; see docs/benchmarks.md's Siconos
+    // table).
     {"lemke", kLemkeSolves},
     // The files with zero diagonals or non-P matrices that need the 2x2 exchange pivot
     // (CPS_2, CPS_3, both Pang files, inf_sol_perturbed, tobenna, enum_fails) fail honestly.

@@ -12,10 +12,10 @@
 #include <type_traits>
 #include <vector>
 
+#include "../core/src/row_simd.hpp"  // the products (internal)
 #include "common/contact_scenes.hpp"
 #include "common/cpu_path_guard.hpp"
 #include "common/row_fill.hpp"
-#include "mlcp/detail/row_simd.hpp"
 #include "mlcp/rows.hpp"
 
 namespace mlcp {

@@ -736,8 +736,8 @@ TEST(DantzigBlock, BorderedUpdatesMatchFreshFactorizations) {
 
 // A warm guess with wrong sets makes rows join the clamped set between block steps: through a
 // reused factor their bordered columns (and their coupling to sliding rows) must give the steps
-// of fresh factorizations, the same number of them and the same answer (review of session 5:
-// the pyramid sequences above only ever had rows leave or slide).
+// of fresh factorizations, the same number of them and the same answer (the pyramid sequences
+// above only ever have rows leave or slide).
 TEST(DantzigBlock, JoinedRowsThroughAReusedFactorTakeTheFreshSteps) {
   test::Generator g(57);
   int reused = 0;

@@ -172,8 +172,8 @@ struct Expected {
   int bodies, dynamic, joints;
 };
 
-// Every scene of the issue, with the counts its description promises (the static bodies are
-// the ground, the ramp and the pit's walls).
+// Every scene file, with the counts its description in scenes/README.md promises (the static bodies
+// are the ground, the ramp and the pit's walls).
 const Expected kScenes[] = {
     {"dominoes", 21, 20, 0},         {"heavy_on_small", 4, 3, 0},
     {"hinge_motor_limits", 1, 1, 1}, {"incline_slide", 3, 1, 0},

@@ -9,10 +9,10 @@
 // they give the same answers bit for bit (tests/core/cpu_test.cpp, and a Bullet pyramid stepped
 // under both in tests/bullet/plumbing_test.cpp); only the time differs. The AVX2 code uses the
 // VEX encodings throughout and 4-wide vectors for the sweep's and the check's 12-wide row
-// products and velocity updates (mlcp/detail/row_simd.hpp). Measured (bullet_bench --pgs-vs-si,
-// 10 sweeps, session 9; ratios to SI in the same run): 15 / 55 / 210 boxes 0.93x / 0.97x / 0.92x
-// with AVX2, 0.95x / 1.00x / 0.96x with the baseline (1.00x / 1.03-1.04x / 0.97-0.99x before
-// either change).
+// products and velocity updates (core/src/row_simd.hpp). AVX2 is chosen for these loops alone
+// because they are where fixed-sweep pgs spends its time; building the whole library for
+// x86-64-v3 gains about what this dispatch gains (docs/decisions.md). docs/benchmarks.md has
+// the times of both paths (bullet_bench --pgs-vs-si, MLCP_CPU_PATH=baseline).
 //
 // The choice is made once, at first use: AVX2 when the CPU has AVX2, BMI1 and BMI2, unless
 // the environment variable MLCP_CPU_PATH is "baseline" ("auto" and "avx2" mean the default; any
@@ -46,8 +46,9 @@ bool setCpuPath(CpuPath path);
 
 // For the solvers' sources: MLCP_CPU_DISPATCH is 1 where an AVX2 variant is compiled, and
 // MLCP_AVX2_VARIANT marks its functions (noinline: a variant is one function with the shared
-// body inlined into it; flatten: with everything that body calls inlined as well: without it GCC
-// compiled the Bullet packing's variant to other code than the one measured).
+// body inlined into it; flatten: everything that body calls is inlined into it too, so the
+// variant has the baseline's code shape; without it GCC compiles the Bullet packing's variant
+// to different code).
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && \
     !defined(MLCP_NO_CPU_DISPATCH)
 #define MLCP_CPU_DISPATCH 1

@@ -18,19 +18,15 @@
 // passing. Otherwise (a pivot below 1e-13 relative, or that residual missed) the exact symmetry
 // check sends A to Eigen's pivoting dense LDL^T (which answers a consistent singular system) or,
 // non-symmetric, to dense partial-pivoting LU. The base's residual check has the final say.
-// Measured:
-//   ODE pendulum_chain (33 rows), instructions per solve (callgrind): sparse path 72.6k
-//   (isSymmetric's A - A^T alone 27k), Eigen's dense LDLT 82k (its unblocked factorization
-//   calls a gemv per column), the envelope path ~25k (factor 6.6k, two solves 7.2k, two
-//   products A x 4.8k, envelope scan 2.9k).
-//   The sparse path likewise tries LDL^T first and runs the exact symmetry check (A - A^T)
-//   only when the answer misses 1e-11 (a pattern found non-symmetric goes to the check and LU
-//   directly next time).
-//   Block-tridiagonal SPD chains (blocks of 3 and 5 rows), whole solve() with the base's checks,
-//   dense vs sparse (us, shared machine, ranges of 3 runs): 3-row blocks 33 rows 5.4-6.6 vs
-//   10-12, 63 rows 8-16 vs 9-17, 96 rows 16-34 vs 13-20, 198 rows 75 vs 43; 5-row blocks 60 rows
-//   9-12 vs 13-20, 125 rows 28-37 vs 28-39. Dense wins to 60-100 rows on a thin band, further on
-//   a wider one and always on a full matrix: RowSolver's 64-row limit sits at the crossover.
+// The sparse path likewise tries LDL^T first and runs the exact symmetry check (A - A^T) only
+// when the answer misses 1e-11 (a pattern found non-symmetric goes to the check and LU directly
+// next time): forming A - A^T costs more than the factorization of a small island.
+// Why an envelope factorization for small A: it needs no ordering, analysis or storage
+// conversion and reads only the band, where Eigen's dense LDLT calls a gemv per column and the
+// sparse path pays for the symmetry check and the conversion; it costs about a third of either
+// on a 33-row joint chain. Dense wins up to 60-100 rows on a thin band, further on a wider one
+// and always on a full matrix, so RowSolver's 64-row limit sits at the crossover
+// (docs/benchmarks.md, docs/decisions.md).
 #pragma once
 
 #include <memory>

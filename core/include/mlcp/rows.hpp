@@ -82,134 +82,53 @@ class RowSystem {
 // the same update rule, options and status semantics as PgsSolver (pgs.hpp). It keeps one
 // 6-vector per body, v = M^-1 J^T x, and visits each row in O(12).
 //
-// Cost per solve, for engines that call it every step with fixed sweep counts (SI-like use):
-// one packing pass into buffers kept between solves (no allocation once they have grown), the
-// sweeps, and one residual check per Options::checkEvery. The packing pass is also the
-// validation: each row is checked by the one-pass rule of RowSystem::validate as it is packed
-// (the bodies and array sizes before), and only a row that fails calls validate() itself to
-// say what is wrong; the caller's x is untouched until every row has passed. Engines that hold
-// their rows in their own form pack them straight from there (solve with a RowFill, a
-// RowSource or solveFrom: no RowSystem copy in between; same packing, same validation). The check
-// is the natural-map residual of residual.hpp at the current x, with w = J v + cfm x + b taken from
-// the body velocities the sweeps maintain: v changes by M^-1 J_i^T dx_i with every change dx_i of
-// x, so v = M^-1 J^T x up to round-off and w = A x + b is exact up to round-off as well. It reads
-// the packed rows only: step_i w_i = (1 - keep) x_i + shift + sA v (the sweep's own terms, scaled
-// back by 1 / step). The check thus needs no second pass over the rows to rebuild v (tests
-// compare it with accuracy() on the assembled problem). It runs in blocks of 64 packed rows: w
-// of the block into an L1 buffer, then the block's rows through AccuracyAccumulator (the per-row
-// rule of accuracy(); bounds and findex read from the packed rows, so the engine path keeps no
-// copies of them). Session 6 (stage timers, 210 boxes, median per step): ~46 us against ~49
-// us for session 5's w vector then accuracy(); one loop for both was slower than the two
-// passes (it spilled the accumulators to the stack, chaining every row through a store and a
-// load).
-// The sweep is bound by the latency chain through the velocities of bodies shared by
-// consecutive rows (load v, dot, clamp, update v, store), not by memory. Four things keep the
-// chain short: ground rows take 8 zero-velocity world slots in turn (one shared slot chained
-// every ground row through its store and load); a run of up to kMaxRun consecutive rows on the
-// same two bodies (a manifold's normals, its friction rows; a contact's rows in ODE's order) is
-// swept through its couplings: row i's step J_i v is step J_i v_start + sum over the run's
-// earlier rows k of c_ik dx_k, c_ik = step_i J_i M^-1 J_k^T computed when packing, so one row
-// waits for the last only through a multiply-add (not a 12-wide velocity update and dot), and
-// v takes the run's changes at its end; the run's loop is unrolled per length so its changes
-// stay in registers; and the velocity change is clamped on its own (below).
-// Measured through the Bullet drop-in (bullet_bench --pgs-vs-si, 210-box pyramid, 4720 rows,
-// 10 sweeps, perf shares of our stages at the end of session 4): sweeps 44%, packing 21% (~0.18
-// ms: ~40 ns a row, the couplings included), the check (slackFromVelocities and accuracy) 5%;
-// the rest is the adapter's (islands.hpp). The couplings and the unrolling took the Bullet
-// sweeps from ~51 us to ~37 us (~8 ns a row); without the unrolling the coupling sums read the
-// changes back from a stack array in pairs and stalled store forwarding, and the runs gained
-// nothing. Packing once lost a quarter of its time to such stalls too (Eigen's M^-1 J^T
-// temporary read back from the stack; now computed in scalars). Round 2 of session 4: packing
-// ~23% (~0.2 ms, ~45 ns a row; the largest single cost is waiting for step = omega / A_ii, the
-// rest is spread thin), the couplings' step J_i computed once per row.
-// Session 5 (timers around the stages, 210 boxes, 10 sweeps, per step): packing ~250 us (~53 ns
-// a row, now with the reading of Bullet's rows: the engine's rows are read in place through a
-// RowSource, or inlined through solveFrom; its angular M^-1 J^T taken from the engine), sweeps
-// ~430 us (~9 ns a row a sweep), the check ~50 us (~11 ns a row: a second pass over the packed
-// rows for w, then accuracy()). In packing (perf with line numbers): the first reads of the
-// engine's rows ~11%, the wait for the division ~11%, the couplings ~7% (two at a time in the
-// lanes of one vector; doubling them cost ~40 us), the rest spread thin. Tried without gain:
-// A_ii and the divisions of 8 rows first, then the rest (staging the rows through a stack array
-// cost +25%); the couplings' dots before the division and scaled after; the division moved
-// ahead of the findex checks and the run bookkeeping.
-// Session 6: packing ~200-220 us against ~250-255 us at 210 boxes (stage timers, median per
-// step, quiet runs; ~44 ns a row) by three changes: shorter addition chains (each coupling in four
-// partial sums, A_ii's linear and angular parts apart: a row's ~400 instructions retire only
-// after its longest chain, and a row does not fit the reorder buffer twice, so a row's latency
-// is the packing's throughput; the iterates move by round-off); the packed rows fetched for
-// writing 8 rows ahead (after the engine's setup they are out of L2); friction rows validated
-// from a compact findex array (reading the normal row's findex from its packed row, thousands
-// of rows back, missed L1 on every friction row). Tried without gain: the sweep's last coupling
-// subtracted after the clamp's other terms (one addition less on the chain between a run's
-// rows: 10 sweeps 1.15 -> 1.21x SI at 55 boxes); rowValid's sum as a tree; fetching 16 rows
-// ahead instead of 8 (within the noise). Not done, and why: the first sweep fused into the
-// packing (the brief's first candidate) cannot keep the iterates: with a warm start row i's
-// first update needs v = M^-1 J^T x_start over all rows, rows after i included, which only
-// exists after the packing; an engine's bodies hold it before (SI's setup applied the start),
-// but in the engine's rounding and order. Deriving step from Bullet's m_jacDiagABInv instead of
-// dividing: friction rows' Bullet denominator has no CFM while ours has (StockMlcp, Regularized),
-// contacts' is another rounding of A_ii (invMass + n . ((I^-1 (r x n)) x r)), and the RowSystem
-// path has no such number (bit for bit would need a RowSystem field: an API change).
-// Session 7 (stage timers, mean per step, min of 5 runs alternated with session 6's code): the
-// row update written once (RowPgs::update, which session 6's sweep called out of line at one
-// site) and one sweep a noinline function of its own (sweepOnce): sweeps ~117 -> ~93 us at 55
-// boxes, ~479 -> ~379 us at 210 (~10.1 -> ~8.0 ns a row a sweep); packing ~48 / ~205 us (~43 ns
-// a row), check ~11 / ~46 us, the same. Which of the two changes of the compiled code pays was
-// not isolated; forcing update() inline and the run's velocity update into scalars made 55 boxes
-// ~7% slower again.
-// Session 7, tried without gain (stage timers, mean per step, min of 6 runs alternated with the
-// code before): the first sweep fused into the packing from the velocities Bullet's setup applied
-// (SI's start; our own M^-1 J^T x_start summed beside it and the velocities moved onto it after
-// the pass, so the check stayed exact): the packing grew by about the sweep it saved (55 boxes
-// +14-18 us packing, -8-16 us sweeps; 210 boxes +42-54 us, -32-86 us; sweeps of session 6's code),
-// with row i updated right after it was packed,
-// through the run's couplings, or trailing the packing by 8 rows alike: each packed row's latency
-// is the packing's throughput, and the update's chain (dot, clamp, velocities) adds about what a
-// sweep of the row costs. A packed row padded from 240 to 304 bytes cost the 210-box stages ~2%:
-// bytes streamed are not what bounds the sweep either (so a smaller row format would gain ~1-2%).
-// Session 8 (a throwaway harness: one 55-box island after the switch, 1160 rows, packed and
-// checked 200 times, min of 7; callgrind instruction counts of the same, deterministic): the
-// packing ~573 instructions a row (623 before), the check ~94, a sweep ~88. The Bullet source's
-// row() and view() are now inlined into pack() (forced: GCC kept a call per row returning the
-// view through memory: -27 instructions), and a body side's J is checked finite through A_ii's
-// test (row_pack.hpp: -21). Packing ~41 -> ~38-39 ns a row in the harness on a quiet machine
-// (~80 -> ~61-70 on a busy one; the check ~7, a sweep ~8.4 quiet). 10 sweeps, 8 runs
-// alternated with the code before: 15 / 55 / 210 boxes min 1.00x / 1.05x / 1.00x -> 0.94x /
-// 1.04x / 0.99x SI, median 1.06x / 1.08x / 1.03x -> 1.00x / 1.04x / 0.99x (a busy machine, SI
-// 0.22-0.24 ms a step at 55 boxes; the residual columns identical); ODE's pgs (ode_pgs_bench,
-// 5 alternated runs) the same (pgs / QuickStep min 0.87x / 0.79x / 0.69x -> 0.88x / 0.76x /
-// 0.70x, residuals identical). Tried without gain:
-// gapTimes without the branch on w's sign (the check 94 -> 107 instructions, ~7.4 -> ~8.3 ns a
-// row in the harness, which replays one island's branch pattern); std::max of three written as
-// two (the same code).
-// Session 8, round 6 (the same harness and callgrind): packing 573 -> 535 instructions a row,
-// pack + check ~44.0 -> ~39.9 ns a row (min of 5, harness): a run's M^-1 J^T read back from
-// its packed rows (stored as 16-byte pairs, so the pair loads forward) instead of a runM copy
-// (-24), the arrays' starts in locals (the pairs' memcpy stores may alias anything: -11), one
-// coupling at a time with the sums j mod 4 in the lanes of two vectors (the same sums, so the
-// same bits; no fewer instructions than two couplings at a time). 10 sweeps, 8 runs alternated
-// with the code before: 15 / 55 / 210 boxes min 0.94x / 1.03x / 0.99x -> 0.93x / 1.02x /
-// 0.97x SI, median 1.00x / 1.04x / 1.005x -> 0.98x / 1.03x / 0.98x (residual columns and the
-// 55-box harness iterates and check identical); ODE pgs the same or faster (min 0.88x / 0.79x /
-// 0.70x -> 0.85x / 0.76x / 0.68x QuickStep, 3 runs). 55 boxes is still above SI. Tried without
-// gain: J read in place instead of copied (+41 instructions: every store may alias the
-// engine's rows, so each use loaded again); M^-1 J^T formed as pairs in registers (+14
-// instructions, the same time); the couplings' partial sums without their +0 start and a
-// final + 0.0 (the same bits, -0.4 instructions: GCC kept the same code); rowRulesValid as one
-// branch over & of its tests (+4 instructions, the same time); the check's two finiteness
-// tests a row folded into one sum checked after the pass, with an exact second pass when it is
-// not finite (check 94 -> 92 instructions, ~7.4 -> ~7.3 ns a row: not worth the second path).
-// Session 9: the packing, sweeps and check are compiled twice, for the baseline and for AVX2, and
-// the CPU picks (mlcp/cpu.hpp; the same bits). The sweep's and the check's row products
-// sA . va + sB . vb and the run's velocity updates are generic vectors (detail/row_simd.hpp): 4 +
-// 2 wide in the AVX2 variant, three pairs in the baseline, in the order Eigen's Vector6
-// expressions summed them (the iterates did not move: bullet_bench's residual columns identical).
-// Callgrind before, 55 boxes: a sweep ~71 instructions a row, the packing ~553. Stage time at 55
-// boxes, 10 sweeps: ~0.136 -> ~0.124 ms (AVX2), ~0.129 ms (baseline pairs: explicit pairs beat
-// Eigen's for the run's velocity stores too). Tried without gain: the packing's couplings as one
-// 4-wide sum (the same bits, sA/sB and mA/mB stored 4-wide so the loads forward; within the
-// noise); 4-wide generic vectors in the baseline (GCC compiles them without AVX through the stack:
-// the sweeps 1.6x slower).
+// A solve runs three stages over buffers kept between solves (no allocation once they have
+// grown), each one pass over the rows:
+//  1. pack: each row becomes a PackedRow (below) holding step J, M^-1 J^T and the constants of
+//     its update. The pass is also the validation: each row is checked by the one-pass rule of
+//     RowSystem::validate as it is packed (the bodies and array sizes before), and only a row
+//     that fails calls validate() itself to say what is wrong; the caller's x is untouched until
+//     every row has passed. Engines that hold their rows in their own form pack them straight
+//     from there (solve with a RowFill, a RowSource or solveFrom: no RowSystem copy in between;
+//     same packing, same validation).
+//  2. sweep: up to Options::maxIterations sweeps over the packed rows in row order (fewer when a
+//     check meets Options::tolerance).
+//  3. check: every Options::checkEvery sweeps, the natural-map residual of residual.hpp at the
+//     current x, with w = J v + cfm x + b taken from the velocities the sweeps maintain (v changes
+//     by M^-1 J_i^T dx_i with every change dx_i of x, so w = A x + b up to round-off). It reads
+//     the packed rows only: step_i w_i = (1 - keep) x_i + shift + sA v, scaled back by 1 / step,
+//     so no second pass over the engine's rows rebuilds v (tests compare it with accuracy() on
+//     the assembled problem). It runs in blocks of 64 rows: w of the block into an L1 buffer,
+//     then the block through AccuracyAccumulator (the per-row rule of accuracy(); bounds and
+//     findex read from the packed rows, so the engine path keeps no copies of them). Two short
+//     loops rather than one: a single loop holds too many accumulators and spills them to the
+//     stack, chaining every row through a store and a load.
+//
+// Cost: O(rows) to pack (a division, M^-1 J^T and the couplings: a row costs several sweeps of
+// it), O(rows) per sweep, O(rows) per check; memory 240 bytes a packed row (plus its check
+// scale and couplings) and one cache line a body. The sweep is bound by the latency chain through
+// the velocities of bodies shared by consecutive rows (load v, dot, clamp, update v, store), not by
+// memory bandwidth, and four things keep that chain short:
+//  - ground rows take kWorldSlots zero-velocity world slots in turn (one shared slot would chain
+//    every ground row through its store and load);
+//  - a run of up to kMaxRun consecutive rows on the same two bodies (a manifold's normals, its
+//    friction rows; a contact's rows in ODE's order) is swept through its couplings: row i's
+//    step J_i v is step J_i v_start + sum over the run's earlier rows k of c_ik dx_k, with
+//    c_ik = step_i J_i M^-1 J_k^T computed when packing, so a row waits for the last one only
+//    through a multiply-add, and v takes the run's changes at its end;
+//  - the run's loop is unrolled per length, so its changes stay in registers;
+//  - the update is regrouped so that only the product with v sits on the chain, and the change
+//    that moves v is clamped on its own (PackedRow below).
+// The packing, sweeps and check are compiled for the baseline and for AVX2 and chosen at run
+// time (mlcp/cpu.hpp); the 12-wide products are written in the order of Eigen's Vector6
+// expressions (core/src/row_simd.hpp), so both variants, solve(RowSystem) and the engine entry
+// points give the same iterates bit for bit.
+//
+// The first sweep is not fused into the packing: with a warm start, row i's first update needs
+// v = M^-1 J^T x_start over all rows, later ones included, which exists only after the pass.
+// The step is divided here rather than taken from an engine's own 1 / A_ii (Bullet's
+// m_jacDiagABInv): an engine's number is another rounding of A_ii, lacks our friction CFM, and
+// the RowSystem path has no such number.
 class RowPgs {
  public:
   Options& options() { return options_; }
@@ -254,8 +173,8 @@ class RowPgs {
     const double* invAngA = nullptr;
     const double* invAngB = nullptr;
     // As in Row. lo and hi are kept apart: the packing copies them to neighbouring places, and
-    // a 16-byte load of two neighbours just written as 8-byte values by the source stalled
-    // store forwarding (a fifth of the packing's time, measured with perf).
+    // a 16-byte load of two neighbours just written as 8-byte values by the source would stall
+    // store forwarding.
     double lo = 0, b = 0, hi = 0, cfm = 0;
     int findex = -1;
     double start = 0, base = 0;
@@ -298,7 +217,7 @@ class RowPgs {
   // regrouped as clamp(keep x_i - shift - (step J_i) v) with keep = 1 - step cfm_i and
   // shift = step b_i: only the product with v depends on the rows just visited, so the row's
   // latency chain (load v, dot, clamp, update v) holds one subtraction instead of a
-  // multiplication and three additions (sweeps ~20% faster; the same iterates up to round-off).
+  // multiplication and three additions (the same iterates up to round-off).
   // The change moving v is clamped apart, dx = clamp((c - x_i) - J v', lo - x_i, hi - x_i) with
   // c = keep x_i - shift, while x_i itself becomes clamp(c - J v', lo, hi): the chain does not
   // wait for x_new - x_i, v and x agree up to round-off, and x stays exactly within its bounds.
@@ -337,7 +256,7 @@ class RowPgs {
   MLCP_AVX2_VARIANT void sweepAvx2(double* x);
   MLCP_AVX2_VARIANT Accuracy checkAvx2(const Vector& x, double bNorm) const;
 #endif
-  // Wide: with 4-wide vectors (the AVX2 variants), else in pairs (mlcp/detail/row_simd.hpp).
+  // Wide: with 4-wide vectors (the AVX2 variants), else in pairs (core/src/row_simd.hpp).
   template <bool Wide>
   void sweepRows(double* x);
   template <bool Wide>

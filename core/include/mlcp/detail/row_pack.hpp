@@ -1,8 +1,8 @@
 // mlcp/detail/row_pack.hpp: RowPgs' packing pass and its engine entry point as templates
 // (rows.hpp), for engines whose row source the compiler should see: RowPgs::solveFrom with a
 // final source class inlines the source's row() into the packing loop (no view written to
-// memory and read back, no call per row; forced on solveFrom's lambda, as GCC otherwise kept
-// it a call: a large row() should be always_inline too). Include it only where solveFrom is
+// memory and read back, no call per row; forced on solveFrom's lambda, which GCC otherwise
+// keeps a call: a large row() should be always_inline too). Include it only where solveFrom is
 // instantiated.
 #pragma once
 
@@ -12,108 +12,11 @@
 #include <cstring>
 #include <limits>
 
+#include "mlcp/detail/row_checks.hpp"
 #include "mlcp/rows.hpp"
 #include "mlcp/solver.hpp"
 
 namespace mlcp {
-namespace detail {
-
-// A view's Jacobian block as [linear; angular] (a missing part reads as zeros).
-inline void jacobianOf(const double* lin, const double* ang, double* j) {
-  for (int k = 0; k < 3; ++k) {
-    j[k] = lin ? lin[k] : 0.0;
-    j[3 + k] = ang ? ang[k] : 0.0;
-  }
-}
-
-// Whether the 6 + 6 entries are all finite (any NaN or Inf entry makes the sum NaN or Inf).
-inline bool jacobiansFinite(const double* jA, const double* jB) {
-  double sum = 0;
-  for (int k = 0; k < 6; ++k) sum += jA[k] + jB[k];
-  return std::isfinite(sum);
-}
-
-// Every per-row rule of RowSystem::validate and Problem::validate except J's finiteness (b,
-// bounds, findex, body indices) for row i of n as one predicate without copies, except that row
-// findex's own findex must be -1 (the callers check that against the other row). slots = bodies
-// + 1; the array sizes are checked.
-inline bool rowRulesValid(const RowPgs::RowView& r, int i, int n, unsigned slots) {
-  if (static_cast<unsigned>(r.bodyA + 1) >= slots || static_cast<unsigned>(r.bodyB + 1) >= slots)
-    return false;
-  if (!(r.cfm >= 0 && r.cfm < kInf)) return false;
-  const double lo = r.lo, hi = r.hi;
-  // !(lo <= hi) also catches NaN bounds.
-  if (!std::isfinite(r.b) || !(lo <= hi) || lo == kInf || hi == -kInf) return false;
-  const int f = r.findex;
-  if (f < 0) return f == -1;
-  if (f >= n || f == i) return false;
-  return hi >= 0 && std::isfinite(hi) && lo == -hi;
-}
-
-// Every per-row rule of RowSystem::validate and Problem::validate (J, b, bounds, findex): the fast
-// path of RowSystem::validate, which the adapters call every step. When it says no, the checks in
-// RowSystem::validate find the row and say what is wrong (Problem::validate stays the one
-// statement of the bound rules' wording). A false alarm (a sum of finite Jacobian entries
-// overflowing) only costs the slow path. RowPgs' packing checks rowRulesValid and J's
-// finiteness apart (pack()).
-inline bool rowValid(const RowPgs::RowView& r, const double* jA, const double* jB, int i, int n,
-                     unsigned slots) {
-  return jacobiansFinite(jA, jB) && rowRulesValid(r, i, n, slots);
-}
-
-// A finite, non-negative inverse mass and a finite inverse inertia.
-inline bool bodyValid(const BodyInverseMass& body) {
-  return std::isfinite(body.invMass) && body.invMass >= 0 && body.invInertia.allFinite();
-}
-
-// M^-1 j for one body written to out[0..5], returning j . M^-1 j; the angular part is the
-// engine's own invAng when given (RowPgs::RowView: the same products, computed by the engine).
-// Scalar code on purpose: the Vector6 that applyInverseMass returns passes through a stack
-// temporary written in 8- and 16-byte pieces, and reading it back in pairs stalled store
-// forwarding on every row of the packing pass (a quarter of its time, measured with perf).
-inline double inverseMassInto(const BodyInverseMass& body, const double* j, const double* invAng,
-                              double* out) {
-  const double im = body.invMass;
-  const Eigen::Matrix3d& I = body.invInertia;
-  double m[6] = {im * j[0], im * j[1], im * j[2]};
-  if (invAng) {
-    for (int k = 0; k < 3; ++k) m[3 + k] = invAng[k];
-  } else {
-    for (int k = 0; k < 3; ++k) m[3 + k] = I(k, 0) * j[3] + I(k, 1) * j[4] + I(k, 2) * j[5];
-  }
-  for (int k = 0; k < 6; ++k) out[k] = m[k];
-  // Linear and angular parts summed apart: the division for the row's step waits on this sum
-  // (a chain of 3 additions instead of 6).
-  return (j[0] * m[0] + j[1] * m[1] + j[2] * m[2]) + (j[3] * m[3] + j[4] * m[4] + j[5] * m[5]);
-}
-
-inline void resizeSystem(const std::vector<BodyInverseMass>& bodies, int n, RowSystem& s,
-                         Vector& start) {
-  s.bodies = bodies;
-  s.rows.resize(n);
-  s.b.resize(n);
-  s.lo.resize(n);
-  s.hi.resize(n);
-  s.cfm.resize(n);
-  s.findex.resize(n);
-  start.resize(n);
-}
-
-inline void setRow(RowSystem& s, Vector& start, int i, const RowPgs::RowView& r) {
-  ConstraintRow& c = s.rows[i];
-  c.bodyA = r.bodyA;
-  c.bodyB = r.bodyB;
-  jacobianOf(r.linA, r.angA, c.jA.data());
-  jacobianOf(r.linB, r.angB, c.jB.data());
-  s.b[i] = r.b;
-  s.lo[i] = r.lo;
-  s.hi[i] = r.hi;
-  s.cfm[i] = r.cfm;
-  s.findex[i] = r.findex;
-  start[i] = r.start;
-}
-
-}  // namespace detail
 
 // How many rows ahead pack() fetches the packed rows it will write.
 constexpr int kPackAhead = 8;
@@ -146,7 +49,7 @@ template <class RowAt>
   unsigned nextWorld = 0;
   int runStart = 0;            // first row of the current run
   int runA = 0, runB = 0;      // its slots (kept here: reading them back from packed_ right after
-                               // their 4-byte stores stalled store forwarding)
+                               // their 4-byte stores would stall store forwarding)
   int lastA = -2, lastB = -2;  // the previous row's bodies
   int runLength = 0;
   std::size_t coupled = 0;  // couplings written
@@ -172,7 +75,7 @@ template <class RowAt>
   };
   int later = -1;  // the first row whose findex points forward (checked after the pass)
   // The arrays' starts in locals: the pairs' stores (memcpy) may alias anything, and the
-  // vectors' own pointers were loaded again after each.
+  // vectors' own pointers would be loaded again after each.
   PackedRow* const packed = packed_.data();
   int* const findexOf = findexOf_.data();
   double* const scale = scale_.data();
@@ -190,8 +93,8 @@ template <class RowAt>
       return stop(i, std::nan(""));
     PackedRow& p = packed[i];
     // The packed rows written a few rows ahead are fetched for writing: after the engine's own
-    // setup they are mostly out of L2, and ~30 stores a row waiting on their lines filled the
-    // store buffer.
+    // setup they are mostly out of L2, and ~30 stores a row waiting on their lines would fill
+    // the store buffer.
     if (i + kPackAhead < n) {
       const char* ahead = reinterpret_cast<const char*>(&packed[i + kPackAhead]);
       for (int line = 0; line < static_cast<int>(sizeof(PackedRow)); line += 64)
@@ -200,7 +103,7 @@ template <class RowAt>
     p.findex = r.findex;
     // Each row's findex again in a compact array, for the check that a friction row's normal
     // row has none: reading it from the normal's packed row (thousands of rows back, out of L1)
-    // stalled on a cache miss per friction row (~5% of the packing at 210 boxes, perf).
+    // would miss the cache once per friction row.
     findexOf[i] = r.findex;
     if (r.findex >= 0) {
       if (r.findex > i) {
@@ -239,7 +142,7 @@ template <class RowAt>
     // NaN and inf fail too. This is also the check that a body side's J is finite: a NaN or
     // infinite entry j_k makes its term j_k (M^-1 j)_k NaN or infinite whatever the (finite)
     // body (inf times anything is inf or NaN, the engine's invAng included), and no sum with
-    // such a term is finite (the rowValid sum of session 6 cost ~20 instructions a row).
+    // such a term is finite (a separate finiteness sum would cost ~20 instructions a row).
     if (!(d > 0 && d <= std::numeric_limits<double>::max())) return stop(i, d);
     const double step = relaxation / d;
     // step J and M^-1 J^T in pairs of entries (j, j + 1) of [A; B] (12 each), stored as pairs:
@@ -261,8 +164,8 @@ template <class RowAt>
     // Couplings to the run's earlier rows k: step J_i M^-1 J_k^T on the run's two bodies, i.e.
     // sA . mA_k + sB . mB_k, over entries j = 0 .. 11 of [A; B] in four partial sums (j mod 4),
     // then two levels: the row's instructions wait on a chain of 5 additions instead of 12
-    // before they retire (with A_ii's shorter sums, 10 sweeps went from ~1.17-1.20x to
-    // ~1.07-1.14x SI at 15 and 55 boxes; the iterates move by round-off). Sums j mod 4 = 0, 1
+    // before they retire, and a row does not fit the reorder buffer twice, so a row's latency is
+    // the packing's throughput (A_ii's sums are split for the same reason). Sums j mod 4 = 0, 1
     // in the lanes of one vector (pairs 0, 2, 4), 2, 3 in another (pairs 1, 3, 5). M^-1 J_k^T is
     // read from row k's packed row (mA and mB are adjacent there), stored a row or more ago.
     const int earlier = runLength - 1;

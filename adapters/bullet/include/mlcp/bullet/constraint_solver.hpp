@@ -36,13 +36,11 @@
 //     vector along the new direction), and it re-creates some points of a resting stack every
 //     step with no cached impulse. Without a remembered answer, friction rows start from the
 //     point's m_appliedImpulseLateral1/2 when the directions persist (direction caching, or
-//     directions not from the velocity). Measured (bullet_bench's 55-box pyramid, dantzig, 60
-//     steps after 30 SI steps): once the stack has come to rest under the exact answers (~30
-//     steps) the start's residual is 4e-5-1e-3 instead of 0.06-0.12 and the block stage settles
-//     in 3 steps (~15 ms CPU per island) instead of 6-24 (22-70 ms). The first ~20 steps after
-//     SI are unchanged: the stack moves from SI's approximate state to the exact answers'
-//     (answers change by 0.1-1 per step; start residual 0.2-0.7) and the block stage does not
-//     settle within its 40 steps.
+//     directions not from the velocity). Why our own answers: once a stack rests under exact
+//     answers, they are a start about 100x closer than the cached impulse (start residual ~1e-4
+//     against ~0.1 on bullet_bench's 55-box pyramid), and dantzig's block stage then settles in
+//     a few steps instead of tens. Right after a switch from SI no start helps: the stack moves
+//     from SI's approximate state to the exact answers' for ~20-40 steps.
 //  5. solve and 6. check — mlcp::RowSolver (mlcp/row_solver.hpp), shared with the ODE adapter:
 //     it classifies the island (bilateral only, frictionless contacts, boxed, friction), runs
 //     the named solver or `auto`'s choice ("pgs" on the rows, others on an assembled A, dense up
@@ -56,10 +54,9 @@
 //  With split impulse on (Bullet's default) and a non-zero penetration rhs in an island, a second
 //  problem with the same A and b = -m_rhsPenetration / m_jacDiagABInv gives push impulses.
 //
-// Cost against SI, "pgs" at SI's sweep count (bulletIterations, bullet_bench --pgs-vs-si; CPU
-// time per step, median of 300 steps, 10 sweeps, two runs): Bullet's row setup and finish are
-// the same code in both. "pgs" islands take a path of their own (solveIslandFast): RowPgs packs
-// in place from Bullet's rows (IslandBuilder::solvePgs; no RowSystem copy), the answer goes to the
+// The "pgs" path. "pgs" islands take a path of their own (solveIslandFast), because at SI's
+// sweep counts the passes around the sweeps cost about as much as the sweeps: RowPgs packs in
+// place from Bullet's rows (IslandBuilder::solvePgs; no RowSystem copy), the answer goes to the
 // bodies per body (RowPgs::velocityChange: M^-1 J^T (x - applied), what the per-row
 // internalApplyImpulse calls sum to) and the applied impulses are stored in remember()'s pass.
 // The two are the same only where our mass model is Bullet's body update. Bullet's solver body
@@ -72,73 +69,14 @@
 // Its answer passes the same acceptable() rule; a rejected one (or keepIslands, or a caller
 // holding rowSolver()) goes through RowSolver on a RowSystem copy like every other solver. The
 // iterates are the same as RowSolver's pgs bit for bit (one packing code); the write-back differs
-// by round-off (the bodies' velocities, 1e-9 apart after ~17 steps of a settling pyramid).
-// Session 4: 15 / 55 / 210 boxes 1.29-1.31x / 1.34-1.36x / 1.34-1.37x SI -> 1.15-1.17x /
-// 1.21-1.23x / 1.21-1.23x; at 50 sweeps 0.96-0.97x -> 0.77-0.79x. At 210 boxes our stages take
-// ~0.87 ms against SI's iterations ~0.67 ms: the sweeps ~0.37 ms (~8 ns a row; SI's ~14 ns),
-// then ~100 ns a row of work SI does not have, because SI sweeps Bullet's rows in place:
-// packing ~0.18 ms (rows.hpp), the island split and numbering ~0.10 ms, the conversion of
-// Bullet's rows ~0.07 ms, storing impulses and remembering the points' answers ~0.08 ms (first
-// touches of Bullet's rows after the sweeps), the check ~0.05 ms (perf shares).
-// Round 2 (numbering in index passes, conversion without a store-forwarding stall, rows and
-// points fetched ahead, remember() without reads of Bullet's rows): 10 sweeps 1.14x / 1.18-1.19x
-// / 1.19x SI (50 sweeps 0.78x / 0.81x / 0.77-0.79x); our stages at 210 boxes ~0.90 ms against
-// SI's iterations ~0.70 ms: sweeps 40%, packing 23%, numbering 15%, conversion 12%, storing and
-// remembering 5.5%, the check ~5% (perf shares of our symbols). The stages around the sweeps
-// still cost ~2x the gap to SI (~0.2 ms); the hot spots left are the first touches of Bullet's
-// rows and points (1.4 MB of rows; with 1.1 MB of packed rows more than a 2 MB L2 holds) and
-// the packing's division, the rest spread thin.
-// Session 5 (rows read in place by the packing, inlined: no Row batch copy; M^-1 J^T's angular
-// part read from Bullet's m_angularComponentA/B (islands.hpp); manifold points and remembered
-// answers only for the cached-impulse start; couplings two at a time; rows fetched further
-// ahead): 10 sweeps 1.08-1.12x / 1.11-1.13x / 1.08-1.09x SI at 15 / 55 / 210 boxes (the same
-// two runs with round 2's code: 1.30-1.31x / 1.22x / 1.17-1.20x on a busier machine), 20 sweeps
-// 0.88-0.90x / 0.92x / 0.90x, 50 sweeps 0.74-0.75x / 0.76x / 0.73-0.74x; residuals unchanged
-// (the same iterates). Stage timers at 210 boxes, per step: island split and numbering ~60 us,
-// packing (with the reading of Bullet's rows) ~250 us, sweeps ~430 us, check ~50 us, storing
-// impulses ~23 us: ~0.80 ms against SI's iterations ~0.66 ms. 1.0x at 10 sweeps is not reached:
-// the packing alone costs more than the gap (rows.hpp lists what it spends and what was tried).
-// The cached-impulse start (the default, not what --pgs-vs-si times) still reads the manifold
-// points in build() and keeps answers in remember().
-// Session 6 (packing with shorter addition chains and its rows fetched for writing, the check in
-// L1 blocks, one-component groups numbered without a per-row island lookup: rows.hpp,
-// islands.hpp): 10 sweeps 1.06-1.07x / 1.12x / 1.05-1.07x SI at 15 / 55 / 210 boxes against
-// 1.09-1.10x / 1.15-1.17x / 1.11-1.13x for session 5's code in the same two runs (alternated
-// per run, three more: 55 boxes 1.15-1.16x -> 1.09-1.10x, 210 boxes 1.12-1.16x -> 1.04-1.08x);
-// 20 sweeps 0.90-0.91x / 0.92-0.93x / 0.88-0.89x, 50 sweeps 0.78-0.81x / 0.78-0.88x /
-// 0.75x. Stage timers at 210 boxes (median per step, quiet runs, session 5's code in brackets):
-// split and numbering ~42-46 us (~53-56), packing ~200-220 us (~250-255), sweeps ~425-460 us
-// (~425-450, unchanged), check ~46 us (~49), storing impulses ~20 us (~20): ~0.75 ms (~0.80)
-// against SI's iterations ~0.67-0.72 ms. Still above 1.0x at 10 sweeps. The iterates moved by
-// round-off (the packing's sums), so over 300 steps of the pyramid the worst residuals differ
-// from session 5's (15 boxes 4.20e-3 -> 4.69e-3, SI's 4.22e-3) while the medians are the same.
-// Session 7 (the sweep ~20% faster, rows.hpp; min-median of 6 runs alternated with session 6's
-// code): 10 sweeps 1.02-1.03x / 1.06-1.07x / 1.00-1.04x SI at 15 / 55 / 210 boxes against
-// 1.06-1.07x / 1.10-1.11x / 1.05-1.06x; 20 sweeps 0.90-0.91x / 0.89x / 0.85-0.88x, 50 sweeps
-// 0.70-0.72x / 0.75x / 0.70x. The iterates and residuals are session 6's. Our stages at 55 boxes
-// (stage timers, mean per step): split ~10 us, packing ~48 us, sweeps ~93 us, check ~11 us,
-// storing ~2 us (~0.16 ms against SI's iterations ~0.15 ms); the fixed passes (~70 us) still
-// cost more than the sweeps save. (Round 4's timers below put the split at ~5 us: the two sets
-// were taken over Bullet's two solveGroup calls a step differently, one call has no rows; the
-// sum of round 3's matches the bench's "ours stages ms" column.) The first sweep fused into the
-// packing did not pay (rows.hpp).
-// Session 7, round 4 (the one-component split numbered in its graph pass, islands.hpp; runs
-// alternated with round 3's code, min / median, 7 and 11 runs on a busy machine): 10 sweeps 1.00x /
-// 1.00-1.10x, 1.04x / 1.05-1.11x, 1.01-1.02x / 1.02-1.05x SI at 15 / 55 / 210 boxes against 1.02x /
-// 1.02-1.10x, 1.05x / 1.09-1.13x, 1.02x / 1.04-1.08x. The split at 55 boxes is now ~4.4 us of a ~10
-// us gap (4% at the min); the graph pass (~3.3 us) is what is left of it, and folding it into the
-// packing cost the packing more than it saved (islands.hpp).
-// Session 9 (mlcp/cpu.hpp, rows.hpp): the packing, sweeps and check compiled for AVX2 too and
-// chosen at run time, and the sweep's and check's 12-wide products and velocity updates written as
-// generic vectors (4 + 2 wide with AVX2, pairs in the baseline; Eigen's order, the same iterates
-// bit for bit). Two runs, ours stages / SI's iterations at 55 boxes, 10 sweeps: 0.124 / 0.126-0.128
-// ms (0.135-0.137 / 0.126-0.128 before); 10 sweeps 0.93x / 0.97x / 0.92x SI at 15 / 55 / 210
-// boxes in both runs (AVX2), 0.95x / 1.00x / 0.96x with MLCP_CPU_PATH=baseline; 20 sweeps
-// 0.75x / 0.75-0.76x / 0.75-0.77x, 50 sweeps 0.54-0.56x / 0.59-0.60x / 0.59-0.60x. The whole
-// library built for x86-64-v3 instead (tools/build.sh DIR -DCMAKE_CXX_FLAGS="-march=x86-64-v3
-// -ffp-contract=off", before the generic vectors) gained about what the dispatch alone gained
-// (55 boxes ~1.00x against 1.01-1.02x, alternated runs), so the rest of our stages gain little
-// from AVX2.
+// by round-off (the bodies' velocities, 1e-9 apart after ~17 steps of a settling pyramid). The
+// cached-impulse start (the default) reads the manifold points in build() and keeps answers in
+// remember(); SI's start (Settings::siStart) reads neither.
+// Cost against SI at the same sweep count: Bullet's row setup and finish are the same code in
+// both. Ours adds one packing pass, the island split, the residual check and the write-back,
+// O(rows) each, and saves on every sweep (RowPgs' sweep, rows.hpp, takes about half of SI's time
+// a row), so it takes about SI's time at Bullet's default 10 sweeps and less from 20 on
+// (docs/benchmarks.md, "Bullet: pgs against SI").
 //
 // "si" runs Bullet's own SI iterations instead (for side-by-side runs with the same statistics).
 #pragma once

@@ -10,48 +10,28 @@
 // mass 0) are "the world": they couple nothing, so two boxes resting on the same ground are two
 // islands. Buffers are kept between calls so a steady scene allocates nothing per step.
 //
-// Two passes over Bullet's rows (288 bytes each, in double precision): the first reads only the
-// body indices (union-find; each row's dynamic bodies kept in a compact array), then the island
-// numbering runs on the compact arrays in two passes (each row's island and place, with no
-// find() for a row on the previous row's bodies; then each island's arrays, sized once and
-// written by index: rows, bodies, findex, manifold points and last step's entries), the second
-// converts each row: into its island's RowSystem (build with system = true, or fillSystem
-// later), or straight into RowPgs' packing through Source (the "pgs" path: no RowSystem copy).
-// Both write the same values (one conversion function). The conversion and the numbering fetch
-// Bullet's rows and the manifold points a few rows ahead; what remember() needs after the
-// solve (points' positions, friction directions) is kept in Island::memo, so after the sweeps
-// only the applied impulses are written back into Bullet's rows. The RowSystem copy cost ~40 ns
-// a row (210-box pyramid), mostly first touches of Bullet's rows and the scattered writes of
-// its arrays; the "pgs" path's numbering ~30 ns and conversion ~23 ns a row (session 4, round 2,
-// perf shares: see constraint_solver.hpp). Session 5: the conversion is read by the packing in
-// place (Source, inlined through RowPgs::solveFrom), and without the cached-impulse start the
-// points are not read at all: the split and numbering ~60 us at 210 boxes (~13 ns a row).
-// Session 6: a group that is one component (every dynamic body under one root after the
-// union-find, no inert row: a pile, a pyramid) skips the per-row island lookup and placing:
-// its rows are island 0 in their own order, the island's arrays are copies, only the bodies are
-// numbered (by first use, as the general numbering does; tested equal bit for bit to it). The
-// split and numbering at 210 boxes ~42-46 us against ~53-56 us (stage timers, median per step).
-// Session 7 (round 4): the one-component case is decided and numbered in the graph pass itself:
-// bodies numbered by first use as the rows come (the same order), components counted as the
-// bodies the rows name less the unions that joined two (no find() per body afterwards); the
-// island takes the pass's rows and findex arrays by swap, and its rowIndex is not written
-// (Island::inOrder). Stage timers, mean per step, 3 runs alternated with the old code: at 55
-// boxes split 5.2-5.7 -> 4.3-4.4 us (numbering 1.5-1.6 -> 0.65, copies 0.5 -> 0.06, the
-// one-component check 0.2 -> 0, the graph pass 3.0-3.3 -> 3.3-3.4); at 210 boxes ~24-30 ->
-// ~19-24 us (numbering 6.4-8.1 -> 2.5-3.3, copies 2.0-2.4 -> 0.1). What is left is the graph
-// pass, bound by its first touch of each row's last line (without its prefetch 5.5 us at 55
-// boxes against 3.8-4.0). Tried and taken out: friction rows not linked when on their contact
-// row's bodies (a branch-free pass for them): the graph pass unchanged (3.0-3.4 us); the graph
-// pass fused into RowPgs' packing (speculatively, when last step had one group and it was one
-// component: bodies numbered as Bullet numbers its solver bodies, each row linked by view() as
-// the packing reads it, checked after the pass and rebuilt when it was several components):
-// split 4.5 -> 1.0-2.1 us at 55 boxes and ~22-35 -> 5-7 us at 210, but the packing grew by
-// more (+6-12 us at 55 boxes); 10 sweeps 15 / 55 / 210 boxes min 0.98x / 1.04x / 1.02x SI ->
-// 1.02x / 1.07x / 1.01-1.03x, median 1.00x / 1.12x / 1.07x -> 1.03-1.05x / 1.15x / 1.08-1.09x
-// (9 alternated runs, a busy machine). Bullet also calls a group with no rows every step in
-// the 55-box pyramid (a group gate of the fused path must not count those).
-// Session 8: Source::row and view() are always_inline (GCC had kept view() a call per row,
-// its RowView returned through memory): the packing -27 instructions a row (rows.hpp).
+// Two passes over Bullet's rows (288 bytes each, in double precision):
+//  1. the graph pass reads only the body indices: a union-find over the dynamic bodies, each
+//     row's bodies kept in a compact array. When the group is one component (every dynamic body
+//     under one root, no inert row: a pile, a pyramid) this pass also decides it and numbers the
+//     bodies by first use as the rows come; components are counted as the bodies the rows name
+//     less the unions that joined two, so no find() per body follows. Such an island takes the
+//     pass's row and findex arrays by swap, in Bullet's order (Island::inOrder, no rowIndex).
+//     Otherwise the numbering runs on the compact arrays in two passes: each row's island and
+//     place (no find() for a row on the previous row's bodies), then each island's arrays, sized
+//     once and written by index (rows, bodies, findex, manifold points, last step's entries).
+//     Both numberings give the same order (tested equal bit for bit).
+//  2. the conversion writes each row either into its island's RowSystem (build with system =
+//     true, or fillSystem later) or straight into RowPgs' packing through Source (the "pgs"
+//     path: read in place by RowPgs::solveFrom, Source::row and view() always_inline, no copy).
+//     Both write the same values (one conversion function).
+// Both passes fetch Bullet's rows and the manifold points a few rows ahead: the passes are bound
+// by their first touch of each row, which sits out of cache after Bullet's setup. What remember()
+// needs after the solve (points' positions, friction directions) is kept in Island::memo, so
+// after the sweeps only the applied impulses are written back into Bullet's rows; without the
+// cached-impulse start the manifold points are not read at all.
+// Cost: O(rows + bodies) per group, near-linear union-find included; no allocation
+// once the buffers have grown.
 #pragma once
 
 #include <BulletDynamics/ConstraintSolver/btSequentialImpulseConstraintSolver.h>

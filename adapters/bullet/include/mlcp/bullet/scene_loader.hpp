@@ -36,8 +36,9 @@
 //   Bullet's default is one row along the sliding direction), SOLVER_ENABLE_FRICTION_DIRECTION_
 //   CACHING | SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION (a contact keeps its friction
 //   directions from step to step, so last step's friction impulses are a meaningful warm start:
-//   Bullet's dantzig step on pyramid_15 went from 3.1 to 1.0 ms, on pyramid_55 from ~950 to
-//   ~520 ms). max_contacts_per_pair is 4 in Bullet's manifolds whatever the scene says.
+//   with directions that follow the sliding velocity, the exact solvers' warm starts are off
+//   and their steps take two to three times as long on the pyramids). max_contacts_per_pair is 4 in
+//   Bullet's manifolds whatever the scene says.
 //
 // Solver names: any mlcp::solverNames() name runs through mlcp::bullet::ConstraintSolver (its
 // statistics fill the measures); the stock ones are

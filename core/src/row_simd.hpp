@@ -1,9 +1,9 @@
-// mlcp/detail/row_simd.hpp: the 6- and 12-wide products of RowPgs' sweeps and check in
+// core/src/row_simd.hpp (internal): the 6- and 12-wide products of RowPgs' sweeps and check in
 // GCC's generic vectors, four entries and two: compiled as pairs of 2-wide SSE2 operations for the
 // baseline and as one 4-wide and one 2-wide AVX operation in the AVX2 variants (mlcp/cpu.hpp),
-// with the same operations in the same order either way (so the same bits). The orders are those
-// of the Eigen expressions they replaced (a 6-vector in 2-wide packets; tests/core/cpu_test.cpp
-// compares them on random products): the iterates did not move.
+// with the same operations in the same order either way (so the same bits). The order is that of
+// Eigen's Vector6 expressions (a 6-vector in 2-wide packets; tests/core/cpu_test.cpp compares
+// them on random products), so RowPgs' iterates equal those of the Eigen formulation.
 #pragma once
 
 #include <cstring>
