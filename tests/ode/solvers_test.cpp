@@ -54,8 +54,9 @@ const Scenes kMonotoneScenes[] = {
 
 TEST(OdeSolvers, PgsAtTightToleranceReachesDantzigsAnswer) {
   StepperOptions options;
-  options.solver.tolerance = 1e-10;
-  options.solver.maxIterations = 20000;
+  options.options.tolerance = 1e-10;
+  options.options.maxIterations = 20000;
+  options.engineIterations = false;
   options.fallback = "";
   for (const Scenes& s : kMonotoneScenes) {
     auto byDantzig = s.make(), byPgs = s.make();
@@ -109,7 +110,8 @@ TEST(OdeSolvers, EveryCoreSolverRunsTheStack) {
 TEST(OdeSolvers, PgsIsWarmStartedFromTheLastStep) {
   // A box at rest: this step's answer is last step's, so a warm start needs almost no sweeps.
   StepperOptions options;
-  options.solver.tolerance = 1e-6;
+  options.options.tolerance = 1e-6;
+  options.engineIterations = false;  // sweeps to the tolerance, not QuickStep's fixed count
   auto warm = boxOnPlane(0.0), cold = boxOnPlane(0.0);
   Stepper warmStepper("pgs", options);
   options.warmStart = false;
