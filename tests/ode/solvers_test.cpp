@@ -131,5 +131,31 @@ TEST(OdeSolvers, PgsIsWarmStartedFromTheLastStep) {
   EXPECT_LT(warmIterations * 2, coldIterations);
 }
 
+// The drop-in's default: pgs costs what dWorldQuickStep's solve costs, the world's QuickStep
+// iteration count (and W), whatever options.maxIterations says; a pgs fallback is not run again.
+TEST(OdeSolvers, DefaultPgsRunsTheWorldsQuickStepIterations) {
+  auto scene = boxStack(3);
+  Settings settings;
+  settings.solver = "pgs";
+  settings.options.maxIterations = 500;  // not used: engineIterations is on by default
+  Stepper stepper(settings);
+  EXPECT_EQ(stepper.settings().options.tolerance, kDefaultIslandTolerance);
+  for (int sweeps : {20, 7}) {
+    dWorldSetQuickStepNumIterations(scene->world, sweeps);
+    int islands = 0;
+    run(*scene, stepper, 5, [&](int, const IslandStats& st) {
+      ++islands;
+      EXPECT_EQ(st.iterations, sweeps);
+      EXPECT_FALSE(st.fellBack);
+    });
+    EXPECT_GT(islands, 0);
+  }
+  settings.engineIterations = false;
+  settings.options.maxIterations = 3;
+  settings.fallback = "";
+  Stepper pinned(settings);
+  run(*scene, pinned, 2, [&](int, const IslandStats& st) { EXPECT_EQ(st.iterations, 3); });
+}
+
 }  // namespace
 }  // namespace mlcp::ode::test
