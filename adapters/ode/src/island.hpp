@@ -106,7 +106,7 @@ struct mlcp::ode::Stepper::Impl {
   StepStats stats;
   WarmStartCache warm;
   IslandWork work;
-  // StepperOptions::keepProblems: this step's islands, and last step's entries whose buffers
+  // Settings::keepProblems: this step's islands, and last step's entries whose buffers
   // the island workspace takes in turn.
   std::vector<IslandProblem> problems, spareProblems;
   std::mutex mutex;  // islands may run on ODE's worker threads

@@ -3,6 +3,12 @@
 //     mlcp::ode::Stepper stepper;               // "auto", or "dantzig", "pgs", ... by name
 //     stepper.step(world, h);                   // instead of dWorldStep(world, h)
 //
+//     mlcp::ode::Settings s;                    // the shape of mlcp::bullet::Settings
+//     s.solver = "pgs";                         // by default: the world's QuickStep
+//     mlcp::ode::Stepper quick(s);              // iterations and W, dWorldQuickStep's cost
+//
+// From C: mlcp/ode/stepper.h (every setting, errors as return codes, no exceptions).
+//
 // How it plugs in. dWorldStep is two calls into ODE's world processing:
 // dxReallocateWorldProcessContext (auto-disabling, islands, arena sized by a memory estimator)
 // then dxProcessIslands, which calls an island stepper of type dstepper_fn_t once per island.
