@@ -178,25 +178,39 @@ TEST(BulletWorlds, PlainWorldPassesTheCheckWithAndWithoutDynamicBodies) {
 
 TEST(BulletWorlds, OneSolverSteppedFromTwoThreadsAtOnceMatchesSteppedAlone) {
   // Two worlds stepped concurrently share one solver: its mutex serializes their groups, and
-  // each world moves as it does with a solver of its own.
+  // each world moves as it does with a solver of its own (without the mutex the two groups'
+  // rows mix in the solver's pools: the piles blow up or drift apart).
+  const auto pile = [](sc::World& w) {
+    w.info().m_minimumSolverBatchSize = 1;  // a solveGroup call per island: many calls a step
+    for (int k = 0; k < 6; ++k) {
+      btTransform pose;
+      pose.setIdentity();
+      for (int level = 0; level < 3; ++level) {
+        pose.setOrigin(btVector3(3.0 * k, 0.5 + level, 0));
+        w.addBox(btVector3(0.5, 0.5, 0.5), 1.0, pose);
+      }
+    }
+    w.addGround();
+  };
   sc::World alone;
-  alone.setSolver(std::make_unique<ConstraintSolver>(exact()));
-  sc::stack(alone, 4);
+  alone.setSolver(std::make_unique<ConstraintSolver>(pgs()));
+  pile(alone);
   sc::World a, b;
-  ConstraintSolver shared(exact());
+  ConstraintSolver shared(pgs());
   for (sc::World* w : {&a, &b}) {
-    sc::stack(*w, 4);
+    pile(*w);
     mlcp::bullet::install(w->world(), shared);
   }
-  alone.step(120);
-  std::thread ta([&] { a.step(120); });
-  std::thread tb([&] { b.step(120); });
+  const int steps = 300;
+  alone.step(steps);
+  std::thread ta([&] { a.step(steps); });
+  std::thread tb([&] { b.step(steps); });
   ta.join();
   tb.join();
   for (std::size_t k = 0; k < alone.dynamicBodies().size(); ++k) {
     const btVector3 p = alone.dynamicBodies()[k]->getCenterOfMassPosition();
     for (sc::World* w : {&a, &b})
-      EXPECT_LT((w->dynamicBodies()[k]->getCenterOfMassPosition() - p).length(), 1e-6) << k;
+      EXPECT_LT((w->dynamicBodies()[k]->getCenterOfMassPosition() - p).length(), 1e-3) << k;
   }
 }
 
