@@ -24,10 +24,13 @@
 //   serial dispatch and the unsplit path give it everything. Bullet's demos pass a
 //   btSequentialImpulseConstraintSolverMt there: with setConstraintSolver(&ours) alone their
 //   960-box walls never reach our solver. install() fills both slots; the pool passed as both
-//   is what every island goes to. The world merges islands whose batch cost (bodies + 8
-//   manifolds + 4 constraints) is below m_minimumSolverBatchSize (taken from
+//   is what every island goes to. The world puts every island of fewer than 32 bodies
+//   (m_batchIslandMinBodyCount, no setter) into one batch island, and merges islands whose batch
+//   cost (bodies + 8 manifolds + 4 constraints) is below m_minimumSolverBatchSize (taken from
 //   btContactSolverInfo at construction, 128): a member sees merged groups and splits them into
-//   connected components as in the plain world.
+//   connected components as in the plain world. (Debian's btSequentialImpulseConstraintSolverMt,
+//   built without BT_THREADSAFE, crashed in btBatchedConstraints::setup on a 55-box pyramid
+//   with the batching threshold lowered to 16 manifolds.)
 // - btMultiBodyDynamicsWorld (and the soft/deformable multibody worlds derived from it):
 //   setConstraintSolver keeps its btMultiBodyConstraintSolver for every island (the island
 //   callback holds it) unless the new solver is of type BT_MULTIBODY_SOLVER; it calls only
