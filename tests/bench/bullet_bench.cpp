@@ -96,7 +96,7 @@ Row run(const Config& cfg, int boxes, int warmup, int settle, int steps) {
   s.cfm = mlcp::bullet::CfmModel::StockMlcp;
   if (cfg.name == "pgs") {
     // Sequential-impulse-like: Bullet's 10 sweeps, residual checked once, always accepted.
-    s.bulletIterations = true;
+    s.engineIterations = true;
     s.acceptResidual = INFINITY;
     s.fallback = "";
   }
@@ -183,7 +183,7 @@ Pair pgsVersusSi(int boxes, int warmup, int steps, int sweeps) {
   }
   mlcp::bullet::Settings s;
   s.cfm = mlcp::bullet::CfmModel::StockMlcp;
-  s.bulletIterations = true;
+  s.engineIterations = true;
   s.acceptResidual = INFINITY;
   s.fallback = "";
   si.setSolver(std::make_unique<Timed>(sc::makeBulletSolver("si")));

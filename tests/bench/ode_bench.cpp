@@ -79,10 +79,11 @@ int main(int argc, char** argv) {
     add("dWorldStep", nullptr, false);
     add("dWorldQuickStep (20 it)", nullptr, true);
     StepperOptions pgs;
-    pgs.solver.maxIterations = 20;
-    pgs.solver.relaxation = 1.3;
-    pgs.solver.checkEvery = 1000000;
-    pgs.solver.tolerance = 0;
+    pgs.options.maxIterations = 20;
+    pgs.options.relaxation = 1.3;
+    pgs.options.checkEvery = 1000000;
+    pgs.options.tolerance = 0;
+    pgs.engineIterations = false;
     pgs.fallback = "";
     add("ours pgs (20 it, w 1.3, warm)", std::make_unique<Stepper>("pgs", pgs), false);
     StepperOptions dz;

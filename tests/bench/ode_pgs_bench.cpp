@@ -166,10 +166,11 @@ int main(int argc, char** argv) {
     ours->recordContacts = true;
 
     StepperOptions tight;
-    tight.solver.maxIterations = referenceSweeps;
-    tight.solver.checkEvery = 10;
-    tight.solver.tolerance = 1e-9;
-    tight.solver.relaxation = 1.0;
+    tight.options.maxIterations = referenceSweeps;
+    tight.options.checkEvery = 10;
+    tight.options.tolerance = 1e-9;
+    tight.options.relaxation = 1.0;
+    tight.engineIterations = false;
     tight.fallback = "";
     Stepper reference("pgs", tight);
     // keepProblems: swapped out, not copied: no measurable cost (stepper.hpp).

@@ -19,7 +19,9 @@ Settings settingsFor(const std::string& name) {
   Settings s;
   s.solver = name;
   s.cfm = mlcp::bullet::CfmModel::StockMlcp;  // globalCfm / dt on friction rows too
+  s.options.tolerance = 1e-10;                // exact answers: the friction cone is checked to 1e-9
   if (name == "pgs") {
+    s.engineIterations = false;
     // Like SI with enough sweeps: the answer after 1000 sweeps is used whatever its residual
     // (these singular face-contact problems converge slowly); the physics is what is checked.
     s.options.maxIterations = 1000;

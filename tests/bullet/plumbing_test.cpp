@@ -41,6 +41,8 @@ double stateDifference(sc::World& a, sc::World& b) {
 Settings fixedSweepPgs(int sweeps) {
   Settings s;
   s.solver = "pgs";
+  s.engineIterations = false;
+  s.options = mlcp::Options();  // core's: tolerance 1e-10 (not reached), checked every sweep
   s.options.maxIterations = sweeps;
   s.acceptResidual = INFINITY;
   return s;
@@ -182,6 +184,7 @@ TEST(BulletPlumbing, GroupsAreSplitIntoConnectedComponents) {
   sc::World w;
   Settings s;
   s.solver = "pgs";
+  s.engineIterations = false;  // sweeps toward the tolerance
   w.setSolver(std::make_unique<ConstraintSolver>(s));
   auto* mine = static_cast<ConstraintSolver*>(w.solver());
   sc::stack(w, 2);
@@ -526,6 +529,27 @@ TEST(BulletPlumbing, SiStartIsTheCachedImpulseTimesTheWarmStartingFactor) {
     }
   }
   EXPECT_GT(contacts, 0);
+}
+
+// The drop-in's default: pgs sweeps btContactSolverInfo::m_numIterations times per problem, as SI
+// does, whatever options.maxIterations says; a pgs fallback is not run again.
+TEST(BulletPlumbing, DefaultPgsRunsBulletsIterationCount) {
+  sc::World w;
+  Settings s;
+  s.solver = "pgs";
+  s.options.maxIterations = 500;  // not used: engineIterations is on by default
+  w.setSolver(std::make_unique<ConstraintSolver>(s));
+  auto* mine = static_cast<ConstraintSolver*>(w.solver());
+  EXPECT_EQ(mine->settings().options.tolerance, mlcp::kDefaultIslandTolerance);
+  sc::stack(w, 3);
+  for (int sweeps : {10, 4}) {
+    w.info().m_numIterations = sweeps;
+    w.step(5);
+    const mlcp::bullet::StepStats& st = mine->lastStep();
+    EXPECT_GT(st.islands, 0);
+    EXPECT_EQ(st.iterations, sweeps * st.islands);
+    EXPECT_EQ(st.fallbacks, 0);
+  }
 }
 
 }  // namespace

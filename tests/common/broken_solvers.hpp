@@ -1,9 +1,10 @@
 // Solvers that break on purpose, to check that fallbacks happen, are counted and reported.
-// registerBrokenSolvers() adds them to the registry as "test-nan" and "test-fail", so that the
-// adapters (which take solvers by name) can be handed them too.
+// registerBrokenSolvers() adds them to the registry as "test-nan", "test-fail" and "test-throw",
+// so that the adapters (which take solvers by name) can be handed them too.
 #pragma once
 
 #include <cmath>
+#include <stdexcept>
 
 #include "mlcp/registry.hpp"
 #include "mlcp/solver.hpp"
@@ -32,12 +33,26 @@ class BrokenSolver : public Solver {
   bool nan_;
 };
 
+// Throws std::runtime_error("injected exception") from its solve: an exception from inside an
+// engine's step, for the adapters' error paths.
+class ThrowingSolver : public Solver {
+ public:
+  const char* name() const override { return "test-throw"; }
+
+ protected:
+  void run(const Problem&, Vector&, Result&) override {
+    throw std::runtime_error("injected exception");
+  }
+};
+
 inline void registerBrokenSolvers() {
   static const bool done = [] {
     registerSolver({"test-nan", "answers NaN (tests only)",
                     [] { return std::unique_ptr<Solver>(new BrokenSolver(true)); }});
     registerSolver({"test-fail", "reports Failed (tests only)",
                     [] { return std::unique_ptr<Solver>(new BrokenSolver(false)); }});
+    registerSolver({"test-throw", "throws from its solve (tests only)",
+                    [] { return std::unique_ptr<Solver>(new ThrowingSolver()); }});
     return true;
   }();
   (void)done;

@@ -98,7 +98,9 @@ TEST(RowSolver, ChoosesByClassSizeAndTolerance) {
 }
 
 TEST(RowSolver, AutoSolvesEachClassWithItsChoiceAndReportsIt) {
-  RowSolver solver;  // auto
+  RowSolverSettings settings;  // auto
+  settings.options.tolerance = 1e-10;
+  RowSolver solver(settings);
   struct Case {
     RowSystem rows;
     const char* choice;
@@ -139,10 +141,11 @@ TEST(RowSolver, AcceptanceIsTheSameRuleForEveryStatus) {
   EXPECT_FALSE(acceptable(r, kInf));
 }
 
-// The fallback's answer from the same start, computed alone.
+// The fallback's answer from the same start, computed alone (with the fallback's options).
 Vector fallbackAlone(const RowSystem& rows, const Vector& start, const std::string& name) {
   RowSolverSettings settings;
   settings.solver = name;
+  settings.options = settings.fallbackOptions;
   settings.fallback = "";
   RowSolver alone(settings);
   Vector x;
@@ -199,6 +202,7 @@ TEST(RowSolver, AnAnswerAboveTheLimitFallsBackWhateverTheSolver) {
   settings.options.maxIterations = 1;
   settings.acceptResidual = 1e-9;
   settings.fallback = "dantzig";
+  settings.fallbackOptions.tolerance = 1e-10;
   RowSolver solver(settings);
   const RowSystem rows = boxOnGround(true);
   Vector x;

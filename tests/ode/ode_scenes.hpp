@@ -20,10 +20,11 @@ namespace mlcp::ode::test {
 // default), no convergence test, no fallback.
 inline StepperOptions fixedSweepPgs(int sweeps, bool keepProblems = false) {
   StepperOptions o;
-  o.solver.maxIterations = sweeps;
-  o.solver.checkEvery = sweeps;
-  o.solver.tolerance = 0;
-  o.solver.relaxation = 1.3;
+  o.options.maxIterations = sweeps;
+  o.options.checkEvery = sweeps;
+  o.options.tolerance = 0;
+  o.options.relaxation = 1.3;
+  o.engineIterations = false;
   o.fallback = "";
   o.keepProblems = keepProblems;
   return o;

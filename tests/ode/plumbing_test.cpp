@@ -86,7 +86,7 @@ TEST(OdePlumbing, OwnRowsWithOdesLcpSolverMatchDWorldStep) {
 
 TEST(OdePlumbing, CompatibleDantzigMatchesDWorldStep) {
   StepperOptions options;
-  options.solver.frictionBounds = FrictionBounds::FixedOnce;
+  options.options.frictionBounds = FrictionBounds::FixedOnce;
   options.warmStart = false;  // stock starts every step from zero
   options.fallback = "";
   for (const NamedScene& scene : kScenes) {

@@ -54,8 +54,9 @@ const Scenes kMonotoneScenes[] = {
 
 TEST(OdeSolvers, PgsAtTightToleranceReachesDantzigsAnswer) {
   StepperOptions options;
-  options.solver.tolerance = 1e-10;
-  options.solver.maxIterations = 20000;
+  options.options.tolerance = 1e-10;
+  options.options.maxIterations = 20000;
+  options.engineIterations = false;
   options.fallback = "";
   for (const Scenes& s : kMonotoneScenes) {
     auto byDantzig = s.make(), byPgs = s.make();
@@ -109,7 +110,8 @@ TEST(OdeSolvers, EveryCoreSolverRunsTheStack) {
 TEST(OdeSolvers, PgsIsWarmStartedFromTheLastStep) {
   // A box at rest: this step's answer is last step's, so a warm start needs almost no sweeps.
   StepperOptions options;
-  options.solver.tolerance = 1e-6;
+  options.options.tolerance = 1e-6;
+  options.engineIterations = false;  // sweeps to the tolerance, not QuickStep's fixed count
   auto warm = boxOnPlane(0.0), cold = boxOnPlane(0.0);
   Stepper warmStepper("pgs", options);
   options.warmStart = false;
@@ -127,6 +129,32 @@ TEST(OdeSolvers, PgsIsWarmStartedFromTheLastStep) {
   });
   EXPECT_GE(warmStarted, 90);  // not when the contact count changed in the first steps
   EXPECT_LT(warmIterations * 2, coldIterations);
+}
+
+// The drop-in's default: pgs costs what dWorldQuickStep's solve costs, the world's QuickStep
+// iteration count (and W), whatever options.maxIterations says; a pgs fallback is not run again.
+TEST(OdeSolvers, DefaultPgsRunsTheWorldsQuickStepIterations) {
+  auto scene = boxStack(3);
+  Settings settings;
+  settings.solver = "pgs";
+  settings.options.maxIterations = 500;  // not used: engineIterations is on by default
+  Stepper stepper(settings);
+  EXPECT_EQ(stepper.settings().options.tolerance, kDefaultIslandTolerance);
+  for (int sweeps : {20, 7}) {
+    dWorldSetQuickStepNumIterations(scene->world, sweeps);
+    int islands = 0;
+    run(*scene, stepper, 5, [&](int, const IslandStats& st) {
+      ++islands;
+      EXPECT_EQ(st.iterations, sweeps);
+      EXPECT_FALSE(st.fellBack);
+    });
+    EXPECT_GT(islands, 0);
+  }
+  settings.engineIterations = false;
+  settings.options.maxIterations = 3;
+  settings.fallback = "";
+  Stepper pinned(settings);
+  run(*scene, pinned, 2, [&](int, const IslandStats& st) { EXPECT_EQ(st.iterations, 3); });
 }
 
 }  // namespace

@@ -27,6 +27,18 @@ for engine in bullet ode; do
   csv_ok "csv-$engine" "$tmp/$engine.csv" 7 "$engine" pgs
   check "unknown-solver-$engine" 2 "unknown solver 'nosuch'" -- \
     "$mlcp" run "$scenes/stack_10.json" --engine "$engine" --solver nosuch --steps 1
+  # --engine-iterations: pgs runs exactly --iterations sweeps per island (the drop-in's default).
+  "$mlcp" run "$scenes/stack_10.json" --engine "$engine" --solver pgs --steps 5 --iterations 7 \
+    --engine-iterations --csv "$tmp/$engine-fixed.csv" > /dev/null 2>&1
+  if awk -F, 'NR > 1 { n = split($11, c, /[: ]/); islands = 0
+                       for (i = 2; i <= n; i += 2) islands += c[i]
+                       if ($8 != 7 * islands || $10 != 0) bad = 1 }
+              END { exit bad || NR != 6 }' "$tmp/$engine-fixed.csv"; then
+    passed=$((passed + 1))
+  else
+    failed=$((failed + 1))
+    echo "FAIL engine-iterations-$engine:"; head -4 "$tmp/$engine-fixed.csv" | sed 's/^/    /'
+  fi
 done
 check stock-bullet 0 'with bullet-si: 3 steps' -- \
   "$mlcp" run "$scenes/resting_box.json" --engine bullet --solver bullet-si --steps 3 --iterations 10

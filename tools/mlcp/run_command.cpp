@@ -26,6 +26,7 @@ struct RunArgs {
   int iterations = -1;
   double tolerance = -1;
   bool noWarmStart = false;
+  bool engineIterations = false;
   std::string fallback = "pgs";
   double fallbackResidual = -1;
   std::string csv;
@@ -47,6 +48,7 @@ int runScene(const RunArgs& args) {
   if (args.iterations >= 0) run.iterations = args.iterations;
   if (args.tolerance >= 0) run.tolerance = args.tolerance;
   if (args.noWarmStart) run.warmStart = false;
+  run.engineIterations = args.engineIterations;
   run.fallback = args.fallback == "none" ? "" : args.fallback;
   if (args.fallbackResidual >= 0) run.fallbackResidual = args.fallbackResidual;
   const int steps = args.steps >= 0 ? args.steps : s.settings.steps;
@@ -156,6 +158,9 @@ Runner addRunCommand(CLI::App& app) {
                   "tolerance of the scaled residual (default: the scene's solver.tolerance)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--no-warm-start", args->noWarmStart, "start every solve from zero");
+  cmd->add_flag("--engine-iterations", args->engineIterations,
+                "pgs/gs run exactly --iterations sweeps, checked once at the end, as the "
+                "engine's own solver does (the adapters' default for a drop-in)");
   cmd->add_option("--fallback", args->fallback,
                   "core solver run when an answer is rejected, or none (default pgs)");
   cmd->add_option("--fallback-residual", args->fallbackResidual,

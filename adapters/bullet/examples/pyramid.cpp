@@ -58,6 +58,7 @@ int main(int argc, char** argv) {
     if (steps <= 0) steps = scene.settings.steps;
     if (!app.count("--tolerance")) settings.options.tolerance = run.tolerance;
     if (!app.count("--max-iterations")) settings.options.maxIterations = run.iterations;
+    settings.engineIterations = false;  // the scene's limit and tolerance, as `mlcp run`
     settings.warmStart = run.warmStart;
     h = scene.settings.timeStep;
 

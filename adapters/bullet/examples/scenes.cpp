@@ -1,5 +1,8 @@
 #include "scenes.hpp"
 
+#include <BulletDynamics/Dynamics/btDiscreteDynamicsWorldMt.h>
+#include <BulletDynamics/Featherstone/btMultiBodyConstraintSolver.h>
+#include <BulletDynamics/Featherstone/btMultiBodyDynamicsWorld.h>
 #include <BulletDynamics/MLCPSolvers/btDantzigSolver.h>
 #include <BulletDynamics/MLCPSolvers/btLemkeSolver.h>
 #include <BulletDynamics/MLCPSolvers/btSolveProjectedGaussSeidel.h>
@@ -65,13 +68,32 @@ std::unique_ptr<btConstraintSolver> makeBulletSolver(const std::string& name, Se
   return std::make_unique<ConstraintSolver>(settings);
 }
 
-World::World(double dt, bool twoFrictionDirections) : dt_(dt) {
+World::World(double dt, bool twoFrictionDirections, WorldKind kind) : dt_(dt) {
   config_ = std::make_unique<btDefaultCollisionConfiguration>();
   dispatcher_ = std::make_unique<btCollisionDispatcher>(config_.get());
   broadphase_ = std::make_unique<btDbvtBroadphase>();
-  solver_ = std::make_unique<btSequentialImpulseConstraintSolver>();
-  world_ = std::make_unique<btDiscreteDynamicsWorld>(dispatcher_.get(), broadphase_.get(),
-                                                     solver_.get(), config_.get());
+  switch (kind) {
+    case WorldKind::Discrete:
+      solver_ = std::make_unique<btSequentialImpulseConstraintSolver>();
+      world_ = std::make_unique<btDiscreteDynamicsWorld>(dispatcher_.get(), broadphase_.get(),
+                                                         solver_.get(), config_.get());
+      break;
+    case WorldKind::DiscreteMt: {
+      auto pool = std::make_unique<btConstraintSolverPoolMt>(1);
+      kept_.push_back(std::make_unique<btSequentialImpulseConstraintSolver>());
+      world_ = std::make_unique<btDiscreteDynamicsWorldMt>(
+          dispatcher_.get(), broadphase_.get(), pool.get(), kept_.back().get(), config_.get());
+      solver_ = std::move(pool);
+      break;
+    }
+    case WorldKind::MultiBody: {
+      auto mb = std::make_unique<btMultiBodyConstraintSolver>();
+      world_ = std::make_unique<btMultiBodyDynamicsWorld>(dispatcher_.get(), broadphase_.get(),
+                                                          mb.get(), config_.get());
+      solver_ = std::move(mb);
+      break;
+    }
+  }
   world_->setGravity(btVector3(0, -9.81, 0));
   if (twoFrictionDirections) info().m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
 }
@@ -83,6 +105,10 @@ World::~World() {
 }
 
 void World::setSolver(std::unique_ptr<btConstraintSolver> solver) {
+  // A multibody world keeps its multibody solver in its island callback: the one replaced stays
+  // alive.
+  if (dynamic_cast<btMultiBodyDynamicsWorld*>(world_.get()) && kept_.empty())
+    kept_.push_back(std::move(solver_));
   world_->setConstraintSolver(solver.get());
   // Direct solvers want one island per call (what Bullet's own demos set for them).
   if (solver->getSolverType() == BT_MLCP_SOLVER) info().m_minimumSolverBatchSize = 1;

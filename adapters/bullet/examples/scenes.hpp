@@ -52,11 +52,23 @@ std::unique_ptr<btConstraintSolver> makeBulletSolver(const std::string& name,
 // Every name makeBulletSolver accepts, for --help texts.
 std::string bulletSolverNames();
 
-// A stock btDiscreteDynamicsWorld and everything it points at, destroyed in the right order.
+// Which stock world World builds.
+enum class WorldKind {
+  Discrete,    // btDiscreteDynamicsWorld with btSequentialImpulseConstraintSolver
+  DiscreteMt,  // btDiscreteDynamicsWorldMt with a btConstraintSolverPoolMt of SI solvers and an
+               // SI solver for large islands (Bullet's MultiThreadedDemo puts a
+               // btSequentialImpulseConstraintSolverMt there; Debian's build of it, without
+               // BT_THREADSAFE, crashed in btBatchedConstraints::setup on a 55-box pyramid with
+               // the batching threshold lowered to 16 manifolds)
+  MultiBody,   // btMultiBodyDynamicsWorld with btMultiBodyConstraintSolver
+};
+
+// A stock Bullet world and everything it points at, destroyed in the right order.
 class World {
  public:
   // dt in seconds (default 1/60); twoFrictionDirections adds SOLVER_USE_2_FRICTION_DIRECTIONS.
-  explicit World(double dt = 1.0 / 60.0, bool twoFrictionDirections = false);
+  explicit World(double dt = 1.0 / 60.0, bool twoFrictionDirections = false,
+                 WorldKind kind = WorldKind::Discrete);
   ~World();
   World(const World&) = delete;
   World& operator=(const World&) = delete;
@@ -88,6 +100,9 @@ class World {
   std::unique_ptr<btCollisionDispatcher> dispatcher_;
   std::unique_ptr<btBroadphaseInterface> broadphase_;
   std::unique_ptr<btConstraintSolver> solver_;
+  // Solvers the world still calls after setSolver: DiscreteMt's large-island solver, and the
+  // multibody solver a MultiBody world's island callback keeps.
+  std::vector<std::unique_ptr<btConstraintSolver>> kept_;
   std::unique_ptr<btDiscreteDynamicsWorld> world_;
   std::vector<std::unique_ptr<btCollisionShape>> shapes_;
   std::vector<std::unique_ptr<btMotionState>> motion_;

@@ -30,12 +30,37 @@ void worst(StepStats& into, const StepStats& from) {
   if (into.message.empty()) into.message = from.message;
 }
 
+constexpr const char* kUnservedWorld =
+    "mlcp::bullet::ConstraintSolver: the world stepped without calling solveGroup, so this "
+    "solver solves nothing in it. A btMultiBodyDynamicsWorld solves through its "
+    "btMultiBodyConstraintSolver, which setConstraintSolver does not replace: multibody worlds "
+    "are not supported (keep Bullet's solver there). For a btDiscreteDynamicsWorldMt use "
+    "mlcp::bullet::install with a SolverPool (mlcp/bullet/worlds.hpp)";
+
 }  // namespace
+
+void accumulate(StepStats& into, const StepStats& from) {
+  into.groups += from.groups;
+  into.islands += from.islands;
+  into.rows += from.rows;
+  into.inertRows += from.inertRows;
+  into.iterations += from.iterations;
+  into.seconds += from.seconds;
+  into.measureSeconds += from.measureSeconds;
+  into.assembleSeconds += from.assembleSeconds;
+  into.fallbacks += from.fallbacks;
+  into.failures += from.failures;
+  into.choices.add(from.choices);
+  into.packedIslands += from.packedIslands;
+  worst(into, from);
+}
 
 ConstraintSolver::ConstraintSolver(const Settings& settings) : settings_(settings) {
   si_ = settings_.solver == "si";
   RowSolverSettings rs = settings_;
   if (si_) rs.solver = "pgs";  // only the fallback name is checked
+  // The same sweeps from the same start give the same answer: no second run.
+  if (settings_.engineIterations && rs.fallback == settings_.solver) rs.fallback.clear();
   try {
     auto rows = std::make_unique<RowSolver>(rs);
     if (!si_) rows_ = std::move(rows);
@@ -47,36 +72,52 @@ ConstraintSolver::ConstraintSolver(const Settings& settings) : settings_(setting
 
 ConstraintSolver::~ConstraintSolver() = default;
 
+btScalar ConstraintSolver::solveGroup(btCollisionObject** bodies, int numBodies,
+                                      btPersistentManifold** manifolds, int numManifolds,
+                                      btTypedConstraint** constraints, int numConstraints,
+                                      const btContactSolverInfo& info, btIDebugDraw* debugDrawer,
+                                      btDispatcher* dispatcher) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return btSequentialImpulseConstraintSolver::solveGroup(bodies, numBodies, manifolds, numManifolds,
+                                                         constraints, numConstraints, info,
+                                                         debugDrawer, dispatcher);
+}
+
 void ConstraintSolver::prepareSolve(int numBodies, int numManifolds) {
+  std::lock_guard<std::mutex> lock(mutex_);
   btSequentialImpulseConstraintSolver::prepareSolve(numBodies, numManifolds);
+  openStep(numBodies);
+}
+
+void ConstraintSolver::openStep(int numBodies) {
   if (stepOpen_) finishStep();
   current_ = StepStats();
   records_.clear();
   builder_.newStep();
   stepOpen_ = true;
+  stepBodies_ = numBodies;
 }
 
 void ConstraintSolver::allSolved(const btContactSolverInfo& info, btIDebugDraw* debugDrawer) {
+  std::lock_guard<std::mutex> lock(mutex_);
   btSequentialImpulseConstraintSolver::allSolved(info, debugDrawer);
+  const bool stepped = stepOpen_;
   if (stepOpen_) finishStep();
+  if (stepped) checkWorld();
+}
+
+void ConstraintSolver::checkWorld() {
+  if (!worldChecked_ && stepBodies_ > 0) {
+    worldChecked_ = true;
+    unserved_ = last_.groups == 0;
+  }
+  if (unserved_) throw std::logic_error(kUnservedWorld);
 }
 
 void ConstraintSolver::finishStep() {
   stepOpen_ = false;
   last_ = current_;
-  totals_.groups += current_.groups;
-  totals_.islands += current_.islands;
-  totals_.rows += current_.rows;
-  totals_.inertRows += current_.inertRows;
-  totals_.iterations += current_.iterations;
-  totals_.seconds += current_.seconds;
-  totals_.measureSeconds += current_.measureSeconds;
-  totals_.assembleSeconds += current_.assembleSeconds;
-  totals_.fallbacks += current_.fallbacks;
-  totals_.failures += current_.failures;
-  totals_.choices.add(current_.choices);
-  totals_.packedIslands += current_.packedIslands;
-  worst(totals_, current_);
+  accumulate(totals_, current_);
 }
 
 void ConstraintSolver::record(const Result& r, int rows, const std::string& choice) {
@@ -96,7 +137,7 @@ btScalar ConstraintSolver::solveGroupCacheFriendlyIterations(
     btIDebugDraw* debugDrawer) {
   // A caller that does not bracket steps with prepareSolve/allSolved gets one step per group.
   const bool ownStep = !stepOpen_;
-  if (ownStep) prepareSolve(numBodies, numManifolds);
+  if (ownStep) openStep(numBodies);
   current_.groups += 1;
   const double t0 = nowSeconds();
   const BulletRows rows{
@@ -116,12 +157,11 @@ btScalar ConstraintSolver::solveGroupCacheFriendlyIterations(
       current_.status = Status::MaxIterations;
     }
   } else {
-    if (settings_.bulletIterations) {
+    if (settings_.engineIterations) {
       // pgs/gs as SI runs them: a fixed sweep count, the residual checked once, at the end.
       for (auto [name, options] : {std::pair(&settings_.solver, &rows_->options()),
                                    std::pair(&settings_.fallback, &rows_->fallbackOptions())})
-        if (*name == "pgs" || *name == "gs")
-          options->maxIterations = options->checkEvery = info.m_numIterations;
+        if (*name == "pgs" || *name == "gs") useEngineIterations(*options, info.m_numIterations);
     }
     const Start start = !settings_.warmStart ? Start::Zero
                         : settings_.siStart  ? Start::AppliedImpulse

@@ -51,10 +51,7 @@ bool MlcpBridge::solveMLCP(const btMatrixXu& A, const btVectorXu& b, btVectorXu&
   Options o = options_;
   o.warmStart = true;
   const std::string name = solver_->name();
-  if (bulletIterations && (name == "pgs" || name == "gs")) {
-    o.maxIterations = numIterations;
-    o.checkEvery = numIterations;
-  }
+  if (engineIterations && (name == "pgs" || name == "gs")) useEngineIterations(o, numIterations);
   solver_->setOptions(o);
   last_ = solver_->solveWithGuess(problem_, start_, answer_);
   if (!acceptable(last_, acceptResidual)) {

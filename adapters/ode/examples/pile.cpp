@@ -16,7 +16,7 @@ int main(int argc, char** argv) {
   CLI::App app{"A scene file in an ODE world; swap dWorldStep for mlcp::ode::Stepper by name."};
   std::string file = MLCP_SCENES_DIR "/sphere_pit.json", solverName;
   int steps = 0, every = 50;
-  mlcp::ode::StepperOptions options;
+  mlcp::ode::Settings options;
   app.add_option("--scene", file, "mlcp-scene/1 file")->capture_default_str();
   app.add_option("--solver", solverName,
                  "dWorldStep (or ode-world) and dWorldQuickStep (or ode-quick) for ODE's stock "
@@ -24,9 +24,9 @@ int main(int argc, char** argv) {
                      mlcp::ode::Stepper::knownSolvers() + " (default: the scene's)");
   app.add_option("--steps", steps, "steps of the scene's time step (default: the scene's)");
   app.add_option("--every", every, "print statistics every this many steps")->capture_default_str();
-  app.add_option("--tolerance", options.solver.tolerance,
+  app.add_option("--tolerance", options.options.tolerance,
                  "core solver tolerance (default: the scene's)");
-  app.add_option("--max-iterations", options.solver.maxIterations,
+  app.add_option("--max-iterations", options.options.maxIterations,
                  "core solver iterations (default: the scene's)");
   app.add_option("--fallback", options.fallback, "fallback core solver, '' for none")
       ->capture_default_str();
@@ -43,8 +43,9 @@ int main(int argc, char** argv) {
     const mlcp::scene::RunSettings run = mlcp::scene::RunSettings::fromScene(scene);
     if (solverName.empty()) solverName = run.solver;
     if (steps <= 0) steps = scene.settings.steps;
-    if (!app.count("--tolerance")) options.solver.tolerance = run.tolerance;
-    if (!app.count("--max-iterations")) options.solver.maxIterations = run.iterations;
+    if (!app.count("--tolerance")) options.options.tolerance = run.tolerance;
+    if (!app.count("--max-iterations")) options.options.maxIterations = run.iterations;
+    options.engineIterations = false;  // the scene's limit and tolerance, as `mlcp run`
     options.warmStart = run.warmStart;
     h = scene.settings.timeStep;
 

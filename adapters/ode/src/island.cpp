@@ -405,20 +405,20 @@ namespace {
 // Stage 5 with ODE's own solver or a core one (RowSolver: choice, verification, fallback).
 // Nothing usable leaves the start (the caller's warm start), as RowSolver does.
 IslandSolve solveWith(Method& method, IslandWork& w, int nub, dxWorldProcessMemArena* arena,
-                      const StepperOptions& so, std::uint64_t key, Vector& x) {
+                      const Settings& so, const Options& options, std::uint64_t key, Vector& x) {
   if (method.kind == Method::Kind::Core) {
-    method.solver->options() = so.solver;
+    method.solver->options() = options;
     return method.solver->solve(w.rows, w.x0, x, key);
   }
   IslandSolve out;
   out.problemClass = classify(w.rows);
   out.choice = out.requested = method.name;
   if (method.kind == Method::Kind::OdeLcp) {
-    out.result = solveWithOdeLcp(w, nub, arena, so.solver, x);
+    out.result = solveWithOdeLcp(w, nub, arena, options, x);
     out.accepted = acceptable(out.result, so.acceptResidual);
     if (!x.allFinite()) {
       x = w.x0;
-      applyAccuracy(out.result, islandAccuracy(w.rows, x), so.solver.tolerance);
+      applyAccuracy(out.result, islandAccuracy(w.rows, x), options.tolerance);
       out.result.message += "; start kept";
     }
     return out;
@@ -487,7 +487,8 @@ void mlcp::ode::Stepper::Impl::runIsland(const dxStepperProcessingCallContext* c
     const std::uint64_t key = reinterpret_cast<std::uintptr_t>(body[0]);
     // The solve's own clock (RowSolver::solve's span, or solveWithOdeLcp's): no second pair of
     // clock reads around it.
-    IslandSolve solved = solveWith(primary, w, nub, ctx->m_stepperArena, options, key, w.x);
+    IslandSolve solved =
+        solveWith(primary, w, nub, ctx->m_stepperArena, options, stepOptions, key, w.x);
     st.solveSeconds = solved.result.seconds;
     st.status = solved.result.status;
     st.iterations = solved.result.iterations;
@@ -500,7 +501,7 @@ void mlcp::ode::Stepper::Impl::runIsland(const dxStepperProcessingCallContext* c
     if (hasReference) {
       const double tr = nowSeconds();
       const IslandSolve rr =
-          solveWith(reference, w, nub, ctx->m_stepperArena, options, key, w.xAlt);
+          solveWith(reference, w, nub, ctx->m_stepperArena, options, stepOptions, key, w.xAlt);
       st.referenceSeconds = nowSeconds() - tr;
       if (std::isfinite(rr.result.residual) && w.xAlt.size() == m) {
         st.referenceResidual = rr.result.residual;

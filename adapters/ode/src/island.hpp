@@ -97,13 +97,16 @@ struct IslandWork {
 
 struct mlcp::ode::Stepper::Impl {
   std::string name;
-  StepperOptions options;
+  Settings options;
+  // This step's options of the primary (and reference): options.options, with the world's
+  // QuickStep count and factor for pgs/gs under engineIterations (beginStep).
+  Options stepOptions;
   Method primary, reference;
   bool hasReference = false;
   StepStats stats;
   WarmStartCache warm;
   IslandWork work;
-  // StepperOptions::keepProblems: this step's islands, and last step's entries whose buffers
+  // Settings::keepProblems: this step's islands, and last step's entries whose buffers
   // the island workspace takes in turn.
   std::vector<IslandProblem> problems, spareProblems;
   std::mutex mutex;  // islands may run on ODE's worker threads
@@ -114,6 +117,8 @@ struct mlcp::ode::Stepper::Impl {
                                 unsigned nj);
   static unsigned estimateMaxCallCount(unsigned activeThreads, unsigned allowedThreads);
 
+  // The step's options from the settings and the world (engineIterations).
+  void beginStep(dxWorld* world);
   void runIsland(const dxStepperProcessingCallContext* context);
   // Swaps the island's rows and answer into a kept IslandProblem (after integration).
   void keepProblem(IslandWork& w, int island);

@@ -52,9 +52,10 @@ class OdeWorld : public scene::World {
       throw std::invalid_argument("unknown solver '" + run.solver +
                                   "' for ODE (known: " + worldSolverNames() + ")");
     }
-    StepperOptions options;
-    options.solver.maxIterations = run.iterations;
-    options.solver.tolerance = run.tolerance;
+    Settings options;
+    options.options.maxIterations = run.iterations;
+    options.options.tolerance = run.tolerance;
+    options.engineIterations = run.engineIterations;  // QuickStep iterations: run.iterations
     options.warmStart = run.warmStart;
     options.fallback = run.fallback;  // the stepper never falls back from "ode-..."
     options.acceptResidual = run.fallbackResidual;

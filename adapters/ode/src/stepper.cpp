@@ -49,6 +49,11 @@ class ActiveScope {
   const dxWorld* world_;
 };
 
+Settings withSolver(Settings settings, const std::string& solver) {
+  settings.solver = solver;
+  return settings;
+}
+
 unsigned sureMaxRows(dxJoint* const* joint, unsigned nj) {
   unsigned m = 0;
   for (unsigned k = 0; k < nj; ++k) {
@@ -93,22 +98,22 @@ int StepStats::maxIterations() const {
 
 std::string Stepper::knownSolvers() { return solverNames() + ", ode-step, ode-quickstep, ode-lcp"; }
 
-Stepper::Stepper(const std::string& solver, const StepperOptions& options)
-    : impl_(std::make_unique<Impl>()) {
-  impl_->name = solver;
+Stepper::Stepper(const std::string& solver, Settings settings)
+    : Stepper(withSolver(std::move(settings), solver)) {}
+
+Stepper::Stepper(const Settings& options) : impl_(std::make_unique<Impl>()) {
+  impl_->name = options.solver;
   impl_->options = options;
-  RowSolverSettings rs;
-  rs.options = options.solver;
-  rs.fallback = options.fallback;
-  rs.fallbackOptions = options.fallbackOptions;
-  rs.acceptResidual = options.acceptResidual;
-  rs.denseMaxRows = options.denseMaxRows;
+  impl_->stepOptions = options.options;
+  RowSolverSettings rs = options;
   if (!options.fallback.empty() && !RowSolver::known(options.fallback))
     throw std::invalid_argument("mlcp::ode::Stepper: fallback '" + options.fallback +
                                 "' is not a core solver (known: " + solverNames() + ")");
+  // The same sweeps from the same start give the same answer: no second run.
+  if (options.engineIterations && rs.fallback == rs.solver) rs.fallback.clear();
   // ODE's own solvers ("ode-...") are there to reproduce stock ODE, answers and all: they never
   // fall back.
-  impl_->primary = makeMethod(solver, rs);
+  impl_->primary = makeMethod(options.solver, rs);
   if (!options.reference.empty()) {
     // The reference only measures: no fallback, every answer kept.
     RowSolverSettings ref = rs;
@@ -125,8 +130,9 @@ Stepper::Stepper(const std::string& solver, const StepperOptions& options)
 Stepper::~Stepper() = default;
 
 const std::string& Stepper::solverName() const { return impl_->name; }
-const StepperOptions& Stepper::options() const { return impl_->options; }
-mlcp::Options& Stepper::solverOptions() { return impl_->options.solver; }
+const Settings& Stepper::settings() const { return impl_->options; }
+mlcp::Options& Stepper::solverOptions() { return impl_->options.options; }
+mlcp::Options& Stepper::fallbackOptions() { return impl_->options.fallbackOptions; }
 const StepStats& Stepper::lastStep() const { return impl_->stats; }
 const std::vector<IslandProblem>& Stepper::lastProblems() const { return impl_->problems; }
 void Stepper::resetWarmStart() { impl_->warm.clear(); }
@@ -143,6 +149,7 @@ bool Stepper::step(dWorldID world, dReal h) {
     std::move(impl_->problems.rbegin(), impl_->problems.rend(), std::back_inserter(spare));
     impl_->problems.clear();
   }
+  impl_->beginStep(world);
   ActiveScope scope(world, impl_.get());
   // dWorldStep's two calls, with our estimator and island stepper.
   dxWorldProcessIslandsInfo islands;
@@ -151,6 +158,20 @@ bool Stepper::step(dWorldID world, dReal h) {
   impl_->warm.endStep();
   impl_->stats.seconds = nowSeconds() - t0;
   return ok;
+}
+
+void Stepper::Impl::beginStep(dxWorld* world) {
+  const auto iterative = [](const std::string& name) { return name == "pgs" || name == "gs"; };
+  const auto engine = [&](Options o, const std::string& name) {
+    if (options.engineIterations && iterative(name)) {
+      useEngineIterations(o, dWorldGetQuickStepNumIterations(world));
+      o.relaxation = dWorldGetQuickStepW(world);
+    }
+    return o;
+  };
+  stepOptions = engine(options.options, options.solver);
+  if (RowSolver* rows = primary.solver.get())
+    rows->fallbackOptions() = engine(options.fallbackOptions, options.fallback);
 }
 
 void Stepper::Impl::stepIsland(const dxStepperProcessingCallContext* context) {

@@ -55,19 +55,50 @@ namespace mlcp {
 inline constexpr double kDefaultAcceptResidual = 1e-3;
 // Largest island assembled dense for matrix-based solvers, in rows. Default 64.
 inline constexpr int kDefaultDenseMaxRows = 64;
+// The scaled natural-map residual an island's solve aims at by default, dimensionless: 1e-6 is
+// an impulse error of a millionth of the island's largest velocity-error term, far below what a
+// step's motion shows, and what exact solvers reach in a few pivots or Newton steps. Core's
+// 1e-10 is a solver test's target: on engine rows (redundant friction, cfm-regularised contacts)
+// dantzig can stall above it (ODE's tank-track rows stop at 1.6e-7) and every step then runs
+// its full pivot and friction-pass limits (330x dWorldStep's time there).
+inline constexpr double kDefaultIslandTolerance = 1e-6;
+// Sweep limit of a pgs/gs fallback when the engine's iteration count is not used
+// (RowSolverSettings::engineIterations false): 100 sweeps, 10x Bullet's and 5x ODE QuickStep's
+// default cost, is what a rejected answer may cost at most by default (core's 1000 would cost
+// 100x SI per rejected island).
+inline constexpr int kDefaultFallbackSweeps = 100;
 
+// Options with the islands' default tolerance (kDefaultIslandTolerance), core defaults otherwise.
+inline Options islandOptions() {
+  Options o;
+  o.tolerance = kDefaultIslandTolerance;
+  return o;
+}
+
+// The fallback's default options: islandOptions() with at most kDefaultFallbackSweeps sweeps.
+inline Options fallbackIslandOptions() {
+  Options o = islandOptions();
+  o.maxIterations = kDefaultFallbackSweeps;
+  return o;
+}
+
+// The island solver's settings, the one shape both adapters' settings derive from
+// (mlcp::bullet::Settings, mlcp::ode::Settings).
 struct RowSolverSettings {
   // A registry name (mlcp::solverNames(), "a>b" chains included), "auto" (chooseSolver per
   // island) or "pgs" (RowPgs on the rows). Default "auto".
   std::string solver = "auto";
   // Options of the primary (tolerance, iteration and pivot limits, ...). warmStart is ignored:
-  // every solve starts from the caller's start. Default: core defaults.
-  Options options;
+  // every solve starts from the caller's start. Default islandOptions(): tolerance 1e-6
+  // (kDefaultIslandTolerance), core defaults otherwise.
+  Options options = islandOptions();
   // Solver run when the primary's answer is rejected (any name `solver` accepts except
   // "auto"), "" for none. Default "pgs".
   std::string fallback = "pgs";
-  // Options of the fallback. Default: core defaults (tolerance 1e-10, 1000 sweeps).
-  Options fallbackOptions;
+  // Options of the fallback. Default fallbackIslandOptions(): tolerance 1e-6, at most 100
+  // sweeps (kDefaultFallbackSweeps); with engineIterations a pgs/gs fallback runs the engine's
+  // count instead.
+  Options fallbackOptions = fallbackIslandOptions();
   // Largest accepted scaled natural-map residual (dimensionless); +inf accepts any finite
   // answer. Default kDefaultAcceptResidual (1e-3).
   double acceptResidual = kDefaultAcceptResidual;
@@ -79,7 +110,22 @@ struct RowSolverSettings {
   // island, ~70 ns on a virtual machine against ~1 us for a 6-row island's whole solve. When
   // false assembleSeconds stays 0. Default true.
   bool timeAssembly = true;
+  // Read by the adapters (RowSolver knows no engine): pgs and gs, as primary or fallback, run
+  // the engine's own iteration count, with the residual checked once at the end, instead of
+  // maxIterations sweeps toward the tolerance: Bullet's btContactSolverInfo::m_numIterations
+  // (10 by default), ODE's dWorldGetQuickStepNumIterations (20) with dWorldGetQuickStepW (1.3)
+  // as the relaxation. A drop-in pgs then costs what the engine's own solver costs (core's
+  // 1000 sweeps toward 1e-10 cost 7-108x SI per step on Bullet's demos); a fallback of the
+  // primary's own name is not run (the same sweeps from the same start give the same answer).
+  // Set false (and options.maxIterations) for more accuracy. Default true.
+  bool engineIterations = true;
 };
+
+// Sets options' sweep limit to an engine's iteration count, checked once at the end.
+// A count below 1 is taken as 1.
+inline void useEngineIterations(Options& options, int iterations) {
+  options.maxIterations = options.checkEvery = iterations < 1 ? 1 : iterations;
+}
 
 // The verification every answer passes (see stage 4 above): finite residual <= acceptResidual
 // and a status other than Failed, NumericalIssue, InvalidInput, Unsupported.

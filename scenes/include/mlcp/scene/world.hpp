@@ -51,6 +51,11 @@ struct RunSettings {
   // is above this goes to the fallback; the better answer is kept). Default 1e-3, the adapters'
   // mlcp::kDefaultAcceptResidual; +inf accepts any finite answer.
   double fallbackResidual = kDefaultAcceptResidual;
+  // pgs/gs run exactly `iterations` sweeps, the residual checked once at the end, as the
+  // engine's own solver runs its iteration count (RowSolverSettings::engineIterations, the
+  // adapters' default for a drop-in; the loaders give the engine the same count). Default
+  // false: a scene run sweeps toward `tolerance` within `iterations`.
+  bool engineIterations = false;
 
   static RunSettings fromScene(const Scene& scene);
 };

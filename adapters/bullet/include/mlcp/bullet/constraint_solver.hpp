@@ -79,11 +79,29 @@
 // (docs/benchmarks.md, "Bullet: pgs against SI").
 //
 // "si" runs Bullet's own SI iterations instead (for side-by-side runs with the same statistics).
+//
+// Worlds served. A btDiscreteDynamicsWorld (and btSoftRigidDynamicsWorld) through
+// setConstraintSolver; a btDiscreteDynamicsWorldMt through mlcp::bullet::install with a
+// SolverPool (mlcp/bullet/worlds.hpp): its large islands go to a second solver slot that
+// setConstraintSolver does not reach. A btMultiBodyDynamicsWorld is refused: it solves through
+// its btMultiBodyConstraintSolver and never calls this solver's solveGroup. A world that steps
+// (prepareSolve with bodies, then allSolved) without one solveGroup call is taken to be such a
+// world: allSolved throws std::logic_error then and at every later step, so the swap never
+// silently does nothing (a btDiscreteDynamicsWorld always calls solveGroup at least once a
+// step, even for a group without rows). The check runs at the first step with bodies; solvers
+// installed by install() (which checks the world itself) and the members of a SolverPool skip
+// it.
+//
+// Threads. solveGroup, prepareSolve and allSolved hold a mutex: one solver called from several
+// threads at once (a btDiscreteDynamicsWorldMt under a threaded task scheduler, when one
+// instance fills both of its slots) solves one group at a time, correctly. For groups solved in
+// parallel give each thread its own instance: SolverPool.
 #pragma once
 
 #include <BulletDynamics/ConstraintSolver/btSequentialImpulseConstraintSolver.h>
 
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -92,6 +110,8 @@
 #include "mlcp/row_solver.hpp"
 #include "mlcp/rows.hpp"
 #include "mlcp/solver.hpp"
+
+class btDiscreteDynamicsWorld;
 
 namespace mlcp::bullet {
 
@@ -111,14 +131,13 @@ enum class CfmModel {
   StockMlcp,
 };
 
-// The island solver's settings (mlcp::RowSolverSettings: solver "auto", options, fallback "pgs",
-// fallbackOptions, acceptResidual 1e-3, denseMaxRows 64; documented in mlcp/row_solver.hpp,
-// the same defaults as the ODE adapter's), plus Bullet's own. `solver` may also be "si":
-// Bullet's own sequential impulse iterations. options.warmStart is governed by warmStart below.
+// The island solver's settings (mlcp::RowSolverSettings: solver "auto", options with tolerance
+// 1e-6, fallback "pgs" with at most 100 sweeps, acceptResidual 1e-3, denseMaxRows 64,
+// engineIterations; documented in mlcp/row_solver.hpp, the shape the ODE adapter's settings
+// share), plus Bullet's own. `solver` may also be "si": Bullet's own sequential impulse
+// iterations. engineIterations (default true) gives pgs/gs btContactSolverInfo::m_numIterations
+// sweeps, as SI and the stock MLCP solvers run. options.warmStart is governed by warmStart below.
 struct Settings : RowSolverSettings {
-  // pgs/gs take their sweep count from btContactSolverInfo::m_numIterations (as SI and the stock
-  // MLCP solvers do) instead of options.maxIterations. Default false.
-  bool bulletIterations = false;
   // Start every solve from last step's impulses (stage 4 below). Default true.
   bool warmStart = true;
   // With warmStart: start contacts and friction where SI starts them, from the cached impulse
@@ -169,6 +188,15 @@ struct StepStats {
   int packedIslands = 0;       // of `islands`: "pgs" answers packed straight from Bullet's rows
 };
 
+// Adds `from`'s counts and times to `into`; keeps the worst residual and status, and the first
+// message.
+void accumulate(StepStats& into, const StepStats& from);
+
+class SolverPool;
+class ConstraintSolver;
+// Puts the solver in every solver slot of the world, or refuses the world (mlcp/bullet/worlds.hpp).
+void install(btDiscreteDynamicsWorld& world, ConstraintSolver& solver);
+
 class ConstraintSolver : public btSequentialImpulseConstraintSolver {
  public:
   // Throws std::invalid_argument with the list of valid names for an unknown solver/fallback.
@@ -189,7 +217,13 @@ class ConstraintSolver : public btSequentialImpulseConstraintSolver {
     return rows_.get();
   }
 
+  // Serialized by the solver's mutex (see "Threads" above).
+  btScalar solveGroup(btCollisionObject** bodies, int numBodies, btPersistentManifold** manifolds,
+                      int numManifolds, btTypedConstraint** constraints, int numConstraints,
+                      const btContactSolverInfo& info, btIDebugDraw* debugDrawer,
+                      btDispatcher* dispatcher) override;
   void prepareSolve(int numBodies, int numManifolds) override;
+  // Throws std::logic_error when the world does not call solveGroup (see "Worlds served").
   void allSolved(const btContactSolverInfo& info, btIDebugDraw* debugDrawer) override;
 
  protected:
@@ -209,7 +243,14 @@ class ConstraintSolver : public btSequentialImpulseConstraintSolver {
   void applyPerRow(Island& island, const Vector& x, bool split);
   void measureSi(int sweeps);
   void record(const Result& r, int rows, const std::string& choice);
+  // prepareSolve's and allSolved's work, with the mutex held by the caller.
+  void openStep(int numBodies);
   void finishStep();
+  // The world check of "Worlds served": throws once the world has stepped without solveGroup.
+  void checkWorld();
+
+  friend class SolverPool;
+  friend void install(btDiscreteDynamicsWorld& world, ConstraintSolver& solver);
 
   Settings settings_;
   std::unique_ptr<RowSolver> rows_;
@@ -224,6 +265,10 @@ class ConstraintSolver : public btSequentialImpulseConstraintSolver {
   bool stepOpen_ = false;
   std::vector<IslandRecord> records_;
   Vector x_;
+  std::mutex mutex_;
+  int stepBodies_ = 0;         // prepareSolve's numBodies of the open step
+  bool worldChecked_ = false;  // the check ran (or install()/SolverPool made it unneeded)
+  bool unserved_ = false;      // the world stepped without calling solveGroup
 };
 
 }  // namespace mlcp::bullet

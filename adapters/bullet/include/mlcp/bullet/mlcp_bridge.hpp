@@ -28,7 +28,8 @@ namespace mlcp::bullet {
 class MlcpBridge : public btMLCPSolverInterface {
  public:
   // Throws std::invalid_argument (listing the valid names) for an unknown solver name.
-  explicit MlcpBridge(const std::string& solver, const Options& options = Options());
+  // Default options: islandOptions() (tolerance 1e-6, mlcp/row_solver.hpp), as the drop-in's.
+  explicit MlcpBridge(const std::string& solver, const Options& options = islandOptions());
 
   Solver& solver() { return *solver_; }
   // Largest accepted scaled residual (dimensionless). Default mlcp::kDefaultAcceptResidual.
@@ -36,9 +37,10 @@ class MlcpBridge : public btMLCPSolverInterface {
   // Problems with more rows than this are converted to sparse storage (dropping A's zeros).
   // Default mlcp::kDefaultDenseMaxRows (64).
   int denseMaxRows = kDefaultDenseMaxRows;
-  // pgs/gs take their sweep count from the numIterations argument (as the stock PGS does).
-  // Default false.
-  bool bulletIterations = false;
+  // pgs/gs take their sweep count from the numIterations argument (as the stock PGS does),
+  // checked once at the end, instead of the options' limit (RowSolverSettings::engineIterations
+  // says why). Default true.
+  bool engineIterations = true;
 
   // The last call's result, and counts over all calls.
   const Result& lastResult() const { return last_; }

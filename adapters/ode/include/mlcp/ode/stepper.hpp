@@ -3,6 +3,12 @@
 //     mlcp::ode::Stepper stepper;               // "auto", or "dantzig", "pgs", ... by name
 //     stepper.step(world, h);                   // instead of dWorldStep(world, h)
 //
+//     mlcp::ode::Settings s;                    // the shape of mlcp::bullet::Settings
+//     s.solver = "pgs";                         // by default: the world's QuickStep
+//     mlcp::ode::Stepper quick(s);              // iterations and W, dWorldQuickStep's cost
+//
+// From C: mlcp/ode/stepper.h (every setting, errors as return codes, no exceptions).
+//
 // How it plugs in. dWorldStep is two calls into ODE's world processing:
 // dxReallocateWorldProcessContext (auto-disabling, islands, arena sized by a memory estimator)
 // then dxProcessIslands, which calls an island stepper of type dstepper_fn_t once per island.
@@ -55,30 +61,21 @@
 
 namespace mlcp::ode {
 
-struct StepperOptions {
-  // Options of the core solver (tolerance, maxIterations, relaxation, frictionBounds, ...); see
-  // mlcp/result.hpp. warmStart there is ignored: warmStart below decides.
-  mlcp::Options solver;
+// The stepper's settings: the island solver's (mlcp::RowSolverSettings, the shape the Bullet
+// adapter's settings share: solver "auto", options with tolerance 1e-6, fallback "pgs" with at
+// most 100 sweeps, acceptResidual 1e-3, denseMaxRows 64, engineIterations; documented in
+// mlcp/row_solver.hpp), plus ODE's own. `solver` may also name one of ODE's own solvers
+// ("ode-step", "ode-quickstep", "ode-lcp"; they never fall back). options.warmStart is ignored:
+// warmStart below decides. engineIterations (default true) gives pgs/gs the world's QuickStep
+// settings at every step: dWorldGetQuickStepNumIterations sweeps (20 by default) with
+// dWorldGetQuickStepW (1.3) as the relaxation, the cost of dWorldQuickStep's solve.
+struct Settings : RowSolverSettings {
   // Start each island's solve from the last step's lambda of the same joints. Default true.
   bool warmStart = true;
   // A contact of the last step warm-starts a contact of this step when both join the same two
   // bodies, have the same rank among that pair's contacts, and their positions are closer
   // than this distance (in ODE's length unit, m). Default 0.05.
   double contactMatchDistance = 0.05;
-  // Islands with at most this many rows give matrix-based solvers (all but "pgs") a dense A,
-  // larger ones a sparse A. Default mlcp::kDefaultDenseMaxRows (64).
-  int denseMaxRows = kDefaultDenseMaxRows;
-  // Core solver run when the primary's answer is rejected (mlcp::acceptable: not finite,
-  // Failed, NumericalIssue, InvalidInput, Unsupported, or residual above acceptResidual); the
-  // better of the two answers is applied. "" disables the fallback; "ode-..." primaries never
-  // fall back. Default "pgs".
-  std::string fallback = "pgs";
-  // Options of the fallback. Default: core defaults (tolerance 1e-10, 1000 sweeps).
-  mlcp::Options fallbackOptions;
-  // Largest accepted scaled natural-map residual (mlcp/residual.hpp), dimensionless; +inf
-  // accepts any finite answer. Default mlcp::kDefaultAcceptResidual (1e-3), as in the Bullet
-  // adapter.
-  double acceptResidual = kDefaultAcceptResidual;
   // Diagnostics: a second solver (any name the stepper accepts except the forwarding ones) run
   // on the same island problem after the primary; its residual and time go to IslandStats,
   // its answer is discarded. "" for none. Default "".
@@ -92,6 +89,8 @@ struct StepperOptions {
   // solvers ("ode-step", "ode-quickstep"). Default false.
   bool keepProblems = false;
 };
+// The name the stepper's settings had before they shared RowSolverSettings.
+using StepperOptions = Settings;
 
 struct IslandStats {
   int bodies = 0;
@@ -110,14 +109,14 @@ struct IslandStats {
   bool warmStarted = false;
   double solveSeconds = 0;                  // the solver(s) only
   double islandSeconds = 0;                 // the whole island, rows to integration
-  double referenceResidual = kNotComputed;  // StepperOptions::reference's answer
+  double referenceResidual = kNotComputed;  // Settings::reference's answer
   // max_i |x_ref,i - x_i| / (1 + max_i |x_i|): how far the reference's lambda is from the
   // applied one, relative to the largest constraint force.
   double referenceDifference = kNotComputed;
   double referenceSeconds = 0;
 };
 
-// One island's problem as the solver received it (StepperOptions::keepProblems).
+// One island's problem as the solver received it (Settings::keepProblems).
 struct IslandProblem {
   int island = 0;  // index in StepStats::islands
   // w = (J M^-1 J^T + diag(cfm)) x + b, lo <= x <= hi, findex island-global: stages 1-3's rows,
@@ -149,9 +148,11 @@ struct StepStats {
 
 class Stepper {
  public:
-  // Throws std::invalid_argument naming the known solvers when `solver` (or options.fallback,
-  // options.reference) is not a name the stepper knows.
-  explicit Stepper(const std::string& solver = "auto", const StepperOptions& options = {});
+  // Throws std::invalid_argument naming the known solvers when settings.solver (or fallback,
+  // reference) is not a name the stepper knows, or for a negative or NaN acceptResidual.
+  explicit Stepper(const Settings& settings);
+  // The same with settings.solver replaced by `solver`.
+  explicit Stepper(const std::string& solver = "auto", Settings settings = {});
   ~Stepper();
   Stepper(const Stepper&) = delete;
   Stepper& operator=(const Stepper&) = delete;
@@ -161,12 +162,16 @@ class Stepper {
   bool step(dWorldID world, dReal h);
 
   const std::string& solverName() const;
-  const StepperOptions& options() const;
-  // The core solver's options (StepperOptions::solver), adjustable between steps.
+  const Settings& settings() const;
+  const Settings& options() const { return settings(); }
+  // The core solver's options (Settings::options), adjustable between steps (with
+  // engineIterations on, pgs/gs take the world's QuickStep count and factor at every step).
   mlcp::Options& solverOptions();
+  // The fallback's options (Settings::fallbackOptions), adjustable between steps.
+  mlcp::Options& fallbackOptions();
   // Statistics of the last step (cleared at the start of each step).
   const StepStats& lastStep() const;
-  // The islands with rows of the last step, in step order, when StepperOptions::keepProblems
+  // The islands with rows of the last step, in step order, when Settings::keepProblems
   // is set (empty otherwise; replaced at the start of each step).
   const std::vector<IslandProblem>& lastProblems() const;
   // Forget the warm-start cache (e.g. after teleporting bodies).
