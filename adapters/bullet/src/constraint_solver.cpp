@@ -76,6 +76,7 @@ void ConstraintSolver::finishStep() {
   totals_.failures += current_.failures;
   totals_.choices.add(current_.choices);
   totals_.packedIslands += current_.packedIslands;
+  totals_.screened.add(current_.screened);
   worst(totals_, current_);
 }
 
@@ -234,6 +235,7 @@ void ConstraintSolver::solveIsland(Island& island, std::uint64_t key, bool split
   const Result& result = solved.result;
   current_.assembleSeconds += solved.assembleSeconds;
   current_.fallbacks += solved.fellBack;
+  current_.screened.add(solved.screened);
   current_.failures += !solved.accepted;
   if (current_.message.empty() && (solved.fellBack || !solved.accepted))
     current_.message = result.message;
