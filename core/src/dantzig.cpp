@@ -43,6 +43,11 @@ void preSweeps(const Problem& problem, int sweeps, Vector& x) {
 
 }  // namespace
 
+// runPivoting's retry of a breakdown adds kRegularization * max |A_ii| to A's diagonal: on
+// Bullet's redundant bridge (two ball joints per hinge line) 1e-10 left a residual of 3-5e-8 on
+// A, 1e-8 of 3-7e-7, 1e-6 of 2-7e-5 (the drift between redundant rows stays either way).
+constexpr double kRegularization = 1e-10;
+
 struct DantzigSolver::Workspace {
   // ---- the problem in processing order: position p holds the caller's row perm[p] ----
   int n = 0;
@@ -57,6 +62,14 @@ struct DantzigSolver::Workspace {
   std::vector<int> frictionRows;
   DenseMatrix histG, histF;  // Anderson history of the friction fixed point (columns)
   double pivTol = 0, epsW = 0, aMax = 0;
+  // Rows nothing limits whose w is 0 (a zero Schur pivot: A singular, e.g. redundant joints)
+  // stay free at their value; redundant counts them for the message.
+  int redundant = 0;
+  // Added to A's diagonal after build() (0: none). runPivoting sets it for its one retry of a
+  // pivoting that broke down on a singular A: A + shift I is positive definite, its answer
+  // solves A's (consistent, or nearly: engines' drift) system up to ~shift |x|.
+  double shift = 0, scale = 0;
+  Vector guess;  // the caller's start, for that retry
 
   // ---- index sets and the factors A_CC = L D U (U = L^T when symmetric) ----
   int m = 0;
@@ -248,6 +261,12 @@ struct DantzigSolver::Workspace {
     slot[p] = static_cast<int>(N.size());
     N.push_back(p);
   }
+  // p is in N (at a bound, or free) and its w breaks that set's sign condition; false for rows
+  // in C (Set::Clamped) and fixed rows.
+  bool violates(int p) const {
+    return (set[p] == Set::AtLo && w[p] < -epsW) || (set[p] == Set::AtHi && w[p] > epsW) ||
+           (set[p] == Set::Free && std::abs(w[p]) > epsW);
+  }
   void leaveN(int k) {
     const int last = N.back();
     N[k] = last;
@@ -271,6 +290,9 @@ struct DantzigSolver::Workspace {
   }
   void setFrictionBounds(const Vector& nu);
   void gatherNormals(Vector& g) const;
+  // A += delta I in the workspace's copies of A. False when a sparse A stores no diagonal entry
+  // for some row (nothing changed then).
+  bool shiftDiagonal(double delta);
   Outcome fail(const std::string& why) {
     message = why;
     return Outcome::Failed;
@@ -356,6 +378,7 @@ void DantzigSolver::Workspace::build(const Problem& pb, const Vector& guess, boo
   for (int p = 0; p < n; ++p) dMax = std::max(dMax, std::abs(diag[p]));
   const double scale = dMax > 0 ? dMax : (aMax > 0 ? aMax : 1.0);
   pivTol = scale;  // multiplied by Options::pivotTolerance in run()
+  this->scale = scale;
   const double bNorm = n ? pb.b.lpNorm<Eigen::Infinity>() : 0.0;
   epsW = 1e-12 * (1.0 + bNorm);
   const size_t nn = size_t(n) * n;
@@ -535,6 +558,7 @@ Outcome DantzigSolver::Workspace::drive(int i) {
     if (kind == Block::None) {
       clearDx();
       if (std::abs(wi) <= epsW) {  // a redundant row: its w is 0 and stays 0 along the ray
+        ++redundant;
         joinN(i, Set::Free);
         return Outcome::Done;
       }
@@ -626,6 +650,7 @@ bool DantzigSolver::Workspace::bulk(bool reuseFactors) {
 
 Outcome DantzigSolver::Workspace::pass(bool fixedOnce, bool reuseFactors) {
   N.clear();
+  redundant = 0;
   span = 0;
   if (reuseFactors) std::fill(set.begin(), set.end(), Set::Unprocessed);
   for (int p = 0; p < n; ++p) x[p] = std::clamp(x[p], lo[p], hi[p]);
@@ -669,20 +694,43 @@ Outcome DantzigSolver::Workspace::finish() {
     solveClamped();
     freshW();
     violators.clear();
-    for (int p : N) {
-      const bool bad = (set[p] == Set::AtLo && w[p] < -epsW) ||
-                       (set[p] == Set::AtHi && w[p] > epsW) ||
-                       (set[p] == Set::Free && std::abs(w[p]) > epsW);
-      if (bad) violators.push_back(p);
-    }
+    for (int p : N)
+      if (violates(p)) violators.push_back(p);
     if (violators.empty()) return Outcome::Done;
     for (int p : violators) {
+      // Driving an earlier violator may have moved this one: into C (its w reached 0 along
+      // that ray, at once when the ray pushes its w further the wrong way), or to a w that now
+      // satisfies its set. Only a row still in N and still violating leaves N here.
+      if (!violates(p)) continue;
       leaveN(slot[p]);
       const Outcome o = drive(p);
       if (o != Outcome::Done) return o;
     }
   }
   return Outcome::Done;
+}
+
+bool DantzigSolver::Workspace::shiftDiagonal(double delta) {
+  if (sparse) {
+    for (int p = 0; p < n; ++p) {
+      bool stored = false;
+      for (int k = rowPtr[p]; k < rowPtr[p + 1]; ++k) stored |= rowIdx[k] == p;
+      if (!stored) return false;
+    }
+    for (int p = 0; p < n; ++p)
+      for (int k = rowPtr[p]; k < rowPtr[p + 1]; ++k)
+        if (rowIdx[k] == p) rowVal[k] += delta;
+    if (!symmetric)
+      for (int q = 0; q < n; ++q)
+        for (int k = colPtr[q]; k < colPtr[q + 1]; ++k)
+          if (colIdx[k] == q) colVal[k] += delta;
+  } else {
+    for (int p = 0; p < n; ++p) dense[p + size_t(p) * n] += delta;
+    if (!symmetric)
+      for (int p = 0; p < n; ++p) denseT[p + size_t(p) * n] += delta;
+  }
+  for (int p = 0; p < n; ++p) diag[p] += delta;
+  return true;
 }
 
 void DantzigSolver::Workspace::gatherNormals(Vector& g) const {
@@ -849,7 +897,9 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
   // FixedOnce) needed half as many pivots in all.
   const bool trustFriction = useGuess && exact && problem.hasFindex() &&
                              (fromBlock || residual(problem, x) <= kTrustedGuess);
+  if (ws.shift == 0) ws.guess = x;
   ws.build(problem, x, useGuess, trustFriction);
+  if (ws.shift > 0) ws.shiftDiagonal(ws.shift);
   ws.pivTol *= opt.pivotTolerance;
   ws.pivots = 0;
   ws.pivotLimit = opt.maxPivots > 0 ? opt.maxPivots : 50 * n + 100;
@@ -887,6 +937,23 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
     ws.pivots = 0;
     result.iterations = totalPivots;
     writeBack();
+    if (o == Outcome::Failed && ws.shift == 0) {
+      // Pivoting breaks down on a singular A (redundant joints, coplanar contacts): once more
+      // from the caller's start on A + delta I; the residual is still measured on A.
+      const std::string first = ws.message;
+      const int spent = totalPivots;
+      const double delta = kRegularization * ws.scale;
+      ws.shift = delta;
+      x = ws.guess;
+      runPivoting(problem, x, result, fromBlock);
+      ws.shift = 0;
+      result.iterations += spent;
+      std::ostringstream os;
+      os << "regularised: A + " << delta << " I after a breakdown (" << first << "); "
+         << result.message;
+      result.message = os.str();
+      return;
+    }
     if (o != Outcome::Done) {
       std::ostringstream os;
       result.status = o == Outcome::Failed       ? Status::Failed
@@ -897,17 +964,22 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
       result.message = os.str();
       return;
     }
+    // Redundant rows (a singular A) are said: their x is one of many answers.
+    const std::string singular = ws.redundant > 0 ? "; " + std::to_string(ws.redundant) +
+                                                        " redundant rows left free (A is singular)"
+                                                  : "";
     if (!friction || !exact) {
       result.status = Status::Converged;
       result.message =
-          friction ? "pivoting finished (friction bounds fixed once)" : "pivoting finished";
+          (friction ? "pivoting finished (friction bounds fixed once)" : "pivoting finished") +
+          singular;
       return;
     }
     std::ostringstream os;  // only on the friction path: its set-up costs as much as a tiny solve
     const double res = residual(problem, x);
     if (res <= opt.tolerance) {
       result.status = Status::Converged;
-      os << "friction bounds settled after " << it << " pass" << (it > 1 ? "es" : "");
+      os << "friction bounds settled after " << it << " pass" << (it > 1 ? "es" : "") << singular;
       result.message = os.str();
       return;
     }

@@ -156,6 +156,33 @@ void LdltSolver::runDense(const Problem& problem, Vector& x, Result& result) {
   }
 }
 
+namespace {
+// A singular symmetric A (redundant joints) whose system is consistent: factor A + delta I,
+// delta = kRegularization * max |A_ii|, and refine against A itself. Each refinement step
+// multiplies the error's part along an eigenvalue lambda of A by delta / (lambda + delta), so
+// the part in A's range vanishes in a few steps and the part in its null space (which changes
+// neither A x nor the bodies' motion) stays bounded. True when the factorization succeeded;
+// the base's residual check says whether the system was consistent.
+constexpr double kRegularization = 1e-9;
+constexpr int kRefinements = 8;
+
+bool solveRegularized(const Eigen::SparseMatrix<double>& A, const Vector& rhs, Vector& x) {
+  const double delta = kRegularization * std::max(1.0, A.diagonal().cwiseAbs().maxCoeff());
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> f;
+  f.setShift(delta);
+  f.compute(A);
+  if (f.info() != Eigen::Success) return false;
+  x = f.solve(rhs);
+  const double target = 1e-14 * (1 + rhs.lpNorm<Eigen::Infinity>());
+  for (int k = 0; k < kRefinements; ++k) {
+    const Vector r = rhs - A * x;
+    if (!(r.lpNorm<Eigen::Infinity>() > target)) break;
+    x += f.solve(r);
+  }
+  return x.allFinite();
+}
+}  // namespace
+
 LdltSolver::LdltSolver() : impl_(std::make_unique<Impl>()) {}
 LdltSolver::~LdltSolver() = default;
 int LdltSolver::analyses() const { return impl_->pattern.analyses(); }
@@ -209,6 +236,18 @@ void LdltSolver::run(const Problem& problem, Vector& x, Result& result) {
   m.lastSymmetric = symmetric;
   if (symmetric && !ok) ok = factorSolve(m.ldlt, true);
   if (!symmetric) ok = factorSolve(m.lu, false);
+  // A singular A factors with a (near-)zero pivot or not at all: regularised instead, and the
+  // better of the two answers kept.
+  const double target = kEnvelopeResidual * (1 + rhs.lpNorm<Eigen::Infinity>());
+  const double plain = ok ? (rhs - A * x).lpNorm<Eigen::Infinity>() : kInf;
+  Vector xr;
+  if (symmetric && !(plain <= target) && solveRegularized(A, rhs, xr) &&
+      !((rhs - A * xr).lpNorm<Eigen::Infinity>() >= plain)) {
+    x.swap(xr);
+    result.status = Status::Converged;
+    result.message = "sparse LDL^T solve of A + delta I, refined (A is singular)";
+    return;
+  }
   if (!ok) {
     result.status = Status::Failed;
     result.message = symmetric ? "LDL^T factorization failed: A is singular"

@@ -12,8 +12,11 @@
 #include "../core/src/dantzig_small.hpp"  // the tiny dense path (internal)
 #include "common/contact_scenes.hpp"
 #include "common/generators.hpp"
+#include "mlcp/io.hpp"
+#include "mlcp/ldlt.hpp"
 #include "mlcp/registry.hpp"
 #include "mlcp/residual.hpp"
+#include "mlcp/rows.hpp"
 
 namespace mlcp {
 namespace {
@@ -1173,6 +1176,70 @@ TEST(DantzigBody, RowsGiveTheAnswersOfTheProblemAlone) {
     } else {
       EXPECT_LT(inBodySpace, factorizations) << "full steps with cfm = 0 fall back";
     }
+  }
+}
+
+// finish() collects the rows of N whose sign condition drifted, then drives them one by one.
+// Driving one can move a later one into C (its w reaches 0 along that ray: at once when the ray
+// pushes it further the wrong way); removing that row from N again corrupted N (slot[] then
+// holds its place in C), and on an empty N read before N's buffer (a heap-buffer-overflow under
+// AddressSanitizer, seen on Bullet's ragdoll piles). This problem (13 rows on 4 bodies: joint,
+// contact and box rows, some rows repeated with scaled Jacobians, b from a known solution) takes
+// that path from a cold start: with the corrupted N the pivoting ended "failed" at residual
+// 1.2e-4; skipping the moved row solves it.
+TEST(Dantzig, DantzigIncrementalFinishSkipsRowsMovedByEarlierDrives) {
+  const Problem p = io::readProblemJson(std::string(MLCP_SOURCE_DIR) +
+                                        "/tests/data/dantzig_finish_moved_violator.json");
+  for (const bool sparse : {false, true}) {
+    Problem q = p;
+    if (sparse) q.setA(p.toSparse());
+    DantzigSolver s;
+    Vector x;
+    const Result r = s.solve(q, x);
+    EXPECT_TRUE(r.converged()) << toString(r.status) << " " << r.message;
+    EXPECT_LE(accuracy(q, x).residual, 1e-12);
+  }
+}
+
+// Redundant joints: a ball joint given twice (the second copy's rows scaled, as Bullet's two
+// point-to-point constraints on one hinge line repeat a direction), its rhs off by a drift of
+// 1e-9: A is singular and the system consistent up to that drift. dantzig and ldlt (sparse) answer
+// it through A + delta I and say so; the residual on A itself is at the drift's level.
+TEST(Dantzig, RedundantJointsAreSolvedRegularised) {
+  RowSystem s;
+  BodyInverseMass body;
+  body.invMass = 1;
+  body.invInertia = Eigen::Matrix3d::Identity() * 2;
+  s.bodies = {body};
+  const Eigen::Vector3d arm(0.3, 0.5, 0);
+  for (int copy = 0; copy < 2; ++copy)
+    for (int k = 0; k < 3; ++k) {
+      ConstraintRow r;
+      r.bodyA = 0;
+      const Eigen::Vector3d e = Eigen::Vector3d::Unit(k) * (copy ? 2.0 : 1.0);
+      r.jA << e, arm.cross(e);
+      s.rows.push_back(r);
+    }
+  s.b.resize(6);
+  s.b << 0.1, -0.2, 0.3, 0.2 + 1e-9, -0.4, 0.6 - 1e-9;
+  s.lo = Vector::Constant(6, -kInf);
+  s.hi = Vector::Constant(6, kInf);
+  s.cfm = Vector::Zero(6);
+  const Problem p = s.assemble(true);
+  DantzigSolver d;
+  LdltSolver l;
+  for (Solver* solver : {static_cast<Solver*>(&d), static_cast<Solver*>(&l)}) {
+    Vector x;
+    Options o;
+    o.tolerance = 1e-6;
+    solver->setOptions(o);
+    const Result r = solver->solve(p, x);
+    SCOPED_TRACE(solver->name());
+    EXPECT_TRUE(r.converged()) << toString(r.status) << " " << r.message;
+    EXPECT_LE(accuracy(p, x).residual, 1e-8);
+    const bool said = r.message.find("regularised") != std::string::npos ||
+                      r.message.find("singular") != std::string::npos;
+    EXPECT_TRUE(said) << r.message;
   }
 }
 

@@ -14,12 +14,6 @@
 namespace mlcp::ode::test {
 namespace {
 
-double maxAbsDiff(const std::vector<double>& a, const std::vector<double>& b) {
-  double d = 0;
-  for (std::size_t i = 0; i < a.size(); ++i) d = std::max(d, std::fabs(a[i] - b[i]));
-  return d;
-}
-
 std::unique_ptr<Scene> freeBodies() {
   auto s = std::make_unique<Scene>();
   dBodyID a = s->addSphereBody(0, 0, 1, 0.1, 1.0);

@@ -30,6 +30,14 @@ inline StepperOptions fixedSweepPgs(int sweeps, bool keepProblems = false) {
   return o;
 }
 
+// max_i |a_i - b_i| (Scene::state() of two worlds); +inf when the sizes differ.
+inline double maxAbsDiff(const std::vector<double>& a, const std::vector<double>& b) {
+  double d = a.size() == b.size() ? 0.0 : INFINITY;
+  for (std::size_t i = 0; i < a.size() && i < b.size(); ++i)
+    d = std::max(d, std::fabs(a[i] - b[i]));
+  return d;
+}
+
 inline void ensureOdeInitialized() {
   static const bool done = [] {
     dInitODE2(0);

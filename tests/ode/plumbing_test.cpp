@@ -39,13 +39,6 @@ struct Diff {
   int contacts = 0;  // contacts made over the run (to see the scene did what it should)
 };
 
-double maxAbsDiff(const std::vector<double>& a, const std::vector<double>& b) {
-  double d = a.size() == b.size() ? 0.0 : INFINITY;
-  for (std::size_t i = 0; i < a.size() && i < b.size(); ++i)
-    d = std::max(d, std::fabs(a[i] - b[i]));
-  return d;
-}
-
 // Runs the scene twice, stock dWorldStep against `ours`, comparing after every step.
 Diff compare(const NamedScene& scene, const StepFn& ours, int steps = 300, dReal h = 0.01) {
   auto stock = scene.make();

@@ -30,12 +30,6 @@ void run(Scene& scene, Stepper& stepper, int steps,
   }
 }
 
-double maxAbsDiff(const std::vector<double>& a, const std::vector<double>& b) {
-  double d = 0;
-  for (std::size_t i = 0; i < a.size(); ++i) d = std::max(d, std::fabs(a[i] - b[i]));
-  return d;
-}
-
 // The answers are compared through what they do to the bodies. With cfm -> 0 (ODE's default
 // world CFM in double precision is 1e-10) lambda itself is not unique (4 contacts hold a box
 // in 3 directions), but for these monotone problems w and the body forces J^T lambda are, and

@@ -158,6 +158,14 @@ btRigidBody* World::addSphere(double radius, double mass, const btVector3& posit
   return b;
 }
 
+btRigidBody* World::addShape(std::unique_ptr<btCollisionShape> shape, double mass,
+                             const btTransform& pose, double friction) {
+  btRigidBody* b =
+      addBody(*this, shapes_, motion_, bodies_, std::move(shape), mass, pose, friction, 0);
+  if (mass > 0) dynamic_.push_back(b);
+  return b;
+}
+
 btRigidBody* World::addGround(double friction, double tilt) {
   btTransform pose;
   pose.setIdentity();
@@ -254,6 +262,75 @@ void joints(World& w) {
   s->setLowerLinLimit(-1.0);
   s->setUpperLinLimit(1.0);
   w.addConstraint(std::move(s));
+}
+
+namespace {
+btTransform frame(double z, double y, double x, const btVector3& origin) {
+  btTransform t;
+  t.setIdentity();
+  t.getBasis().setEulerZYX(z, y, x);
+  t.setOrigin(origin);
+  return t;
+}
+
+// RagdollDemo's figure with its pelvis at `at`.
+void ragdoll(World& w, const btVector3& at) {
+  struct Part {
+    double radius, height, x, y, roll;
+  };
+  const double h = SIMD_HALF_PI;
+  const Part parts[11] = {
+      {0.15, 0.20, 0, 1.0, 0},      {0.15, 0.28, 0, 1.2, 0},      {0.10, 0.05, 0, 1.6, 0},
+      {0.07, 0.45, -0.18, 0.65, 0}, {0.05, 0.37, -0.18, 0.2, 0},  {0.07, 0.45, 0.18, 0.65, 0},
+      {0.05, 0.37, 0.18, 0.2, 0},   {0.05, 0.33, -0.35, 1.45, h}, {0.04, 0.25, -0.7, 1.45, h},
+      {0.05, 0.33, 0.35, 1.45, -h}, {0.04, 0.25, 0.7, 1.45, -h}};
+  btRigidBody* b[11];
+  for (int i = 0; i < 11; ++i) {
+    const Part& p = parts[i];
+    const btTransform pose = frame(p.roll, 0, 0, at + btVector3(p.x, p.y - 1.0, 0));
+    b[i] = w.addShape(std::make_unique<btCapsuleShape>(p.radius, p.height), 1.0, pose);
+    b[i]->setDamping(0.05, 0.85);
+  }
+  auto hinge = [&](int i, int j, double ya, double yb, double lo, double hi) {
+    auto c = std::make_unique<btHingeConstraint>(*b[i], *b[j], frame(0, h, 0, btVector3(0, ya, 0)),
+                                                 frame(0, h, 0, btVector3(0, yb, 0)));
+    c->setLimit(lo, hi);
+    w.addConstraint(std::move(c));
+  };
+  auto cone = [&](int i, int j, const btTransform& a, const btTransform& bf, double s1, double s2,
+                  double twist) {
+    auto c = std::make_unique<btConeTwistConstraint>(*b[i], *b[j], a, bf);
+    c->setLimit(s1, s2, twist);
+    w.addConstraint(std::move(c));
+  };
+  const double q = SIMD_PI / 4;
+  hinge(0, 1, 0.15, -0.15, -q, h);
+  cone(1, 2, frame(h, 0, 0, btVector3(0, 0.30, 0)), frame(h, 0, 0, btVector3(0, -0.14, 0)), q, q,
+       h);
+  cone(0, 3, frame(-5 * q, 0, 0, btVector3(-0.18, -0.10, 0)),
+       frame(-5 * q, 0, 0, btVector3(0, 0.225, 0)), q, q, 0);
+  hinge(3, 4, -0.225, 0.185, 0, h);
+  cone(0, 5, frame(q, 0, 0, btVector3(0.18, -0.10, 0)), frame(q, 0, 0, btVector3(0, 0.225, 0)), q,
+       q, 0);
+  hinge(5, 6, -0.225, 0.185, 0, h);
+  cone(1, 7, frame(SIMD_PI, 0, 0, btVector3(-0.2, 0.15, 0)), frame(h, 0, 0, btVector3(0, -0.18, 0)),
+       h, h, 0);
+  hinge(7, 8, 0.18, -0.14, 0, h);
+  cone(1, 9, frame(0, 0, 0, btVector3(0.2, 0.15, 0)), frame(h, 0, 0, btVector3(0, -0.18, 0)), h, h,
+       0);
+  hinge(9, 10, 0.18, -0.14, 0, h);
+}
+}  // namespace
+
+void ragdollPile(World& w, int columns, int layers) {
+  w.addGround(0.5);
+  for (int layer = 0; layer < layers; ++layer)
+    for (int i = 0; i < columns; ++i)
+      for (int k = 0; k < columns; ++k) {
+        // Each layer shifted and raised so the figures land across the ones below.
+        const double shift = 0.3 * (layer % 2);
+        ragdoll(w, btVector3(i * 1.0 + shift, 1.2 + 2.0 * layer, k * 0.8 + shift));
+      }
 }
 
 }  // namespace mlcp::bullet::scenes

@@ -88,6 +88,9 @@ class World {
                          double friction = 0.5, double restitution = 0);
   // A static 100 x 1 x 100 m slab whose top face is y = 0, tilted by `tilt` radians about z.
   btRigidBody* addGround(double friction = 1.0, double tilt = 0);
+  // Any shape (capsules, cylinders, ...); the world keeps it.
+  btRigidBody* addShape(std::unique_ptr<btCollisionShape> shape, double mass,
+                        const btTransform& pose, double friction = 0.5);
   void addConstraint(std::unique_ptr<btTypedConstraint> c, bool disableCollisions = true);
 
   // One fixed step of dt (no sub-stepping, no interpolation).
@@ -122,5 +125,9 @@ void frictionlessDrop(World& w);
 // Joints without contacts: a point-to-point chain of two boxes, a hinged door swinging, and a
 // box on a slider with limits, all under gravity.
 void joints(World& w);
+// Bullet's RagdollDemo figure (11 unit-mass capsules; hips, shoulders and neck held by
+// btConeTwistConstraint, knees, elbows and the spine by btHingeConstraint), `columns` x `columns`
+// of them in each of `layers` layers dropped onto the ground and onto each other (a pile).
+void ragdollPile(World& w, int columns, int layers);
 
 }  // namespace mlcp::bullet::scenes

@@ -52,6 +52,7 @@ void accumulate(StepStats& into, const StepStats& from) {
   into.failures += from.failures;
   into.choices.add(from.choices);
   into.packedIslands += from.packedIslands;
+  into.screened.add(from.screened);
   worst(into, from);
 }
 
@@ -274,6 +275,7 @@ void ConstraintSolver::solveIsland(Island& island, std::uint64_t key, bool split
   const Result& result = solved.result;
   current_.assembleSeconds += solved.assembleSeconds;
   current_.fallbacks += solved.fellBack;
+  current_.screened.add(solved.screened);
   current_.failures += !solved.accepted;
   if (current_.message.empty() && (solved.fellBack || !solved.accepted))
     current_.message = result.message;

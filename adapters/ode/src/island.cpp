@@ -497,6 +497,7 @@ void mlcp::ode::Stepper::Impl::runIsland(const dxStepperProcessingCallContext* c
     st.choice = std::move(solved.choice);
     st.fellBack = solved.fellBack;
     st.accepted = solved.accepted;
+    st.screened = solved.screened;
 
     if (hasReference) {
       const double tr = nowSeconds();

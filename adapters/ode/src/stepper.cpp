@@ -83,6 +83,12 @@ ChoiceCounts StepStats::choices() const {
   return counts;
 }
 
+ScreenCounts StepStats::screened() const {
+  ScreenCounts counts;
+  for (const IslandStats& s : islands) counts.add(s.screened);
+  return counts;
+}
+
 double StepStats::maxResidual() const {
   double r = 0;
   for (const IslandStats& s : islands)

@@ -30,9 +30,13 @@
 // When it works. For a P-matrix (e.g. symmetric positive definite A, i.e. physics with
 // cfm > 0) every Schur complement is positive and the method finds the unique solution. For
 // symmetric positive semidefinite A (rank-deficient contacts, cfm = 0) a consistent problem
-// usually solves (a zero-pivot row whose w is already 0 is left where it is); otherwise, and
-// for general non-symmetric matrices, the method may stop with Failed. Every answer is
-// checked by the base class with the natural-map residual.
+// usually solves (a zero-pivot row whose w is already 0 is left where it is, and the message
+// counts such redundant rows). A pivoting that breaks down (Failed) is run once more from the
+// caller's start on A + delta I, delta = 1e-10 max |A_ii|: engines' redundant joints disagree by
+// their drift (Bullet's bridge of planks joined by two ball joints each: ~1e-8 of b), which no
+// zero pivot absorbs; the regularised answer leaves a residual on A at that level, and the
+// message says "regularised". Otherwise, and for general non-symmetric matrices, the method may
+// stop with Failed. Every answer is checked by the base class with the natural-map residual.
 //
 // Cost. Per pivot O(|C|^2) for the factor solve and update plus O(|N| n) for dw on N rows
 // (O(nnz) of those rows when A is sparse); O(n^3) overall in the worst case, like a dense

@@ -8,7 +8,10 @@
 // only on the sparsity pattern and is kept between calls: a simulation whose joint graph does not
 // change pays for it once and refactorizes numerically each step, as SuiteSparse's
 // analyze/factorize split does. One step of iterative refinement follows the solve. Bounded rows
-// are refused (Unsupported); a singular A is reported as Failed.
+// are refused (Unsupported). A singular symmetric sparse A (redundant joints) whose LDL^T fails
+// or misses the residual is factored as A + delta I (delta = 1e-9 max |A_ii|) and refined
+// against A, up to 8 steps; the message says so and the residual check says how consistent it
+// was. A singular non-symmetric A is reported as Failed.
 //
 // The storage chooses the path. A dense A (RowSolver assembles islands up to denseMaxRows = 64
 // rows dense) is factored without pivoting inside its envelope: row i of L starts at A's first

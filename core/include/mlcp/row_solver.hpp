@@ -7,6 +7,10 @@
 //
 // Stages per island (the Bullet drop-in and the ODE stepper both run exactly this):
 //
+//  0. screen the rows one by one (RowScreen, row_screen.hpp): a degenerate row (non-finite rhs
+//     or Jacobian, no effect on any body, A_ii = 0 without cfm, empty bounds) takes x = 0 and
+//     is left out, NaN bounds become +-inf; stages 1-4 run on the rows kept, so one such row
+//     never costs the rest of its island its answer. IslandSolve::screened counts them.
 //  1. classify the rows by their bounds alone (no matrix needed; ProblemClass, problem.hpp):
 //       no rows                       -> Empty:       nothing to solve ("none");
 //       every row -inf..inf            -> Linear:      bilateral joints only;
@@ -46,6 +50,7 @@
 
 #include "mlcp/problem.hpp"
 #include "mlcp/result.hpp"
+#include "mlcp/row_screen.hpp"
 #include "mlcp/rows.hpp"
 #include "mlcp/solver.hpp"
 
@@ -198,6 +203,7 @@ struct IslandSolve {
   bool fellBack = false;       // the primary's answer was rejected and the fallback ran
   bool accepted = true;        // the returned answer passes acceptable()
   double assembleSeconds = 0;  // part of result.seconds spent classifying and assembling A
+  ScreenCounts screened;       // rows screened in stage 0 (inert ones answered x = 0)
 };
 
 // Counts of IslandSolve::choice over a step, e.g. "dantzig:3 ldlt:1 none:2".
@@ -251,6 +257,9 @@ class RowSolver {
 
  private:
   struct Slot;
+  // Stages 1-4 on rows that passed the screen.
+  IslandSolve solveScreened(const RowSystem& rows, const Vector& start, Vector& x,
+                            std::uint64_t islandKey);
   Slot& slot(std::uint64_t key);
   Solver* assembledSolver(Slot& island, const std::string& name);
   Result run(const RowSystem& rows, const std::string& name, const Options& options,
@@ -265,6 +274,8 @@ class RowSolver {
   bool haveAssembled_ = false;
   double solveStart_ = 0;  // the current solve's start, until its primary's run() reads it
   Vector xFallback_;
+  RowScreen screen_;
+  Vector keptStart_, keptX_;  // the kept rows' start and answer when rows were screened
   std::unordered_map<std::uint64_t, std::unique_ptr<Slot>> slots_;
   std::uint64_t lastKey_ = 0;  // the key of lastSlot_
   Slot* lastSlot_ = nullptr;   // the island solved last (slots_ owns it)

@@ -106,6 +106,9 @@ struct IslandStats {
   std::string choice;
   bool fellBack = false;  // the primary's answer was rejected and the fallback ran
   bool accepted = true;   // the applied answer passes mlcp::acceptable
+  // Degenerate rows screened before the solve, by reason (mlcp/row_screen.hpp): inert ones
+  // applied no force (lambda 0), the rest of the island was solved without them.
+  ScreenCounts screened;
   bool warmStarted = false;
   double solveSeconds = 0;                  // the solver(s) only
   double islandSeconds = 0;                 // the whole island, rows to integration
@@ -140,9 +143,10 @@ struct StepStats {
   std::vector<IslandStats> islands;
   double seconds = 0;  // the whole step() call
   int rows() const;
-  int fallbacks() const;         // islands that fell back
-  ChoiceCounts choices() const;  // IslandStats::choice counted over the islands
-  double maxResidual() const;    // over islands with rows; 0 when there are none
+  int fallbacks() const;          // islands that fell back
+  ChoiceCounts choices() const;   // IslandStats::choice counted over the islands
+  ScreenCounts screened() const;  // IslandStats::screened summed over the islands
+  double maxResidual() const;     // over islands with rows; 0 when there are none
   int maxIterations() const;
 };
 

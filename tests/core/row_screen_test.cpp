@@ -1,0 +1,199 @@
+// RowScreen: each reason a row is screened for, the compaction (findex renumbered, inert rows
+// answered 0), and RowSolver solving the rest of an island around a degenerate row.
+#include "mlcp/row_screen.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "mlcp/residual.hpp"
+#include "mlcp/row_solver.hpp"
+
+namespace mlcp {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// One unit body (mass 1, inertia 1) held to the world: a ball joint's three rows 0-2, a contact
+// row 3 along y with its friction row 4 along x, and nothing else.
+RowSystem island() {
+  RowSystem s;
+  BodyInverseMass body;
+  body.invMass = 1;
+  body.invInertia = Eigen::Matrix3d::Identity();
+  s.bodies = {body};
+  const Eigen::Vector3d arm(0, 0.5, 0);
+  auto add = [&](const Eigen::Vector3d& lin, double b, double lo, double hi, int findex) {
+    ConstraintRow r;
+    r.bodyA = 0;
+    r.jA << lin, arm.cross(lin);
+    s.rows.push_back(r);
+    const int n = s.size();
+    for (Vector* v : {&s.b, &s.lo, &s.hi, &s.cfm}) v->conservativeResize(n);
+    s.b[n - 1] = b;
+    s.lo[n - 1] = lo;
+    s.hi[n - 1] = hi;
+    s.cfm[n - 1] = 0;
+    s.findex.push_back(findex);
+  };
+  for (int k = 0; k < 3; ++k) add(Eigen::Vector3d::Unit(k), 0.1 * (k + 1), -kInf, kInf, -1);
+  add(Eigen::Vector3d::UnitY(), -1, 0, kInf, -1);
+  add(Eigen::Vector3d::UnitX(), 0.2, -0.5, 0.5, 3);
+  return s;
+}
+
+TEST(RowScreen, CleanRowsPassUntouched) {
+  RowScreen screen;
+  EXPECT_FALSE(screen.screen(island()));
+  EXPECT_EQ(screen.counts().total(), 0);
+  EXPECT_EQ(screen.counts().toString(), "");
+}
+
+TEST(RowScreen, NonFiniteRhsIsInert) {
+  RowSystem s = island();
+  s.b[1] = -kInf;
+  RowScreen screen;
+  ASSERT_TRUE(screen.screen(s));
+  EXPECT_EQ(screen.counts().nonFiniteRhs, 1);
+  EXPECT_EQ(screen.counts().inert(), 1);
+  EXPECT_EQ(screen.kept().size(), 4);
+  EXPECT_EQ(screen.keptIndex(), (std::vector<int>{0, 2, 3, 4}));
+  EXPECT_EQ(screen.kept().findex[3], 2);  // the friction row follows its contact's new place
+  EXPECT_EQ(screen.kept().validate(), "");
+}
+
+TEST(RowScreen, NonFiniteJacobianOrCfmIsInert) {
+  RowSystem s = island();
+  s.rows[0].jA[4] = kNaN;
+  s.cfm[2] = kInf;
+  RowScreen screen;
+  ASSERT_TRUE(screen.screen(s));
+  EXPECT_EQ(screen.counts().nonFiniteRow, 2);
+  EXPECT_EQ(screen.kept().validate(), "");
+}
+
+TEST(RowScreen, ZeroJacobianIsInert) {
+  RowSystem s = island();
+  s.rows[1].jA.setZero();
+  RowScreen screen;
+  ASSERT_TRUE(screen.screen(s));
+  EXPECT_EQ(screen.counts().noJacobian, 1);
+  // A row on the world only (both body indices -1) moves nothing either.
+  s = island();
+  s.rows[2].bodyA = -1;
+  ASSERT_TRUE(screen.screen(s));
+  EXPECT_EQ(screen.counts().noJacobian, 1);
+}
+
+TEST(RowScreen, ZeroDiagonalWithoutCfmIsInertWithCfmKept) {
+  // A body that cannot turn (Bullet's angular factor 0): a purely angular row has A_ii = 0.
+  RowSystem s = island();
+  s.bodies[0].invInertia.setZero();
+  s.rows[0].jA << 0, 0, 0, 1, 0, 0;
+  RowScreen screen;
+  ASSERT_TRUE(screen.screen(s));
+  EXPECT_EQ(screen.counts().zeroDiagonal, 1);
+  EXPECT_EQ(screen.counts().inert(), 1);
+  // The same row with cfm has A_ii = cfm > 0: a regular row.
+  s.cfm[0] = 1e-5;
+  EXPECT_FALSE(screen.screen(s));
+  // Round-off above zero is still zero: the test is relative to the row's scale.
+  s.cfm[0] = 0;
+  s.bodies[0].invInertia = Eigen::Matrix3d::Identity() * 1e-20;
+  s.bodies[0].invInertia(1, 1) = 1;
+  ASSERT_TRUE(screen.screen(s));
+  EXPECT_EQ(screen.counts().zeroDiagonal, 1);
+}
+
+TEST(RowScreen, EmptyBoundsAreInert) {
+  RowSystem s = island();
+  s.lo[0] = kInf;
+  s.lo[1] = 2;
+  s.hi[1] = 1;
+  RowScreen screen;
+  ASSERT_TRUE(screen.screen(s));
+  EXPECT_EQ(screen.counts().emptyBounds, 2);
+}
+
+TEST(RowScreen, NaNBoundsClampToInfinityAndStay) {
+  RowSystem s = island();
+  s.lo[0] = kNaN;
+  s.hi[1] = kNaN;
+  RowScreen screen;
+  ASSERT_TRUE(screen.screen(s));
+  EXPECT_EQ(screen.counts().clampedBound, 2);
+  EXPECT_EQ(screen.counts().inert(), 0);
+  ASSERT_EQ(screen.kept().size(), 5);
+  EXPECT_EQ(screen.kept().lo[0], -kInf);
+  EXPECT_EQ(screen.kept().hi[1], kInf);
+  EXPECT_EQ(screen.kept().validate(), "");
+}
+
+TEST(RowScreen, FrictionOfAnInertNormalIsInert) {
+  RowSystem s = island();
+  s.b[3] = kNaN;
+  RowScreen screen;
+  ASSERT_TRUE(screen.screen(s));
+  EXPECT_EQ(screen.counts().nonFiniteRhs, 1);
+  EXPECT_EQ(screen.counts().inertNormal, 1);
+  EXPECT_EQ(screen.kept().size(), 3);
+  EXPECT_EQ(screen.counts().toString(), "non-finite-rhs:1 inert-normal:1");
+}
+
+TEST(RowScreen, GatherAndScatter) {
+  RowSystem s = island();
+  s.b[1] = kInf;
+  RowScreen screen;
+  ASSERT_TRUE(screen.screen(s));
+  Vector full(5), kept;
+  full << 1, 2, 3, 4, 5;
+  screen.gather(full, kept);
+  EXPECT_EQ(kept, (Vector(4) << 1, 3, 4, 5).finished());
+  screen.scatter(kept, full);
+  EXPECT_EQ(full, (Vector(5) << 1, 0, 3, 4, 5).finished());
+}
+
+// One degenerate row no longer costs the island its answer: the other rows are solved exactly
+// (their residual recomputed on the rows kept), the inert row answers 0, and the counts and
+// the message say what was screened. Every solver name gets the same rows.
+TEST(RowScreen, RowSolverSolvesTheRestOfTheIsland) {
+  for (const char* name : {"auto", "dantzig", "pgs"}) {
+    RowSystem s = island();
+    s.b[1] = -kInf;
+    s.bodies[0].invInertia(0, 0) = 0;  // no turning about x: row 0's J is (1,0,0 | 0,0,0)
+    s.rows.push_back(s.rows[0]);       // ... and an angular-only row about x: A_ii = 0
+    s.rows.back().jA << 0, 0, 0, 1, 0, 0;
+    for (Vector* v : {&s.b, &s.lo, &s.hi, &s.cfm}) v->conservativeResize(6);
+    s.b[5] = 0.3;
+    s.lo[5] = -kInf;
+    s.hi[5] = kInf;
+    s.cfm[5] = 0;
+    s.findex.push_back(-1);
+    RowSolverSettings settings;
+    settings.solver = name;
+    RowSolver solver(settings);
+    Vector x;
+    const IslandSolve out = solver.solve(s, Vector::Zero(6), x, 1);
+    SCOPED_TRACE(name);
+    EXPECT_TRUE(out.accepted) << out.result.message;
+    EXPECT_EQ(out.screened.nonFiniteRhs, 1);
+    EXPECT_EQ(out.screened.zeroDiagonal, 1);
+    ASSERT_EQ(x.size(), 6);
+    EXPECT_EQ(x[1], 0);
+    EXPECT_EQ(x[5], 0);
+    RowScreen screen;
+    ASSERT_TRUE(screen.screen(s));
+    Vector kept;
+    screen.gather(x, kept);
+    const RowSystem& k = screen.kept();
+    const Accuracy a =
+        accuracy(kept, k.slack(kept), k.lo, k.hi, k.findex, k.b.lpNorm<Eigen::Infinity>());
+    EXPECT_LT(a.residual, 1e-6);
+    EXPECT_NE(out.result.message.find("2 of 6 rows inert"), std::string::npos)
+        << out.result.message;
+  }
+}
+
+}  // namespace
+}  // namespace mlcp
