@@ -69,7 +69,7 @@ int stepsFor(const Scene& s) {
 }
 
 TEST(SceneWorlds, EverySceneFileIsRun) {
-  EXPECT_GE(mlcp::scene::listSceneFiles(kScenes).size(), 16u);
+  EXPECT_GE(mlcp::scene::listSceneFiles(kScenes).size(), 24u);
   EXPECT_FALSE(engines().empty());
 }
 
@@ -84,7 +84,14 @@ TEST_P(EveryScene, RunsInEveryEngineWithoutNaN) {
     // No fallback: Bullet's would re-solve most pyramid steps with 1000 sweeps (slow under
     // sanitizers); this test is about loading and stepping, not accuracy.
     run.fallback = "";
-    auto world = loader(s, run);
+    std::unique_ptr<World> world;
+    try {
+      world = loader(s, run);
+    } catch (const mlcp::scene::Unsupported& e) {
+      // six_dof_spring in ODE; content_test checks which scenes an engine refuses.
+      EXPECT_EQ(std::string(e.what()).find("unsupported in "), 0u) << e.what();
+      continue;
+    }
     const int steps = stepsFor(s);
     for (int i = 0; i < steps; ++i) world->step();
     EXPECT_EQ(world->stepsTaken(), steps);
@@ -99,7 +106,10 @@ TEST_P(EveryScene, RunsInEveryEngineWithoutNaN) {
     EXPECT_LT(m.maxSpeed, 20.0) << engine << " " << s.name;
     // A wrong shape, pose or plane shows as deep contacts. Not for the mass-ratio scenes: pgs
     // with 50 sweeps and no fallback lets their heavy tops sink (a solver limit, not a bug).
-    if (s.name != "mass_ratio_stack" && s.name != "heavy_on_small") {
+    // Nor hull_stack in ODE, whose convex-convex collider gives one point per resting face pair
+    // (see content_test's HullStackStands).
+    if (s.name != "mass_ratio_stack" && s.name != "heavy_on_small" &&
+        !(s.name == "hull_stack" && engine == "ode")) {
       EXPECT_LT(m.maxPenetration, 0.05) << engine << " " << s.name;
     }
     EXPECT_STREQ(world->engine(), engine.c_str());
