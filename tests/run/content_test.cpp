@@ -18,14 +18,9 @@
 #include <string>
 #include <vector>
 
+#include "common/scene_engines.hpp"
 #include "mlcp/scene/scene.hpp"
 #include "mlcp/scene/world.hpp"
-#ifdef MLCP_HAVE_BULLET
-#include "mlcp/bullet/scene_loader.hpp"
-#endif
-#ifdef MLCP_HAVE_ODE
-#include "mlcp/ode/scene_loader.hpp"
-#endif
 
 namespace {
 
@@ -40,16 +35,8 @@ Scene load(const std::string& name) {
   return mlcp::scene::loadScene(kScenes + "/" + name + ".json");
 }
 
-using Loader = std::function<std::unique_ptr<World>(const Scene&, const RunSettings&)>;
-
-Loader loaderOf(const std::string& engine) {
-#ifdef MLCP_HAVE_BULLET
-  if (engine == "bullet") return &mlcp::bullet::loadWorld;
-#endif
-#ifdef MLCP_HAVE_ODE
-  if (engine == "ode") return &mlcp::ode::loadWorld;
-#endif
-  return nullptr;
+mlcp::test::SceneLoader loaderOf(const std::string& engine) {
+  return mlcp::test::sceneLoader(engine);
 }
 
 struct Case {
@@ -184,8 +171,7 @@ INSTANTIATE_TEST_SUITE_P(Scenes, SceneContent, testing::ValuesIn(cases()),
 
 std::vector<std::string> engines() {
   std::vector<std::string> e;
-  for (const char* name : {"bullet", "ode"})
-    if (loaderOf(name)) e.push_back(name);
+  for (const auto& [name, loader] : mlcp::test::sceneEngines()) e.push_back(name);
   return e;
 }
 

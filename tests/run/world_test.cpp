@@ -14,13 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "common/scene_engines.hpp"
 #include "mlcp/scene/scene.hpp"
-#ifdef MLCP_HAVE_BULLET
-#include "mlcp/bullet/scene_loader.hpp"
-#endif
-#ifdef MLCP_HAVE_ODE
-#include "mlcp/ode/scene_loader.hpp"
-#endif
 
 namespace {
 
@@ -32,18 +27,9 @@ using mlcp::scene::World;
 
 const std::string kScenes = std::string(MLCP_SOURCE_DIR) + "/scenes";
 
-using Loader = std::function<std::unique_ptr<World>(const Scene&, const RunSettings&)>;
+using Loader = mlcp::test::SceneLoader;
 
-std::vector<std::pair<std::string, Loader>> engines() {
-  std::vector<std::pair<std::string, Loader>> e;
-#ifdef MLCP_HAVE_BULLET
-  e.emplace_back("bullet", &mlcp::bullet::loadWorld);
-#endif
-#ifdef MLCP_HAVE_ODE
-  e.emplace_back("ode", &mlcp::ode::loadWorld);
-#endif
-  return e;
-}
+std::vector<std::pair<std::string, Loader>> engines() { return mlcp::test::sceneEngines(); }
 
 Scene load(const std::string& name) { return mlcp::scene::loadScene(kScenes + "/" + name); }
 
