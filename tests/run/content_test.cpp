@@ -10,6 +10,7 @@
 // (kKnownFailures below); MLCP_RUN_KNOWN_FAILURES=1 in the environment runs them anyway.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -258,6 +259,34 @@ TEST(SceneContentPhysics, HullStackStands) {
     auto world = loaderOf(engine)(s, RunSettings::fromScene(s));
     for (int i = 0; i < 60; ++i) world->step();
     EXPECT_NEAR(world->states()[top].position[2], s.bodies[top].position[2], 0.01) << engine;
+  }
+}
+
+// A capsule hanging from a cone-twist joint (swing 0.5 rad, twist 0.3 rad), swung about x
+// and spun about its bone: a free ball joint would let it swing to ~1.4 rad and twist without
+// end; the cone keeps both near their limits (Bullet's soft limits and ODE's stops overshoot a
+// little) in both engines, so ODE's ball + Euler angular motor maps the same axes.
+TEST(SceneContentPhysics, ConeTwistKeepsSwingAndTwistInItsCone) {
+  const Scene s = mlcp::scene::parseScene(R"({"format": "mlcp-scene/1",
+      "bodies": [{"name": "bone", "shape": {"type": "capsule", "radius": 0.05, "length": 0.4},
+                  "mass": 1, "position": [0, 0, 1.75], "velocity": [0, 1.25, 0],
+                  "angular_velocity": [5, 0, 5]}],
+      "joints": [{"type": "cone_twist", "bodies": ["bone"], "anchor": [0, 0, 2],
+                  "axis": [0, 0, -1], "cone": {"swing1": 0.5, "swing2": 0.5, "twist": 0.3}}]})");
+  for (const std::string& engine : engines()) {
+    auto world = loaderOf(engine)(s, RunSettings::fromScene(s));
+    double swing = 0, twist = 0;
+    for (int i = 0; i < 120; ++i) {
+      world->step();
+      const mlcp::scene::Quat q = world->states()[0].orientation;
+      const mlcp::scene::Vec3 bone = mlcp::scene::rotate(q, {0, 0, -1});
+      swing = std::max(swing, std::acos(std::clamp(-bone[2], -1.0, 1.0)));
+      twist = std::max(twist, std::abs(mlcp::scene::twistAngle(q, {0, 0, -1})));
+    }
+    EXPECT_GT(swing, 0.4) << engine << ": it swings to its limit";
+    EXPECT_LT(swing, 0.65) << engine;
+    EXPECT_GT(twist, 0.2) << engine << ": it twists to its limit";
+    EXPECT_LT(twist, 0.45) << engine;
   }
 }
 
