@@ -290,6 +290,34 @@ TEST(SceneContentPhysics, ConeTwistKeepsSwingAndTwistInItsCone) {
   }
 }
 
+// A box hanging from a universal joint (axis x fixed in the box, axis2 y fixed in the world)
+// spun about z and swung about x: the joint lets it swing but keeps the box's x axis
+// perpendicular to the world's y (no turn about the third axis), and keeps its anchor. A free
+// ball joint would turn 5 rad in the second; Bullet's universal (a btGeneric6DofConstraint,
+// locked axis softness 0.5) lets the first step's spin through, 5 rad/s x 1/60 s = 0.083 rad.
+TEST(SceneContentPhysics, UniversalJointSwingsButDoesNotTwist) {
+  const Scene s = mlcp::scene::parseScene(R"({"format": "mlcp-scene/1",
+      "bodies": [{"name": "box", "shape": {"type": "box", "size": [0.2, 0.2, 0.2]}, "mass": 1,
+                  "position": [0, 0, 1.5], "velocity": [0, 1.5, 0], "angular_velocity": [3, 0, 5]}],
+      "joints": [{"type": "universal", "bodies": ["box"], "anchor": [0, 0, 2], "axis": [1, 0, 0],
+                  "axis2": [0, 1, 0]}]})");
+  for (const std::string& engine : engines()) {
+    auto world = loaderOf(engine)(s, RunSettings::fromScene(s));
+    double swing = 0, twist = 0, drift = 0;  // twist: |y . (box's x axis)|
+    for (int i = 0; i < 60; ++i) {
+      world->step();
+      const mlcp::scene::Quat q = world->states()[0].orientation;
+      const mlcp::scene::Vec3 down = mlcp::scene::rotate(q, {0, 0, -1});
+      swing = std::max(swing, std::acos(std::clamp(-down[2], -1.0, 1.0)));
+      twist = std::max(twist, std::abs(mlcp::scene::rotate(q, {1, 0, 0})[1]));
+      drift = std::max(drift, world->last().jointError);
+    }
+    EXPECT_GT(swing, 0.2) << engine;
+    EXPECT_LT(twist, 0.1) << engine;
+    EXPECT_LT(drift, 0.01) << engine;
+  }
+}
+
 TEST(SceneContentPhysics, SixDofSpringIsUnsupportedInOde) {
 #ifdef MLCP_HAVE_ODE
   const Scene s = load("six_dof_spring");
