@@ -5,10 +5,13 @@ Their bodies and joints repeat with rotations the scene generators (stack, pyram
 not express; this script is their source. Run it from anywhere after changing it:
     python3 tools/make_scenes.py
 and commit the JSON it writes (tests, benches and charts read only the JSON).
+    python3 tools/make_scenes.py --check
+exits 1 when a committed file differs from what the script writes (a ctest runs this).
 """
 import json
 import math
 import os
+import sys
 
 SCENES = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scenes")
 
@@ -36,7 +39,7 @@ def r(v, digits=6):
     return [round(c, digits) + 0.0 for c in v]
 
 
-def dump(scene, path):
+def text_of(scene):
     """One body or joint per line: long files stay readable and diff well."""
     lines = ["{"]
     head = [k for k in scene if k not in ("bodies", "joints")]
@@ -49,8 +52,7 @@ def dump(scene, path):
             lines.append("    " + json.dumps(item) + ("," if i + 1 < len(items) else ""))
         lines.append("  ]" + ("," if key == "bodies" else ""))
     lines.append("}")
-    with open(path, "w") as f:
-        f.write("\n".join(lines) + "\n")
+    return "\n".join(lines) + "\n"
 
 
 # A ragdoll standing at the origin, z up, facing +y, in a T pose: capsule parts (Bullet's
@@ -169,5 +171,18 @@ def plank_bridge(planks=12, sag=0.5):
 
 
 if __name__ == "__main__":
-    dump(ragdoll_pile(), os.path.join(SCENES, "ragdoll_pile.json"))
-    dump(plank_bridge(), os.path.join(SCENES, "plank_bridge.json"))
+    check = sys.argv[1:] == ["--check"]
+    stale = []
+    for name, scene in (("ragdoll_pile", ragdoll_pile()), ("plank_bridge", plank_bridge())):
+        path = os.path.join(SCENES, name + ".json")
+        text = text_of(scene)
+        if check:
+            with open(path) as f:
+                if f.read() != text:
+                    stale.append(path)
+        else:
+            with open(path, "w") as f:
+                f.write(text)
+    for path in stale:
+        print("%s differs from what tools/make_scenes.py writes: run it and commit" % path)
+    sys.exit(1 if stale else 0)
