@@ -8,6 +8,9 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <stdexcept>
+
+#include "mlcp/scene/convex_hull.hpp"
 
 namespace mlcp::scene {
 
@@ -194,6 +197,33 @@ Quat parseOrientation(const Node& n) {
   return fromAxisAngle(axis, angle);
 }
 
+// The hull's corners, moved so that its centroid is the body origin, its faces and its
+// inertia per kg; the body axes must be the hull's principal axes.
+void parseHull(const Node& n, Shape& s) {
+  const std::size_t count = n.arraySize();
+  if (count > std::size_t(kMaxHullPoints))
+    n.fail("a convex hull takes at most " + std::to_string(kMaxHullPoints) + " points, got " +
+           std::to_string(count));
+  std::vector<Vec3> points;
+  for (std::size_t i = 0; i < count; ++i) points.push_back(n.item(i).vec3());
+  ConvexHull h;
+  try {
+    h = convexHullOf(points);
+  } catch (const std::invalid_argument& e) {
+    n.fail(e.what());
+  }
+  const auto& I = h.inertiaPerKg;
+  const double scale = I[0] + I[1] + I[2];
+  if (std::max({std::abs(I[3]), std::abs(I[4]), std::abs(I[5])}) > 1e-9 * scale)
+    n.fail(
+        "the hull's products of inertia are not 0: give the points in its principal axes "
+        "(and turn the body by its orientation)");
+  for (Vec3 p : h.points)
+    s.hullPoints.push_back({p[0] - h.centroid[0], p[1] - h.centroid[1], p[2] - h.centroid[2]});
+  s.hullFaces = h.faces;
+  s.hullInertiaPerKg = {I[0], I[1], I[2]};
+}
+
 Shape parseShape(const Node& n) {
   n.requireObject();
   const std::string type = n.at("type").string();
@@ -211,6 +241,15 @@ Shape parseShape(const Node& n) {
     s.type = ShapeType::Capsule;
     s.radius = n.at("radius").positive();
     s.length = n.at("length").nonNegative();
+  } else if (type == "cylinder") {
+    n.allowOnly({"type", "radius", "length"});
+    s.type = ShapeType::Cylinder;
+    s.radius = n.at("radius").positive();
+    s.length = n.at("length").positive();
+  } else if (type == "convex_hull") {
+    n.allowOnly({"type", "points"});
+    s.type = ShapeType::ConvexHull;
+    parseHull(n.at("points"), s);
   } else if (type == "plane") {
     n.allowOnly({"type", "normal", "offset"});
     s.type = ShapeType::Plane;
@@ -218,20 +257,26 @@ Shape parseShape(const Node& n) {
     s.offset = numberOr(n, "offset", 0.0, &Node::number);
   } else {
     n.child("type").fail("unknown shape " + inQuotes(type) +
-                         " (known: plane, box, sphere, capsule)");
+                         " (known: plane, box, sphere, capsule, cylinder, convex_hull)");
   }
   return s;
 }
 
-// Extent of an unrotated shape along z (what a stack piles up).
-double heightOf(const Shape& s) {
+// Lowest and highest z of an unrotated shape in its body frame (what a stack piles up).
+std::pair<double, double> zRangeOf(const Shape& s) {
   switch (s.type) {
-    case ShapeType::Box: return s.size[2];
-    case ShapeType::Sphere: return 2 * s.radius;
-    case ShapeType::Capsule: return s.length + 2 * s.radius;
+    case ShapeType::Box: return {-s.size[2] / 2, s.size[2] / 2};
+    case ShapeType::Sphere: return {-s.radius, s.radius};
+    case ShapeType::Capsule: return {-s.length / 2 - s.radius, s.length / 2 + s.radius};
+    case ShapeType::Cylinder: return {-s.length / 2, s.length / 2};
+    case ShapeType::ConvexHull: {
+      auto [lo, hi] = std::minmax_element(s.hullPoints.begin(), s.hullPoints.end(),
+                                          [](const Vec3& a, const Vec3& b) { return a[2] < b[2]; });
+      return {(*lo)[2], (*hi)[2]};
+    }
     case ShapeType::Plane: break;
   }
-  return 0;
+  return {0, 0};
 }
 
 enum class BodyRole { Explicit, Template, UnrotatedTemplate };
@@ -286,12 +331,13 @@ void expandStack(const Node& n, const Body& t, const std::string& name, const Ve
   const long long count = n.at("count").integer(1, kMaxGeneratedBodies);
   const double gap = numberOr(n, "gap", 0.0, &Node::nonNegative);
   const double factor = numberOr(n, "mass_factor", 1.0, &Node::positive);
-  const double h = heightOf(t.shape);
+  const auto [zLow, zHigh] = zRangeOf(t.shape);
+  const double h = zHigh - zLow;
   double mass = t.mass;
   for (long long i = 0; i < count; ++i) {
     Body b = t;
     b.name = name + "." + std::to_string(i);
-    b.position = {base[0], base[1], base[2] + double(i) * (h + gap) + h / 2};
+    b.position = {base[0], base[1], base[2] + double(i) * (h + gap) - zLow};
     b.mass = mass;
     mass *= factor;
     out.push_back(std::move(b));
@@ -440,50 +486,197 @@ void parseJointLimitsAndMotor(const Node& n, Joint& j) {
   }
 }
 
+JointSpring parseSpring(const Node& n) {
+  n.allowOnly({"stiffness", "damping"});
+  JointSpring sp;
+  sp.enabled = true;
+  sp.stiffness = n.at("stiffness").nonNegative();
+  sp.damping = numberOr(n, "damping", 0.0, &Node::nonNegative);
+  return sp;
+}
+
+void parseCone(const Node& n, ConeLimits& c) {
+  n.allowOnly({"swing1", "swing2", "twist"});
+  c.swing1 = n.at("swing1").inRange(1e-6, kPi - 1e-6);
+  c.swing2 = n.has("swing2") ? n.child("swing2").inRange(1e-6, kPi - 1e-6) : c.swing1;
+  c.twist = n.at("twist").inRange(0, kPi - 1e-6);
+}
+
+// "locked", "free" or {"lower": l, "upper": u, "spring": {...}} (limits both or neither).
+AxisDof parseDof(const Node& n) {
+  AxisDof d;
+  if (n.value().is_string()) {
+    const std::string mode = n.string();
+    if (mode == "free")
+      d.mode = AxisDof::Mode::Free;
+    else if (mode != "locked")
+      n.fail("expected \"locked\", \"free\" or {\"lower\", \"upper\", \"spring\"}, got " +
+             shortDump(n.value()));
+    return d;
+  }
+  n.allowOnly({"lower", "upper", "spring"});
+  if (n.has("lower") != n.has("upper")) n.fail("give both \"lower\" and \"upper\" or neither");
+  d.mode = n.has("lower") ? AxisDof::Mode::Limited : AxisDof::Mode::Free;
+  if (n.has("lower")) {
+    d.lower = n.child("lower").number();
+    d.upper = n.child("upper").number();
+    if (d.lower > d.upper) n.fail("lower is above upper");
+  }
+  if (n.has("spring")) d.spring = parseSpring(n.child("spring"));
+  return d;
+}
+
+void parseDofs(const Node& n, const char* key, AxisDof* dofs) {
+  if (!n.has(key)) return;
+  const Node list = n.child(key);
+  if (list.arraySize() != 3) list.fail("expected 3 axes [x, y, z]");
+  for (std::size_t a = 0; a < 3; ++a) dofs[a] = parseDof(list.item(a));
+}
+
+// The world axis least aligned with `axis`, made perpendicular to it.
+Vec3 defaultNormal(const Vec3& axis) {
+  int k = 0;
+  for (int a = 1; a < 3; ++a)
+    if (std::abs(axis[a]) < std::abs(axis[k])) k = a;
+  Vec3 e{0, 0, 0};
+  e[k] = 1;
+  const double d = dot(e, axis);
+  Vec3 v{e[0] - d * axis[0], e[1] - d * axis[1], e[2] - d * axis[2]};
+  const double l = norm(v);
+  return {v[0] / l, v[1] / l, v[2] / l};
+}
+
+Vec3 perpendicularTo(const Node& n, const Vec3& axis) {
+  const Vec3 v = n.unitVec3();
+  if (std::abs(dot(v, axis)) > 1e-6) n.fail("must be perpendicular to \"axis\"");
+  return v;
+}
+
+struct JointFields {
+  JointType type;
+  std::initializer_list<const char*> allowed;
+  bool twoBodies;       // needs [A, B]
+  bool anchorRequired;  // else A's position
+};
+
+const JointFields* jointFields(const std::string& type) {
+  static const JointFields table[] = {
+      {JointType::Ball, {"name", "type", "bodies", "anchor", "collide_connected"}, false, true},
+      {JointType::Hinge,
+       {"name", "type", "bodies", "anchor", "axis", "limits", "motor", "collide_connected"},
+       false,
+       true},
+      {JointType::Slider,
+       {"name", "type", "bodies", "anchor", "axis", "limits", "motor", "collide_connected"},
+       false,
+       false},
+      {JointType::Fixed, {"name", "type", "bodies", "anchor", "collide_connected"}, false, false},
+      {JointType::ConeTwist,
+       {"name", "type", "bodies", "anchor", "axis", "normal", "cone", "collide_connected"},
+       false,
+       true},
+      {JointType::SixDof,
+       {"name", "type", "bodies", "anchor", "axis", "normal", "linear", "angular",
+        "collide_connected"},
+       false,
+       false},
+      {JointType::Universal,
+       {"name", "type", "bodies", "anchor", "axis", "axis2", "collide_connected"},
+       false,
+       true},
+      {JointType::Hinge2,
+       {"name", "type", "bodies", "anchor", "axis", "axis2", "limits", "suspension",
+        "collide_connected"},
+       true,
+       true},
+      {JointType::Gear,
+       {"name", "type", "bodies", "anchor", "anchor2", "axis", "axis2", "ratio",
+        "collide_connected"},
+       true,
+       false},
+  };
+  for (const JointFields& f : table)
+    if (type == toString(f.type)) return &f;
+  return nullptr;
+}
+
+// The axes, limits and springs of the joint types beyond ball, hinge, slider and fixed.
+void parseJointAxes(const Node& n, const Scene& scene, Joint& j) {
+  switch (j.type) {
+    case JointType::Hinge:
+    case JointType::Slider:
+      j.axis = n.at("axis").unitVec3();
+      parseJointLimitsAndMotor(n, j);
+      break;
+    case JointType::ConeTwist:
+      j.axis = n.at("axis").unitVec3();
+      j.normal =
+          n.has("normal") ? perpendicularTo(n.child("normal"), j.axis) : defaultNormal(j.axis);
+      parseCone(n.at("cone"), j.cone);
+      break;
+    case JointType::SixDof:
+      j.axis = n.has("axis") ? n.child("axis").unitVec3() : Vec3{1, 0, 0};
+      j.normal =
+          n.has("normal") ? perpendicularTo(n.child("normal"), j.axis) : defaultNormal(j.axis);
+      parseDofs(n, "linear", &j.dofs[0]);
+      parseDofs(n, "angular", &j.dofs[3]);
+      break;
+    case JointType::Universal:
+    case JointType::Hinge2:
+      j.axis = n.at("axis").unitVec3();
+      j.axis2 = perpendicularTo(n.at("axis2"), j.axis);
+      if (j.type == JointType::Hinge2) {
+        j.limits.enabled = true;  // steering locked at 0 unless the file says otherwise
+        parseJointLimitsAndMotor(n, j);
+        if (n.has("suspension")) j.suspension = parseSpring(n.child("suspension"));
+      }
+      break;
+    case JointType::Gear:
+      j.axis = n.at("axis").unitVec3();
+      j.axis2 = n.has("axis2") ? n.child("axis2").unitVec3() : j.axis;
+      j.anchor2 = n.has("anchor2") ? n.child("anchor2").vec3() : scene.bodies[j.body1].position;
+      j.ratio = n.at("ratio").positive();
+      if (norm(Vec3{j.anchor2[0] - j.anchor[0], j.anchor2[1] - j.anchor[1],
+                    j.anchor2[2] - j.anchor[2]}) < 1e-9)
+        n.fail("a gear pair needs two different centres (anchor, anchor2)");
+      break;
+    case JointType::Ball:
+    case JointType::Fixed: break;
+  }
+}
+
 Joint parseJoint(const Node& n, std::size_t index, const Scene& scene) {
   n.requireObject();
   Joint j;
   j.name = n.has("name") ? n.child("name").string() : "joints[" + std::to_string(index) + "]";
   const Node typeNode = n.at("type");
   const std::string type = typeNode.string();
-  if (type == "ball") {
-    j.type = JointType::Ball;
-    n.allowOnly({"name", "type", "bodies", "anchor", "collide_connected"});
-  } else if (type == "hinge") {
-    j.type = JointType::Hinge;
-    n.allowOnly(
-        {"name", "type", "bodies", "anchor", "axis", "limits", "motor", "collide_connected"});
-  } else if (type == "slider") {
-    j.type = JointType::Slider;
-    n.allowOnly(
-        {"name", "type", "bodies", "anchor", "axis", "limits", "motor", "collide_connected"});
-  } else if (type == "fixed") {
-    j.type = JointType::Fixed;
-    n.allowOnly({"name", "type", "bodies", "anchor", "collide_connected"});
-  } else {
-    typeNode.fail("unknown joint type " + inQuotes(type) + " (known: ball, hinge, slider, fixed)");
-  }
+  const JointFields* fields = jointFields(type);
+  if (!fields)
+    typeNode.fail("unknown joint type " + inQuotes(type) +
+                  " (known: ball, hinge, slider, fixed, cone_twist, six_dof, universal, hinge2, "
+                  "gear)");
+  j.type = fields->type;
+  n.allowOnly(fields->allowed);
 
   const Node bodies = n.at("bodies");
   const std::size_t count = bodies.arraySize();
   if (count < 1 || count > 2)
     bodies.fail("expected 1 body name (jointed to the world) or 2, got " +
                 shortDump(bodies.value()));
+  if (fields->twoBodies && count != 2)
+    bodies.fail("a " + type + " joint joins two bodies, got " + shortDump(bodies.value()));
   j.body0 = jointBody(bodies.item(0), scene);
   if (count == 2) {
     j.body1 = jointBody(bodies.item(1), scene);
     if (j.body1 == j.body0) bodies.fail("a joint needs two different bodies");
   }
 
-  const bool anchorRequired = j.type == JointType::Ball || j.type == JointType::Hinge;
-  if (anchorRequired || n.has("anchor"))
+  if (fields->anchorRequired || n.has("anchor"))
     j.anchor = n.at("anchor").vec3();
   else
     j.anchor = scene.bodies[j.body0].position;
-  if (j.type == JointType::Hinge || j.type == JointType::Slider) {
-    j.axis = n.at("axis").unitVec3();
-    parseJointLimitsAndMotor(n, j);
-  }
+  parseJointAxes(n, scene, j);
   if (n.has("collide_connected")) j.collideConnected = n.child("collide_connected").boolean();
   return j;
 }
@@ -524,6 +717,8 @@ const char* toString(ShapeType type) {
     case ShapeType::Box: return "box";
     case ShapeType::Sphere: return "sphere";
     case ShapeType::Capsule: return "capsule";
+    case ShapeType::Cylinder: return "cylinder";
+    case ShapeType::ConvexHull: return "convex_hull";
   }
   return "?";
 }
@@ -534,6 +729,11 @@ const char* toString(JointType type) {
     case JointType::Hinge: return "hinge";
     case JointType::Slider: return "slider";
     case JointType::Fixed: return "fixed";
+    case JointType::ConeTwist: return "cone_twist";
+    case JointType::SixDof: return "six_dof";
+    case JointType::Universal: return "universal";
+    case JointType::Hinge2: return "hinge2";
+    case JointType::Gear: return "gear";
   }
   return "?";
 }
@@ -561,6 +761,13 @@ Vec3 inertiaOf(const Shape& s, double m) {
           mc * (h * h / 12 + r * r / 4) + ms * (0.4 * r * r + h * h / 4 + 3 * h * r / 8);
       return {transverse, transverse, axial};
     }
+    case ShapeType::Cylinder: {
+      const double r2 = s.radius * s.radius, h2 = s.length * s.length;
+      const double transverse = m * (3 * r2 + h2) / 12;
+      return {transverse, transverse, m * r2 / 2};
+    }
+    case ShapeType::ConvexHull:
+      return {m * s.hullInertiaPerKg[0], m * s.hullInertiaPerKg[1], m * s.hullInertiaPerKg[2]};
     case ShapeType::Plane: break;
   }
   return {0, 0, 0};

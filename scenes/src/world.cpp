@@ -102,6 +102,18 @@ void World::step() {
   ++steps_;
 }
 
+// Whether the joint keeps a point of the two bodies together (up to a slider's travel).
+static bool anchorIsShared(const Joint& j) {
+  switch (j.type) {
+    case JointType::Gear: return false;
+    case JointType::Hinge2: return !j.suspension.enabled;
+    case JointType::SixDof:
+      return std::all_of(j.dofs.begin(), j.dofs.begin() + 3,
+                         [](const AxisDof& d) { return d.mode == AxisDof::Mode::Locked; });
+    default: return true;
+  }
+}
+
 void measureStates(const Scene& scene, const std::vector<BodyState>& states,
                    const std::vector<std::pair<Vec3, Vec3>>& anchors, StepMeasures& m) {
   Vec3 p{0, 0, 0};
@@ -123,6 +135,7 @@ void measureStates(const Scene& scene, const std::vector<BodyState>& states,
   m.jointError = 0;
   for (std::size_t i = 0; i < scene.joints.size() && i < anchors.size(); ++i) {
     const Joint& j = scene.joints[i];
+    if (!anchorIsShared(j)) continue;
     const BodyState* s1 = j.body1 >= 0 ? &states[j.body1] : nullptr;
     Vec3 d = sub(toWorld(&states[j.body0], anchors[i].first), toWorld(s1, anchors[i].second));
     if (j.type == JointType::Slider) {

@@ -45,6 +45,21 @@ check stock-bullet 0 'with bullet-si: 3 steps' -- \
 printf '{"format": "mlcp-scene/1", "bodies": [{"name": "b", "shape": {"type": "box", "size": [1, -1, 1]}, "mass": 1}]}' > "$tmp/bad.json"
 check bad-scene 2 'bad.json: bodies\[0\].shape.size' -- "$mlcp" run "$tmp/bad.json" --engine ode --steps 1
 check missing-scene 2 'nope.json' -- "$mlcp" run "$tmp/nope.json" --engine bullet --steps 1
+if "$mlcp" run --help | grep -q ode; then
+  check unsupported-six-dof-ode 2 'unsupported in ODE: six_dof joint hanger' -- \
+    "$mlcp" run "$scenes/six_dof_spring.json" --engine ode --steps 1
+  # Two cylinders falling onto each other: this ODE build has no cylinder-cylinder collider.
+  printf '%s' '{"format": "mlcp-scene/1", "bodies": [
+    {"name": "a", "shape": {"type": "cylinder", "radius": 0.5, "length": 0.2}, "mass": 1, "position": [0, 0, 0]},
+    {"name": "b", "shape": {"type": "cylinder", "radius": 0.5, "length": 0.2}, "mass": 1, "position": [0, 0, 0.25]}]}' > "$tmp/cylinders.json"
+  if ! "$mlcp" run "$tmp/cylinders.json" --engine ode --steps 30 > "$tmp/cyl.out" 2>&1 &&
+     grep -q 'unsupported in ODE: contacts between cylinder and cylinder' "$tmp/cyl.out"; then
+    check unsupported-cylinders-ode 2 'unsupported in ODE: contacts between cylinder and cylinder' -- \
+      "$mlcp" run "$tmp/cylinders.json" --engine ode --steps 30
+  else  # an ODE built with libccd collides them
+    check cylinders-ode 0 'steps' -- "$mlcp" run "$tmp/cylinders.json" --engine ode --steps 30
+  fi
+fi
 check unknown-engine 2 "unknown engine 'physx'" -- "$mlcp" run "$scenes/stack_10.json" --engine physx --steps 1
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

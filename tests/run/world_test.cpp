@@ -14,13 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "common/scene_engines.hpp"
 #include "mlcp/scene/scene.hpp"
-#ifdef MLCP_HAVE_BULLET
-#include "mlcp/bullet/scene_loader.hpp"
-#endif
-#ifdef MLCP_HAVE_ODE
-#include "mlcp/ode/scene_loader.hpp"
-#endif
 
 namespace {
 
@@ -32,18 +27,9 @@ using mlcp::scene::World;
 
 const std::string kScenes = std::string(MLCP_SOURCE_DIR) + "/scenes";
 
-using Loader = std::function<std::unique_ptr<World>(const Scene&, const RunSettings&)>;
+using Loader = mlcp::test::SceneLoader;
 
-std::vector<std::pair<std::string, Loader>> engines() {
-  std::vector<std::pair<std::string, Loader>> e;
-#ifdef MLCP_HAVE_BULLET
-  e.emplace_back("bullet", &mlcp::bullet::loadWorld);
-#endif
-#ifdef MLCP_HAVE_ODE
-  e.emplace_back("ode", &mlcp::ode::loadWorld);
-#endif
-  return e;
-}
+std::vector<std::pair<std::string, Loader>> engines() { return mlcp::test::sceneEngines(); }
 
 Scene load(const std::string& name) { return mlcp::scene::loadScene(kScenes + "/" + name); }
 
@@ -69,7 +55,7 @@ int stepsFor(const Scene& s) {
 }
 
 TEST(SceneWorlds, EverySceneFileIsRun) {
-  EXPECT_GE(mlcp::scene::listSceneFiles(kScenes).size(), 16u);
+  EXPECT_GE(mlcp::scene::listSceneFiles(kScenes).size(), 24u);
   EXPECT_FALSE(engines().empty());
 }
 
@@ -84,7 +70,14 @@ TEST_P(EveryScene, RunsInEveryEngineWithoutNaN) {
     // No fallback: Bullet's would re-solve most pyramid steps with 1000 sweeps (slow under
     // sanitizers); this test is about loading and stepping, not accuracy.
     run.fallback = "";
-    auto world = loader(s, run);
+    std::unique_ptr<World> world;
+    try {
+      world = loader(s, run);
+    } catch (const mlcp::scene::Unsupported& e) {
+      // six_dof_spring in ODE; content_test checks which scenes an engine refuses.
+      EXPECT_EQ(std::string(e.what()).find("unsupported in "), 0u) << e.what();
+      continue;
+    }
     const int steps = stepsFor(s);
     for (int i = 0; i < steps; ++i) world->step();
     EXPECT_EQ(world->stepsTaken(), steps);
@@ -99,7 +92,10 @@ TEST_P(EveryScene, RunsInEveryEngineWithoutNaN) {
     EXPECT_LT(m.maxSpeed, 20.0) << engine << " " << s.name;
     // A wrong shape, pose or plane shows as deep contacts. Not for the mass-ratio scenes: pgs
     // with 50 sweeps and no fallback lets their heavy tops sink (a solver limit, not a bug).
-    if (s.name != "mass_ratio_stack" && s.name != "heavy_on_small") {
+    // Nor hull_stack in ODE, whose convex-convex collider gives one point per resting face pair
+    // (see content_test's HullStackStands).
+    if (s.name != "mass_ratio_stack" && s.name != "heavy_on_small" &&
+        !(s.name == "hull_stack" && engine == "ode")) {
       EXPECT_LT(m.maxPenetration, 0.05) << engine << " " << s.name;
     }
     EXPECT_STREQ(world->engine(), engine.c_str());

@@ -14,8 +14,11 @@
 #include <fstream>
 #include <map>
 #include <set>
+#include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "mlcp/scene/convex_hull.hpp"
 
 namespace {
 
@@ -142,9 +145,35 @@ double boundingRadius(const Body& b) {
     case ShapeType::Box: return length(b.shape.size) / 2;
     case ShapeType::Sphere: return b.shape.radius;
     case ShapeType::Capsule: return b.shape.length / 2 + b.shape.radius;
+    case ShapeType::Cylinder: return std::hypot(b.shape.length / 2, b.shape.radius);
+    case ShapeType::ConvexHull: {
+      double r = 0;
+      for (const Vec3& p : b.shape.hullPoints) r = std::max(r, length(p));
+      return r;
+    }
     case ShapeType::Plane: break;
   }
   return 1e300;
+}
+
+// Cylinders and convex hulls are checked through shapes that contain them: a cylinder as the
+// capsule of its radius and length, a hull as the box of its corners' bounds (exact for the
+// scenes' prisms, which rest on their flat faces). Overlaps can then only be over-reported.
+std::vector<Body> checkedShapes(const Scene& s) {
+  std::vector<Body> out = s.bodies;
+  for (Body& b : out) {
+    if (b.shape.type == ShapeType::Cylinder) {
+      b.shape.type = ShapeType::Capsule;
+    } else if (b.shape.type == ShapeType::ConvexHull) {
+      Vec3 lo = b.shape.hullPoints[0], hi = lo;
+      for (const Vec3& p : b.shape.hullPoints)
+        for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
+      b.shape.type = ShapeType::Box;
+      b.shape.size = sub(hi, lo);
+      b.position = add(b.position, rotate(b.orientation, scale(add(lo, hi), 0.5)));
+    }
+  }
+  return out;
 }
 
 // The separation, or a lower bound of it (> `margin`) when the bounding spheres are farther
@@ -175,14 +204,30 @@ struct Expected {
 // Every scene file, with the counts its description in scenes/README.md promises (the static bodies
 // are the ground, the ramp and the pit's walls).
 const Expected kScenes[] = {
-    {"dominoes", 21, 20, 0},         {"heavy_on_small", 4, 3, 0},
-    {"hinge_motor_limits", 1, 1, 1}, {"incline_slide", 3, 1, 0},
-    {"incline_stick", 3, 1, 0},      {"mass_ratio_stack", 7, 6, 0},
-    {"pendulum_chain", 11, 11, 11},  {"pyramid_1000", 1016, 1015, 0},
-    {"pyramid_15", 16, 15, 0},       {"pyramid_210", 211, 210, 0},
-    {"pyramid_55", 56, 55, 0},       {"ragdoll", 12, 11, 10},
-    {"resting_box", 2, 1, 0},        {"slider_motor_limits", 2, 2, 2},
-    {"sphere_pit", 221, 216, 0},     {"stack_10", 11, 10, 0},
+    {"dominoes", 21, 20, 0},
+    {"heavy_on_small", 4, 3, 0},
+    {"hinge_motor_limits", 1, 1, 1},
+    {"incline_slide", 3, 1, 0},
+    {"incline_stick", 3, 1, 0},
+    {"mass_ratio_stack", 7, 6, 0},
+    {"pendulum_chain", 11, 11, 11},
+    {"pyramid_1000", 1016, 1015, 0},
+    {"pyramid_15", 16, 15, 0},
+    {"pyramid_210", 211, 210, 0},
+    {"pyramid_55", 56, 55, 0},
+    {"ragdoll", 12, 11, 10},
+    {"resting_box", 2, 1, 0},
+    {"slider_motor_limits", 2, 2, 2},
+    {"sphere_pit", 221, 216, 0},
+    {"stack_10", 11, 10, 0},
+    {"ragdoll_pile", 67, 66, 60},
+    {"plank_bridge", 15, 14, 26},
+    {"vehicle", 6, 5, 4},
+    {"six_dof_spring", 3, 2, 2},
+    {"gear_pair", 3, 2, 3},
+    {"stack_1000", 1001, 1000, 0},
+    {"boxes_3000", 3001, 3000, 0},
+    {"hull_stack", 9, 8, 0},
 };
 
 TEST(SceneFiles, EveryFileIsListedAndLoadsWithItsCounts) {
@@ -213,8 +258,9 @@ TEST(SceneFiles, NothingInterpenetrates) {
   for (const Expected& e : kScenes) {
     SCOPED_TRACE(e.file);
     const Scene s = load(e.file);
+    const std::vector<Body> shapes = checkedShapes(s);
     std::vector<Placed> placed;
-    for (const Body& b : s.bodies) placed.push_back(place(b));
+    for (const Body& b : shapes) placed.push_back(place(b));
     int overlaps = 0;
     for (std::size_t i = 0; i < placed.size(); ++i)
       for (std::size_t j = i + 1; j < placed.size(); ++j) {
@@ -231,13 +277,14 @@ TEST(SceneFiles, NothingInterpenetrates) {
 // Scenes that start at rest: every dynamic body touches (within 1 micrometre) a body or plane
 // whose centre is lower, so nothing drops at the first step.
 TEST(SceneFiles, RestingBodiesTouchTheirSupports) {
-  for (const char* name :
-       {"resting_box", "incline_stick", "incline_slide", "stack_10", "pyramid_15", "pyramid_55",
-        "pyramid_210", "pyramid_1000", "heavy_on_small", "mass_ratio_stack"}) {
+  for (const char* name : {"resting_box", "incline_stick", "incline_slide", "stack_10",
+                           "pyramid_15", "pyramid_55", "pyramid_210", "pyramid_1000",
+                           "heavy_on_small", "mass_ratio_stack", "stack_1000", "hull_stack"}) {
     SCOPED_TRACE(name);
     const Scene s = load(name);
+    const std::vector<Body> shapes = checkedShapes(s);
     std::vector<Placed> placed;
-    for (const Body& b : s.bodies) placed.push_back(place(b));
+    for (const Body& b : shapes) placed.push_back(place(b));
     for (std::size_t i = 0; i < s.bodies.size(); ++i) {
       if (s.bodies[i].isStatic()) continue;
       bool supported = false;
@@ -654,8 +701,9 @@ TEST(SceneErrors, NegativeOrOutOfRangeNumbers) {
 }
 
 TEST(SceneErrors, UnknownNames) {
-  expectError(withBodies(R"({"name": "b", "shape": {"type": "cylinder"}, "mass": 1})"),
-              {"bodies[0].shape.type: unknown shape \"cylinder\"", "plane, box, sphere, capsule"});
+  expectError(withBodies(R"({"name": "b", "shape": {"type": "cone"}, "mass": 1})"),
+              {"bodies[0].shape.type: unknown shape \"cone\"",
+               "plane, box, sphere, capsule, cylinder, convex_hull"});
   expectError(withBodies(kBox, R"("joints": [{"type": "ball", "bodies": ["b", "nobody"],
                                                "anchor": [0, 0, 0]}],)"),
               {"joints[0].bodies[1]: no body named \"nobody\""});
@@ -762,6 +810,172 @@ TEST(SceneErrors, FilesNameThemselves) {
     EXPECT_EQ(std::string(e.what()).rfind(path.string() + ": bodies[0].mass: ", 0), 0u) << e.what();
   }
   std::filesystem::remove(path);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Cylinders, convex hulls and the joints of real programs (cone-twist, 6-dof, universal,
+// hinge-2, gear).
+
+TEST(ConvexHull, CubeCornersGiveTheBoxAndItsInertia) {
+  std::vector<Vec3> corners;
+  for (double x : {-1.0, 1.0})
+    for (double y : {-0.5, 0.5})
+      for (double z : {-1.5, 1.5}) corners.push_back({x + 3, y, z});  // centred at (3, 0, 0)
+  const ConvexHull h = convexHullOf(corners);
+  EXPECT_EQ(h.faces.size(), 6u);
+  for (const auto& f : h.faces) EXPECT_EQ(f.size(), 4u);
+  EXPECT_NEAR(h.volume, 2 * 1 * 3, 1e-12);
+  EXPECT_NEAR(h.centroid[0], 3, 1e-12);
+  Shape box;
+  box.type = ShapeType::Box;
+  box.size = {2, 1, 3};
+  const Vec3 ib = inertiaOf(box, 1);
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(h.inertiaPerKg[a], ib[a], 1e-12);
+  for (int a = 3; a < 6; ++a) EXPECT_NEAR(h.inertiaPerKg[a], 0, 1e-12);
+  // Faces run counter-clockwise seen from outside: (p1 - p0) x (p2 - p0) along the normal.
+  for (std::size_t f = 0; f < h.faces.size(); ++f) {
+    const auto& v = h.faces[f];
+    const Vec3 n = cross(sub(h.points[v[1]], h.points[v[0]]), sub(h.points[v[2]], h.points[v[0]]));
+    EXPECT_GT(dot(n, h.normals[f]), 0);
+  }
+}
+
+// A regular tetrahedron of edge a: volume a^3 / (6 sqrt 2), inertia m a^2 / 20 about any axis
+// through its centroid.
+TEST(ConvexHull, TetrahedronMatchesItsClosedForm) {
+  const double a = 2 * std::sqrt(2.0);  // corners of alternate cube vertices (+-1)
+  const ConvexHull h = convexHullOf({{1, 1, 1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}});
+  EXPECT_EQ(h.faces.size(), 4u);
+  EXPECT_NEAR(h.volume, a * a * a / (6 * std::sqrt(2.0)), 1e-12);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(h.inertiaPerKg[i], a * a / 20, 1e-12);
+}
+
+TEST(ConvexHull, BadPointSetsAreRefused) {
+  EXPECT_THROW(convexHullOf({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}), std::invalid_argument);
+  EXPECT_THROW(convexHullOf({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}}), std::invalid_argument);
+  EXPECT_THROW(convexHullOf({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0, 0, 1}}),
+               std::invalid_argument);
+  // The centre of a face of the tetrahedron is no corner.
+  try {
+    convexHullOf({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0.2, 0.2, 0}});
+    ADD_FAILURE() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("point 4 is not a corner"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Inertia, CylinderMatchesIntegration) {
+  Shape cyl;
+  cyl.type = ShapeType::Cylinder;
+  cyl.radius = 0.3;
+  cyl.length = 0.2;
+  const Vec3 expect = sliceInertia([](double) { return 0.3; }, -0.1, 0.1, 10.0);
+  const Vec3 got = inertiaOf(cyl, 10.0);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(got[i], expect[i], 1e-6 * expect[i]);
+}
+
+TEST(SceneParse, HullsAreCentredOnTheirCentroid) {
+  // A square pyramid (base 2 x 2 at z = 0, apex at z = 3): centroid at z = 3/4.
+  const Scene s = parseScene(withBodies(R"({"name": "p", "mass": 2, "position": [0, 0, 5],
+      "shape": {"type": "convex_hull", "points": [[1, 1, 0], [1, -1, 0], [-1, 1, 0], [-1, -1, 0],
+                                                  [0, 0, 3]]}})"));
+  const Body& p = s.bodies[0];
+  EXPECT_EQ(p.shape.hullFaces.size(), 5u);
+  EXPECT_NEAR(p.shape.hullPoints[4][2], 3 - 0.75, 1e-12);
+  // About the centroid: I_zz = m (a^2 + b^2) / 20 = m 8 / 20 for a base 2 x 2 (a = b = 2).
+  EXPECT_NEAR(p.inertia[2], 2 * 8.0 / 20, 1e-12);
+  // A stack rests hulls on their lowest corners, not at their centroid's half height: a
+  // frustum (2 x 2 base, 1 x 1 top, 1 high) has its centroid below mid-height.
+  const Scene st = parseScene(withBodies(R"({"generator": "stack", "name": "p", "count": 2,
+      "body": {"mass": 1, "shape": {"type": "convex_hull", "points": [[1, 1, 0], [1, -1, 0],
+               [-1, 1, 0], [-1, -1, 0], [0.5, 0.5, 1], [0.5, -0.5, 1], [-0.5, 0.5, 1],
+               [-0.5, -0.5, 1]]}}})"));
+  EXPECT_LT(st.bodies[0].position[2], 0.5);
+  for (const Body& b : st.bodies) {
+    double low = 1e300;
+    for (const Vec3& q : b.shape.hullPoints) low = std::min(low, q[2] + b.position[2]);
+    EXPECT_NEAR(low, &b == &st.bodies[0] ? 0 : 1, 1e-12) << b.name;
+  }
+}
+
+TEST(SceneParse, NewJointsTakeTheirFields) {
+  const std::string two = std::string(kBox) + "," +
+                          R"({"name": "c", "shape": {"type": "box", "size": [1, 1, 1]},
+                               "mass": 1, "position": [3, 0, 0]})";
+  const Scene s = parseScene(withBodies(two, R"("joints": [
+      {"type": "cone_twist", "bodies": ["c", "b"], "anchor": [1.5, 0, 0], "axis": [1, 0, 0],
+       "cone": {"swing1": 0.5, "twist": 0.2}},
+      {"type": "six_dof", "bodies": ["c"], "linear": ["free", {"lower": -1e30, "upper": 1e30},
+       {"spring": {"stiffness": 10}}], "angular": ["locked", "free", "locked"]},
+      {"type": "universal", "bodies": ["c", "b"], "anchor": [1.5, 0, 0], "axis": [0, 1, 0],
+       "axis2": [0, 0, 1]},
+      {"type": "hinge2", "bodies": ["b", "c"], "anchor": [3, 0, 0], "axis": [0, 0, 1],
+       "axis2": [0, 1, 0], "suspension": {"stiffness": 1000, "damping": 10}},
+      {"type": "gear", "bodies": ["b", "c"], "axis": [0, 0, 1], "ratio": 3}],)"));
+  ASSERT_EQ(s.joints.size(), 5u);
+  const Joint& cone = s.joints[0];
+  EXPECT_EQ(cone.type, JointType::ConeTwist);
+  EXPECT_DOUBLE_EQ(cone.cone.swing2, 0.5);  // defaults to swing1
+  EXPECT_NEAR(dot(cone.normal, cone.axis), 0, 1e-15);
+  const Joint& six = s.joints[1];
+  EXPECT_EQ(six.dofs[0].mode, AxisDof::Mode::Free);
+  EXPECT_EQ(six.dofs[1].mode, AxisDof::Mode::Limited);
+  EXPECT_DOUBLE_EQ(six.dofs[1].upper, 1e30);
+  EXPECT_EQ(six.dofs[2].mode, AxisDof::Mode::Free);
+  EXPECT_TRUE(six.dofs[2].spring.enabled);
+  EXPECT_EQ(six.dofs[3].mode, AxisDof::Mode::Locked);
+  EXPECT_EQ(six.dofs[4].mode, AxisDof::Mode::Free);
+  EXPECT_EQ(six.anchor, (Vec3{3, 0, 0}));  // bodies[0]'s position
+  EXPECT_EQ(s.joints[2].axis2, (Vec3{0, 0, 1}));
+  const Joint& h2 = s.joints[3];
+  EXPECT_TRUE(h2.limits.enabled);  // steering locked at 0 by default
+  EXPECT_EQ(h2.limits.lower, 0);
+  EXPECT_EQ(h2.limits.upper, 0);
+  EXPECT_DOUBLE_EQ(h2.suspension.stiffness, 1000);
+  const Joint& gear = s.joints[4];
+  EXPECT_DOUBLE_EQ(gear.ratio, 3);
+  EXPECT_EQ(gear.axis2, gear.axis);
+  EXPECT_EQ(gear.anchor, (Vec3{0, 0, 0}));
+  EXPECT_EQ(gear.anchor2, (Vec3{3, 0, 0}));
+  EXPECT_STREQ(toString(JointType::Hinge2), "hinge2");
+  EXPECT_STREQ(toString(ShapeType::ConvexHull), "convex_hull");
+}
+
+TEST(SceneErrors, NewShapesAndJoints) {
+  const std::string two = std::string(kBox) + "," +
+                          R"({"name": "c", "shape": {"type": "box", "size": [1, 1, 1]},
+                               "mass": 1, "position": [3, 0, 0]})";
+  auto joints = [&](const std::string& j) { return withBodies(two, "\"joints\": [" + j + "],"); };
+  expectError(withBodies(R"({"name": "h", "mass": 1, "shape": {"type": "convex_hull",
+      "points": [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]]}})"),
+              {"bodies[0].shape.points: the points lie in one plane"});
+  expectError(withBodies(R"({"name": "h", "mass": 1, "shape": {"type": "convex_hull",
+      "points": [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]]}})"),
+              {"bodies[0].shape.points: the hull's products of inertia are not 0"});
+  expectError(withBodies(R"({"name": "c", "mass": 1, "shape": {"type": "cylinder", "radius": 1,
+      "length": 0}})"),
+              {"bodies[0].shape.length: expected a positive number"});
+  expectError(joints(R"({"type": "hinge2", "bodies": ["b"], "anchor": [0, 0, 0],
+      "axis": [0, 0, 1], "axis2": [0, 1, 0]})"),
+              {"joints[0].bodies: a hinge2 joint joins two bodies"});
+  expectError(joints(R"({"type": "universal", "bodies": ["b", "c"], "anchor": [0, 0, 0],
+      "axis": [0, 0, 1], "axis2": [0, 1, 1]})"),
+              {"joints[0].axis2: must be perpendicular to \"axis\""});
+  expectError(
+      joints(R"({"type": "six_dof", "bodies": ["b"], "linear": ["loose", "free", "free"]})"),
+      {"joints[0].linear[0]: expected \"locked\", \"free\""});
+  expectError(joints(R"({"type": "six_dof", "bodies": ["b"], "angular": [{"lower": 1}, "free",
+      "free"]})"),
+              {"joints[0].angular[0]: give both \"lower\" and \"upper\" or neither"});
+  expectError(joints(R"({"type": "cone_twist", "bodies": ["b"], "anchor": [0, 0, 0],
+      "axis": [1, 0, 0], "cone": {"swing1": 4, "twist": 0}})"),
+              {"joints[0].cone.swing1: expected a number in"});
+  expectError(joints(R"({"type": "gear", "bodies": ["b", "c"], "axis": [0, 0, 1], "ratio": 1,
+      "anchor": [3, 0, 0]})"),
+              {"joints[0]: a gear pair needs two different centres"});
+  expectError(joints(R"({"type": "gear", "bodies": ["b", "c"], "axis": [0, 0, 1],
+      "limits": {"lower": 0, "upper": 1}, "ratio": 1})"),
+              {"joints[0]: unknown field \"limits\""});
 }
 
 }  // namespace

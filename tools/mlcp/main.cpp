@@ -4,6 +4,7 @@
 
 #include "commands.hpp"
 #include "mlcp/registry.hpp"
+#include "mlcp/scene/world.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"mlcp: mixed linear complementarity solvers for physics engines.\nSolvers: " +
@@ -29,7 +30,14 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     return code == 0 ? 0 : mlcp::cli::kInvalidInput;
   }
-  for (auto& [cmd, run] : commands)
-    if (cmd->parsed()) return run();
+  // An engine that cannot express a scene's feature may say so at any step (ODE meets a pair
+  // of shapes it has no collider for only when they come close): exit 2 as for bad input.
+  try {
+    for (auto& [cmd, run] : commands)
+      if (cmd->parsed()) return run();
+  } catch (const mlcp::scene::Unsupported& e) {
+    std::cerr << "mlcp: " << e.what() << "\n";
+    return mlcp::cli::kInvalidInput;
+  }
   return mlcp::cli::kInvalidInput;
 }

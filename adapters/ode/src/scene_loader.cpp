@@ -2,8 +2,10 @@
 #include "mlcp/ode/scene_loader.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <map>
+#include <mutex>
 #include <set>
 #include <stdexcept>
 #include <utility>
@@ -32,6 +34,56 @@ void setLimitsAndMotor(dJointID joint, const scene::Joint& j, void (*set)(dJoint
   if (j.motor.enabled) {
     set(joint, dParamVel, j.motor.velocity);
     set(joint, dParamFMax, j.motor.maxForce);
+  }
+}
+
+// A geom of ODE class `cls` around the origin (no space, no body), to probe dCollide with.
+dGeomID probeGeom(int cls) {
+  // A unit cube as ODE's convex data: planes (n, d), corners, polygons (count, indices).
+  static dReal planes[] = {1, 0,  0, 0.5, -1, 0, 0, 0.5, 0, 1, 0,  0.5,
+                           0, -1, 0, 0.5, 0,  0, 1, 0.5, 0, 0, -1, 0.5};
+  static dReal points[] = {-0.5, -0.5, -0.5, 0.5, -0.5, -0.5, 0.5, 0.5, -0.5, -0.5, 0.5, -0.5,
+                           -0.5, -0.5, 0.5,  0.5, -0.5, 0.5,  0.5, 0.5, 0.5,  -0.5, 0.5, 0.5};
+  static unsigned polygons[] = {4, 1, 2, 6, 5, 4, 0, 4, 7, 3, 4, 3, 7, 6, 2,
+                                4, 0, 1, 5, 4, 4, 4, 5, 6, 7, 4, 0, 3, 2, 1};
+  switch (cls) {
+    case dSphereClass: return dCreateSphere(nullptr, 0.5);
+    case dBoxClass: return dCreateBox(nullptr, 1, 1, 1);
+    case dCapsuleClass: return dCreateCapsule(nullptr, 0.3, 0.5);
+    case dCylinderClass: return dCreateCylinder(nullptr, 0.5, 1);
+    case dPlaneClass: return dCreatePlane(nullptr, 0, 0, 1, 0);
+    case dConvexClass: return dCreateConvex(nullptr, planes, 6, points, 8, polygons);
+    default: return nullptr;
+  }
+}
+
+// Whether this ODE build collides geoms of these two classes at all: dCollide returns 0 for
+// a pair it has no collider for (Debian's libode is built without libccd: no cylinder-cylinder,
+// capsule-cylinder or convex-cylinder), which must not pass for "no contact".
+bool hasCollider(int a, int b) {
+  static std::mutex mutex;
+  static std::map<std::pair<int, int>, bool> known;
+  std::lock_guard<std::mutex> lock(mutex);
+  const auto key = std::minmax(a, b);
+  auto it = known.find(key);
+  if (it != known.end()) return it->second;
+  dGeomID g1 = probeGeom(a), g2 = probeGeom(b);
+  dContactGeom c[4];
+  const bool any = g1 && g2 && dCollide(g1, g2, 4, c, sizeof(dContactGeom)) > 0;
+  if (g1) dGeomDestroy(g1);
+  if (g2) dGeomDestroy(g2);
+  return known[key] = any;
+}
+
+const char* className(int cls) {
+  switch (cls) {
+    case dSphereClass: return "sphere";
+    case dBoxClass: return "box";
+    case dCapsuleClass: return "capsule";
+    case dCylinderClass: return "cylinder";
+    case dPlaneClass: return "plane";
+    case dConvexClass: return "convex_hull";
+    default: return "?";
   }
 }
 
@@ -136,6 +188,9 @@ class OdeWorld : public scene::World {
     } else {
       m.residual = st.maxResidual();
       m.status = toString(worst);
+      m.unsolved = static_cast<int>(
+          std::count_if(st.islands.begin(), st.islands.end(),
+                        [](const IslandStats& is) { return is.rows > 0 && !is.accepted; }));
     }
   }
 
@@ -151,7 +206,9 @@ class OdeWorld : public scene::World {
 }  // namespace
 
 OdeScene::OdeScene(const scene::Scene& s, const scene::RunSettings& run)
-    : materials_(s.materials), maxContactsPerPair_(s.settings.maxContactsPerPair) {
+    : materials_(s.materials),
+      maxContactsPerPair_(s.settings.maxContactsPerPair),
+      timeStep_(s.settings.timeStep) {
   ensureOdeInitialized();
   world_ = dWorldCreate();
   // Sweep and prune, not dHashSpaceCreate: ODE 0.16's hash space never reports some pairs of
@@ -164,20 +221,31 @@ OdeScene::OdeScene(const scene::Scene& s, const scene::RunSettings& run)
   dWorldSetAutoDisableFlag(world_, s.settings.sleeping ? 1 : 0);
   dWorldSetQuickStepNumIterations(world_, run.iterations);
 
-  for (std::size_t i = 0; i < s.bodies.size(); ++i) addBody(s, static_cast<int>(i));
-  for (const scene::Joint& j : s.joints) addJoint(j);
+  try {
+    for (std::size_t i = 0; i < s.bodies.size(); ++i) addBody(s, static_cast<int>(i));
+    for (const scene::Joint& j : s.joints) addJoint(j);
+  } catch (...) {  // scene::Unsupported: no destructor runs for a constructor that throws
+    release();
+    throw;
+  }
 }
 
-OdeScene::~OdeScene() {
-  dJointGroupDestroy(contacts_);
-  dSpaceDestroy(space_);  // destroys its geoms
-  dWorldDestroy(world_);  // destroys bodies and joints
+OdeScene::~OdeScene() { release(); }
+
+void OdeScene::release() {
+  if (contacts_) dJointGroupDestroy(contacts_);
+  if (space_) dSpaceDestroy(space_);  // destroys its geoms
+  if (world_) dWorldDestroy(world_);  // destroys bodies and joints
+  contacts_ = nullptr;
+  space_ = nullptr;
+  world_ = nullptr;
 }
 
 void OdeScene::collide() {
   contactCount_ = 0;
   deepest_ = 0;
   dSpaceCollide(space_, this, &OdeScene::nearCallback);
+  if (!missingCollider_.empty()) throw scene::Unsupported(missingCollider_);
 }
 
 void OdeScene::addBody(const scene::Scene& s, int index) {
@@ -195,6 +263,10 @@ void OdeScene::addBody(const scene::Scene& s, int index) {
     case scene::ShapeType::Capsule:
       g = dCreateCapsule(space_, b.shape.radius, b.shape.length);
       break;
+    case scene::ShapeType::Cylinder:
+      g = dCreateCylinder(space_, b.shape.radius, b.shape.length);
+      break;
+    case scene::ShapeType::ConvexHull: g = createConvex(b.shape); break;
   }
   materialOf_[g] = b.material;
   const dQuaternion q = {b.orientation.w, b.orientation.x, b.orientation.y, b.orientation.z};
@@ -249,8 +321,118 @@ void OdeScene::addJoint(const scene::Joint& j) {
       dJointAttach(joint, a, b);
       dJointSetFixed(joint);
       break;
+    default: addOtherJoint(j, a, b); break;
   }
   if (!j.collideConnected && j.body1 >= 0) noCollide_.insert(std::minmax(j.body0, j.body1));
+}
+
+dGeomID OdeScene::createConvex(const scene::Shape& shape) {
+  auto hull = std::make_unique<HullData>();
+  for (const scene::Vec3& p : shape.hullPoints)
+    hull->points.insert(hull->points.end(), p.begin(), p.end());
+  for (const std::vector<int>& face : shape.hullFaces) {
+    const scene::Vec3& p0 = shape.hullPoints[face[0]];
+    const scene::Vec3& p1 = shape.hullPoints[face[1]];
+    const scene::Vec3& p2 = shape.hullPoints[face[2]];
+    const double u[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+    const double v[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+    double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+    const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    for (double& c : n) c /= len;  // outward: the corners run counter-clockwise
+    hull->planes.insert(hull->planes.end(),
+                        {n[0], n[1], n[2], n[0] * p0[0] + n[1] * p0[1] + n[2] * p0[2]});
+    hull->polygons.push_back(static_cast<unsigned>(face.size()));
+    for (int i : face) hull->polygons.push_back(static_cast<unsigned>(i));
+  }
+  dGeomID g = dCreateConvex(space_, hull->planes.data(),
+                            static_cast<unsigned>(shape.hullFaces.size()), hull->points.data(),
+                            static_cast<unsigned>(shape.hullPoints.size()), hull->polygons.data());
+  hulls_.push_back(std::move(hull));  // ODE keeps pointers into these arrays
+  return g;
+}
+
+void OdeScene::addOtherJoint(const scene::Joint& j, dBodyID a, dBodyID b) {
+  const auto& p = j.anchor;
+  const auto& x = j.axis;
+  const auto& y = j.axis2;
+  dJointID joint = nullptr;
+  switch (j.type) {
+    case scene::JointType::ConeTwist: {
+      // A ball joint and an Euler angular motor whose stops limit each angle: twist about the
+      // axis (fixed in bodies[0]), swing1 about the normal (fixed in bodies[1]), swing2 about
+      // their cross product. Limits per angle make a pyramid of swings, not Bullet's elliptic
+      // cone; the middle Euler angle must stay below pi/2.
+      if (j.cone.swing2 >= 1.5)
+        throw scene::Unsupported("unsupported in ODE: cone_twist " + j.name +
+                                 ": swing2 of 1.5 rad or more (the middle angle of ODE's Euler "
+                                 "angular motor must stay below pi/2)");
+      joint = dJointCreateBall(world_, nullptr);
+      dJointAttach(joint, a, b);
+      dJointSetBallAnchor(joint, p[0], p[1], p[2]);
+      dJointID motor = dJointCreateAMotor(world_, nullptr);
+      dJointAttach(motor, a, b);
+      dJointSetAMotorMode(motor, dAMotorEuler);
+      dJointSetAMotorAxis(motor, 0, 1, x[0], x[1], x[2]);
+      dJointSetAMotorAxis(motor, 2, 2, j.normal[0], j.normal[1], j.normal[2]);
+      const double stops[3] = {j.cone.twist, j.cone.swing2, j.cone.swing1};
+      const int lo[3] = {dParamLoStop, dParamLoStop2, dParamLoStop3};
+      const int hi[3] = {dParamHiStop, dParamHiStop2, dParamHiStop3};
+      for (int i = 0; i < 3; ++i) {
+        dJointSetAMotorParam(motor, lo[i], -stops[i]);
+        dJointSetAMotorParam(motor, hi[i], stops[i]);
+      }
+      break;
+    }
+    case scene::JointType::Universal:
+      joint = dJointCreateUniversal(world_, nullptr);
+      dJointAttach(joint, a, b);
+      dJointSetUniversalAnchor(joint, p[0], p[1], p[2]);
+      dJointSetUniversalAxis1(joint, x[0], x[1], x[2]);
+      dJointSetUniversalAxis2(joint, y[0], y[1], y[2]);
+      break;
+    case scene::JointType::Hinge2:
+      joint = dJointCreateHinge2(world_, nullptr);
+      dJointAttach(joint, a, b);
+      dJointSetHinge2Anchor(joint, p[0], p[1], p[2]);
+      dJointSetHinge2Axes(joint, x.data(), y.data());
+      setLimitsAndMotor(joint, j, &dJointSetHinge2Param);
+      if (j.suspension.enabled) {
+        // ODE's spring-damper as a soft constraint: erp = h k / (h k + c), cfm = 1 / (h k + c).
+        const double hk = timeStep_ * j.suspension.stiffness, c = j.suspension.damping;
+        if (hk + c <= 0)
+          throw scene::Unsupported("unsupported in ODE: hinge2 " + j.name +
+                                   ": a suspension without stiffness or damping");
+        dJointSetHinge2Param(joint, dParamSuspensionERP, hk / (hk + c));
+        dJointSetHinge2Param(joint, dParamSuspensionCFM, 1 / (hk + c));
+      }
+      break;
+    case scene::JointType::Gear: {
+      const double d = x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
+      // Parallel-axes mode turns the wheels in opposite senses about one common axis: the
+      // scene's w0 . axis = -ratio w1 . axis2 with axis2 = axis.
+      if (std::abs(d - 1) > 1e-9)
+        throw scene::Unsupported("unsupported in ODE: gear " + j.name +
+                                 ": axis2 differs from axis (dTransmissionParallelAxes turns "
+                                 "both wheels about one direction)");
+      joint = dJointCreateTransmission(world_, nullptr);
+      dJointAttach(joint, a, b);
+      dJointSetTransmissionMode(joint, dTransmissionParallelAxes);
+      dJointSetTransmissionAnchor1(joint, p[0], p[1], p[2]);
+      dJointSetTransmissionAnchor2(joint, j.anchor2[0], j.anchor2[1], j.anchor2[2]);
+      dJointSetTransmissionAxis(joint, x[0], x[1], x[2]);
+      // ODE's ratio is the first wheel's radius over the second's (transmission.cpp), the
+      // inverse of the speed ratio the scene gives.
+      dJointSetTransmissionRatio(joint, 1 / j.ratio);
+      break;
+    }
+    case scene::JointType::SixDof:
+      throw scene::Unsupported("unsupported in ODE: six_dof joint " + j.name +
+                               " (ODE has no joint with per-axis limits and springs)");
+    default:
+      throw scene::Unsupported(std::string("unsupported in ODE: joint type ") +
+                               scene::toString(j.type));
+  }
+  (void)joint;
 }
 
 void OdeScene::nearCallback(void* data, dGeomID g1, dGeomID g2) {
@@ -261,6 +443,10 @@ void OdeScene::nearCallback(void* data, dGeomID g1, dGeomID g2) {
   const int n = w->maxContactsPerPair_;
   w->buffer_.resize(n);
   const int found = dCollide(g1, g2, n, &w->buffer_[0].geom, sizeof(dContact));
+  const int c1 = dGeomGetClass(g1), c2 = dGeomGetClass(g2);
+  if (found == 0 && w->missingCollider_.empty() && !hasCollider(c1, c2))
+    w->missingCollider_ = std::string("unsupported in ODE: contacts between ") + className(c1) +
+                          " and " + className(c2) + " (this ODE build has no collider for them)";
   const scene::Material& m1 = w->materials_[w->materialOf_.at(g1)];
   const scene::Material& m2 = w->materials_[w->materialOf_.at(g2)];
   const double mu = scene::combinedFriction(m1, m2);

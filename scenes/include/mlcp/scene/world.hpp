@@ -18,11 +18,14 @@
 //   joint_error   max over joints of the drift of the joint's anchor: the anchor is fixed in
 //                 each body's frame at creation; the error is the distance between its two
 //                 world positions now (for a slider only the part perpendicular to the axis,
-//                 which is free to slide); orientation drift is not measured  (m)
+//                 which is free to slide); orientation drift is not measured; joints that
+//                 let their anchors part (gears, hinge-2 suspensions, six_dof joints with a
+//                 linear axis not locked) are left out  (m)
 #pragma once
 
 #include <limits>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -30,6 +33,14 @@
 #include "mlcp/scene/scene.hpp"
 
 namespace mlcp::scene {
+
+// What an engine loader throws for a scene feature that engine cannot express, with a message
+// "unsupported in ENGINE: what": never a silent drop. An invalid_argument, as an unknown solver
+// name is (the CLI exits 2 on both).
+class Unsupported : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
 
 // What a run uses: the solver and its limits. fromScene() takes the scene's `solver` defaults.
 struct RunSettings {
@@ -80,6 +91,10 @@ struct StepMeasures {
   // Worst status over islands, mlcp::toString names ("converged", "max-iterations", ...).
   std::string status = "converged";
   int fallbacks = 0;
+  // Islands whose applied answer still fails mlcp::acceptable after the fallback (Bullet's
+  // StepStats::failures, ODE's IslandStats::accepted false); 0 for stock solvers, which do not
+  // say.
+  int unsolved = 0;
   // Which solver answered each island, counted: e.g. "dantzig:3 ldlt:1 none:2" (islands with
   // no rows are "none"); "" when the engine does not say (stock solvers).
   std::string choice;

@@ -14,7 +14,11 @@
 //
 // How the scene maps onto Bullet:
 // - shapes: plane btStaticPlaneShape(normal, offset), box btBoxShape(size / 2), sphere
-//   btSphereShape, capsule btCapsuleShapeZ(radius, length) (along the body's z axis);
+//   btSphereShape, capsule btCapsuleShapeZ(radius, length) (along the body's z axis), cylinder
+//   btCylinderShapeZ(radius, radius, length / 2), convex hull btConvexHullShape of the corners
+//   with a 1 mm margin (Bullet's 0.04 m default inflates the hull) and its polyhedral features
+//   for separating-axis contact clipping (the world's m_enableSatConvex, set when a hull is
+//   present);
 // - mass and the scene's inertia (never Bullet's own approximation, which is a box for
 //   capsules); pose, velocities; sleeping only when the scene allows it;
 // - materials: Bullet multiplies the two bodies' friction, so each body gets sqrt(mu) and a
@@ -28,7 +32,17 @@
 //   Bullet measures the hinge angle of its body A relative to B, as the scene does, but the
 //   slider offset of B relative to A: the slider's frame axis is reversed so that its limits
 //   and motor keep the scene's signs (world_test checks both by driving the motors into the
-//   upper limits);
+//   upper limits); cone_twist btConeTwistConstraint (frame x the twist axis, z the normal:
+//   setLimit(swing1, swing2, twist)); six_dof btGeneric6DofSpring2Constraint (RO_XYZ, frame
+//   x = axis, y = normal, its body B the scene's bodies[0] so that offsets and angles are
+//   bodies[0]'s relative to bodies[1]; free axes lower 1 > upper -1, springs at the creation
+//   pose; stiffness and damping as the scene gives them, setStiffness(i, k, false): by default
+//   Bullet caps a spring at m / (16 dt^2) of the lighter body, which let the vehicle's 20 kN/m
+//   suspension act as 2.2 kN/m and the chassis sink 0.23 m); universal
+//   btUniversalConstraint(anchor, axis, axis2); hinge2 btHinge2Constraint (chassis, wheel, anchor,
+//   axis, axis2), steering limits, the suspension as its spring on linear z within Bullet's +-1 m
+//   travel, or linear z locked when the scene has none; gear btGearConstraint with both axes in
+//   their bodies' frames and the ratio;
 // - settings: gravity, one fixed step of time_step per step (no substeps), m_erp = m_erp2 =
 //   erp, m_globalCfm = cfm, m_numIterations = iterations, minimumSolverBatchSize 1 (islands
 //   solved one by one, as the direct solvers want), SOLVER_USE_2_FRICTION_DIRECTIONS (two
@@ -82,6 +96,9 @@ class BulletScene {
  private:
   void addBody(const scene::Scene& s, const scene::Body& b);
   void addJoint(const scene::Joint& j);
+  // The joint types beyond ball, hinge, slider and fixed (see the mapping above).
+  std::unique_ptr<btTypedConstraint> makeJoint(const scene::Joint& j, btRigidBody& a,
+                                               btRigidBody& b) const;
 
   double timeStep_;
   std::unique_ptr<btDefaultCollisionConfiguration> config_;

@@ -14,8 +14,12 @@
 //
 // How the scene maps onto ODE:
 // - one dWorld and a hash space; geoms dCreatePlane (a x + b y + c z = d), dCreateBox,
-//   dCreateSphere, dCreateCapsule (along the body's z axis). Static bodies are geoms without
-//   a body (placed by their pose);
+//   dCreateSphere, dCreateCapsule, dCreateCylinder (along the body's z axis), dCreateConvex
+//   (planes and polygons from the scene's hull faces). Static bodies are geoms without a body
+//   (placed by their pose). A pair of geom classes this ODE build has no collider for (Debian's
+//   libode has no libccd: cylinder-cylinder, capsule-cylinder, convex-cylinder) makes
+//   collide() throw scene::Unsupported the first time such a pair's boxes overlap, rather than
+//   pass for "no contact";
 // - masses through dMassSetParameters with the scene's inertia (centre of mass at the body
 //   origin); pose, velocities; auto-disable only when the scene allows sleeping;
 // - contacts from dSpaceCollide in a near callback: at most max_contacts_per_pair points per
@@ -26,6 +30,14 @@
 // - joints: dJointCreateBall / Hinge (dParamLoStop, dParamHiStop, dParamVel, dParamFMax) /
 //   Slider (the same) / Fixed, attached as (A, B) or (A, 0) for the world. ODE measures the
 //   hinge angle and slider offset of body 1 relative to body 2, as the scene does;
+//   cone_twist a ball joint plus a dAMotorEuler whose stops hold twist (about the axis, fixed
+//   in A), swing2 (the middle angle, < 1.5 rad) and swing1 (about the normal, fixed in B):
+//   limits per angle, a pyramid where Bullet's is an elliptic cone; universal
+//   dJointCreateUniversal; hinge2 dJointCreateHinge2 (steering stops; a suspension of stiffness
+//   k and damping c as dParamSuspensionERP h k / (h k + c) and CFM 1 / (h k + c), ODE's
+//   spring formulas); gear dJointCreateTransmission in dTransmissionParallelAxes mode with the
+//   two centres as anchors and ODE's ratio (first radius over second) 1 / ratio. six_dof
+//   throws scene::Unsupported: ODE has no joint with per-axis springs and limits;
 // - settings: gravity, dWorldSetERP(erp), dWorldSetCFM(cfm) (ODE adds cfm / h to A's
 //   diagonal, the scene's meaning).
 //
@@ -79,7 +91,17 @@ class OdeScene {
  private:
   void addBody(const scene::Scene& s, int index);
   void addJoint(const scene::Joint& j);
+  // The joint types beyond ball, hinge, slider and fixed (see the mapping above).
+  void addOtherJoint(const scene::Joint& j, dBodyID a, dBodyID b);
+  void release();  // destroys the ODE objects (the destructor, or a constructor that throws)
+  dGeomID createConvex(const scene::Shape& shape);
   static void nearCallback(void* data, dGeomID g1, dGeomID g2);
+
+  // dCreateConvex's arrays, which ODE points into for the geom's life.
+  struct HullData {
+    std::vector<dReal> planes, points;
+    std::vector<unsigned> polygons;
+  };
 
   dWorldID world_ = nullptr;
   dSpaceID space_ = nullptr;
@@ -87,6 +109,11 @@ class OdeScene {
   std::vector<dBodyID> bodies_;
   std::vector<scene::Material> materials_;
   int maxContactsPerPair_ = 0;
+  double timeStep_ = 0;
+  std::vector<std::unique_ptr<HullData>> hulls_;
+  // Set by the near callback for a pair of geom classes ODE has no collider for; collide()
+  // throws scene::Unsupported with it.
+  std::string missingCollider_;
   std::map<dGeomID, int> materialOf_;
   std::set<std::pair<int, int>> noCollide_;
   std::vector<dContact> buffer_;
