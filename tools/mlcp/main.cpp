@@ -3,6 +3,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "mlcp/input_limits.hpp"
 #include "mlcp/registry.hpp"
 
 int main(int argc, char** argv) {
@@ -26,8 +27,10 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : mlcp::cli::kInvalidInput;
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help
+    // One line, the value echoed short: an option's text can be anything.
+    std::cerr << "mlcp: " << mlcp::io::capped(e.what(), 200) << " (see --help)\n";
+    return mlcp::cli::kInvalidInput;
   }
   for (auto& [cmd, run] : commands)
     if (cmd->parsed()) return run();

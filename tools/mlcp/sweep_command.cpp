@@ -357,7 +357,7 @@ Runner addSweepCommand(CLI::App& app) {
       ->delimiter(',')
       ->required();
   cmd->add_option("--steps", args->steps, "steps per run (default: each scene's settings.steps)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(nonNegativeNumber());
   cmd->add_flag("--no-warm-start", args->noWarmStart, "start every solve from zero");
   cmd->add_option("--fallback", args->fallback,
                   "core solver run when an answer is rejected, or none (default pgs)");

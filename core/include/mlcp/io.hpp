@@ -14,6 +14,11 @@
 // dense (storage 0) and sparse-block (storage 1) matrices, see ../shared/data/siconos/README.md.
 // Both store their values column by column (the dense form prints one column per line).
 //
+// Every reader runs the guards of mlcp/input_limits.hpp (regular files of at most 256 MiB, JSON
+// nesting of at most 64 levels, messages that quote at most 60 characters of the input) and
+// takes entries of A and b, and finite bounds, of magnitude at most 1e100: products of two
+// entries and sums of many such products stay finite.
+//
 // Errors are thrown as FormatError, whose message names the file and what is wrong. A file
 // that parses but describes an invalid problem (lo > hi, findex out of range, ...) is reported
 // too: readers return only problems that pass Problem::validate().
@@ -39,6 +44,7 @@ std::string problemToJson(const Problem& problem);
 
 // Reads a Siconos LCP .dat file (dense or sparse-block storage).
 Problem readSiconosLcp(const std::string& path);
+Problem parseSiconosLcp(const std::string& text, const std::string& sourceName = "<string>");
 
 // Reads either kind, chosen by the file's extension (.json or .dat).
 Problem readProblem(const std::string& path);
