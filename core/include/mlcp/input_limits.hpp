@@ -27,7 +27,7 @@
 namespace mlcp::io {
 
 // Largest files read, in bytes. Problem files: 256 MiB holds a dense problem of n = 3000
-// written at full precision (9 million numbers) or a sparse one of some 10 million non-zeros.
+// written at full precision (9 million numbers) or a sparse one of some 7 million non-zeros.
 inline constexpr std::size_t kMaxProblemFileBytes = std::size_t(256) << 20;
 // Scene files: 16 MiB is some 100 000 explicit bodies (the scene's body limit); generators keep
 // real scenes at a few kB.
