@@ -31,7 +31,8 @@ std::string shortDump(const json& v) {
   return s;
 }
 
-std::string inQuotes(const std::string& s) { return "\"" + s + "\""; }
+// Names and keys come from the file: quoted capped, so that a message stays one short line.
+std::string inQuotes(const std::string& s) { return "\"" + io::capped(s) + "\""; }
 
 std::string joinNames(std::initializer_list<const char*> names) {
   std::string s;
@@ -47,7 +48,9 @@ class Node {
       : v_(value), path_(std::move(path)), source_(source) {}
 
   [[noreturn]] void fail(const std::string& what) const {
-    throw FormatError(source_ + ": " + (path_.empty() ? "top level" : path_) + ": " + what);
+    const std::string where =
+        path_.empty() ? "top level" : io::capped(path_, 2 * io::kMaxEchoChars);
+    throw FormatError(source_ + ": " + where + ": " + what);
   }
 
   const json& value() const { return v_; }

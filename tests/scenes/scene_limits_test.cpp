@@ -39,6 +39,11 @@ void expectFileError(const std::string& name, const std::vector<std::string>& pa
   EXPECT_EQ(what.find('\n'), std::string::npos) << what.substr(0, 400);
 }
 
+std::string oneBody(const std::string& fields) {
+  return R"({"format": "mlcp-scene/1", "bodies": [{"name": "b", )" + fields + "}]}";
+}
+const char* kBox = R"("shape": {"type": "box", "size": [1, 1, 1]}, )";
+
 TEST(SceneFuzzRegression, NumberOverflow1e309) {
   expectFileError("scene_number_overflow_1e309.json", {"not valid JSON: number overflow"});
 }
@@ -61,6 +66,26 @@ TEST(SceneFuzzRegression, Nested5000Levels) {
   expectFileError("scene_nested_5000.json", {"JSON nested deeper than 64 levels"});
 }
 
+// Found by scene_parser_fuzz: a key of 7000 characters was echoed whole ("unknown field ...").
+TEST(SceneFuzzRegression, LongUnknownField) {
+  expectFileError("scene_long_unknown_field.json", {"unknown field \"po[[[[", "...\""});
+}
+
+TEST(SceneFuzzRegression, LongNamesAreCappedInEveryMessage) {
+  const std::string name(5000, 'n');
+  for (const std::string& text :
+       {oneBody(std::string(kBox) + R"("mass": 1, "material": ")" + name + "\""),
+        R"({"format": "mlcp-scene/1", "materials": {")" + name +
+            R"(": {"friction": -1}}, "bodies": []})",
+        R"({"format": "mlcp-scene/1", "bodies": [{"name": "b", )" + std::string(kBox) +
+            R"("mass": 1}], "joints": [{"type": "ball", "bodies": [")" + name +
+            R"("], "anchor": [0, 0, 0]}]})"}) {
+    const std::string e = errorOf(text);
+    EXPECT_FALSE(e.empty());
+    EXPECT_LT(e.size(), 300u) << e.substr(0, 400);
+  }
+}
+
 TEST(SceneFiles, NotRegularFilesAreRefused) {
   for (const char* path : {"/dev/zero", "/dev/urandom"}) {
     try {
@@ -72,11 +97,6 @@ TEST(SceneFiles, NotRegularFilesAreRefused) {
     }
   }
 }
-
-std::string oneBody(const std::string& fields) {
-  return R"({"format": "mlcp-scene/1", "bodies": [{"name": "b", )" + fields + "}]}";
-}
-const char* kBox = R"("shape": {"type": "box", "size": [1, 1, 1]}, )";
 
 TEST(SceneLimits, EachRangeNamesItsField) {
   using namespace limits;
