@@ -35,7 +35,7 @@ found=0
 for t in "${targets[@]}"; do
   corpus=$build/corpus/$t crashes=$build/crashes/$t
   mkdir -p "$corpus" "$crashes"
-  seed "$t" | while read -r f; do [ -f "$f" ] && cp -n "$f" "$corpus/" ; done
+  seed "$t" | while read -r f; do if [ -f "$f" ]; then cp -n "$f" "$corpus/"; fi; done
   log=$build/$t.log
   set +e
   ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
