@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Installs everything mlcp needs on Debian 12 (run as root, or with sudo available) and
-# fetches ODE's internal headers from Debian's source package. Idempotent and quick when
-# everything is already there. Used by tools/test.sh and tools/main.sh.
+# Installs everything mlcp needs on Debian 12 (run as root, or with sudo available; clang and
+# libclang-rt-14-dev, which holds libFuzzer, are for tools/fuzz.sh) and fetches ODE's internal
+# headers from Debian's source package. Idempotent and quick when everything is already there.
+# Used by tools/test.sh and tools/main.sh.
 set -euo pipefail
 repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 
@@ -11,6 +12,7 @@ packages=(
   libbullet-dev libode-dev
   libgtest-dev libbenchmark-dev nlohmann-json3-dev libcli11-dev
   clang-format dpkg-dev python3 python3-venv
+  clang libclang-rt-14-dev
 )
 
 sudo_if_needed() { if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi; }

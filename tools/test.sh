@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # The whole test suite: set-up, the format check (tools/format.sh --check), a Release build with
-# every test (ctest), then the same tests under AddressSanitizer + UndefinedBehaviorSanitizer.
+# every test (ctest), the fuzz targets for 20 s each (tools/fuzz.sh: libFuzzer, its own clang
+# build tree of the core and scene libraries only), then the same tests under AddressSanitizer +
+# UndefinedBehaviorSanitizer.
 # Exit status is non-zero on any failure.
 #   tools/test.sh            everything
 #   tools/test.sh --fast     the Release build only (no sanitizer build)
@@ -18,6 +20,9 @@ echo "== Release build and tests"
 ctest --test-dir "$repo/build" --output-on-failure -j "$jobs"
 
 if [ "${1:-}" != "--fast" ]; then
+  echo "== Fuzzing (20 s per target)"
+  "$repo/tools/fuzz.sh" 20
+
   echo "== Sanitizer build (ASan + UBSan) and tests"
   "$repo/tools/build.sh" "$repo/build-asan" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMLCP_SANITIZE=ON
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \

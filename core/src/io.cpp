@@ -3,9 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iomanip>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <utility>
+
+#include "mlcp/input_limits.hpp"
 
 namespace mlcp::io {
 
@@ -18,21 +21,39 @@ namespace {
 }
 
 std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, "cannot open file");
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
+  return readInputFile(path, kMaxProblemFileBytes, "problem file");
+}
+
+json parseDocument(const std::string& text, const std::string& source) {
+  checkJsonNesting(text, source);
+  try {
+    return json::parse(text);
+  } catch (const json::exception& e) {
+    fail(source, jsonErrorText(e));
+  }
+}
+
+// Entries of A and b, and finite bounds, are at most this large in magnitude: products of two
+// of them and sums of a million such products stay finite (1e100^2 * 1e6 < 1e308).
+constexpr double kMaxMagnitude = 1e100;
+
+double checkedEntry(double v, const std::string& source, const std::string& where) {
+  if (!(std::abs(v) <= kMaxMagnitude)) {
+    std::ostringstream os;
+    os << where << " = " << std::setprecision(3) << v << " is outside [-1e100, 1e100]";
+    fail(source, os.str());
+  }
+  return v;
 }
 
 double number(const json& v, const std::string& source, const std::string& where) {
-  if (v.is_number()) return v.get<double>();
+  if (v.is_number()) return checkedEntry(v.get<double>(), source, where);
   if (v.is_string()) {
     const std::string s = v.get<std::string>();
     if (s == "inf" || s == "+inf") return kInf;
     if (s == "-inf") return -kInf;
   }
-  fail(source, where + " must be a number or \"inf\"/\"-inf\", got " + v.dump());
+  fail(source, where + " must be a number or \"inf\"/\"-inf\", got " + capped(v.dump()));
 }
 
 Vector vectorField(const json& doc, const char* key, int n, const std::string& source,
@@ -67,7 +88,8 @@ void setMatrix(Problem& p, const json& a, int n, const std::string& source) {
       for (int j = 0; j < n; ++j) {
         if (!row[j].is_number())
           fail(source, "A[" + std::to_string(i) + "][" + std::to_string(j) + "] is not a number");
-        A(i, j) = row[j].get<double>();
+        A(i, j) = checkedEntry(row[j].get<double>(), source,
+                               "A[" + std::to_string(i) + "][" + std::to_string(j) + "]");
       }
     }
     p.setA(std::move(A));
@@ -93,7 +115,8 @@ void setMatrix(Problem& p, const json& a, int n, const std::string& source) {
     if (i < 0 || i >= n || j < 0 || j >= n)
       fail(source, where + " index (" + std::to_string(i) + ", " + std::to_string(j) +
                        ") is outside 0.." + std::to_string(n - 1));
-    triplets.emplace_back(static_cast<int>(i), static_cast<int>(j), e[2].get<double>());
+    triplets.emplace_back(static_cast<int>(i), static_cast<int>(j),
+                          checkedEntry(e[2].get<double>(), source, where));
   }
   SparseMatrix A(n, n);
   A.setFromTriplets(triplets.begin(), triplets.end());  // sums duplicates
@@ -113,12 +136,7 @@ void checkValid(const Problem& p, const std::string& source) {
 }  // namespace
 
 Problem parseProblemJson(const std::string& text, const std::string& source) {
-  json doc;
-  try {
-    doc = json::parse(text);
-  } catch (const json::exception& e) {
-    fail(source, std::string("not valid JSON: ") + e.what());
-  }
+  const json doc = parseDocument(text, source);
   if (!doc.is_object()) fail(source, "top level must be a JSON object");
   if (!doc.contains("format") || doc["format"] != "mlcp-problem/1")
     fail(source, "\"format\" must be \"mlcp-problem/1\"");
@@ -128,8 +146,10 @@ Problem parseProblemJson(const std::string& text, const std::string& source) {
   const int n = static_cast<int>(doc["n"].get<long long>());
   if (!doc.contains("A")) fail(source, "missing \"A\"");
   Problem p;
-  setMatrix(p, doc["A"], n, source);
+  // b first: its n entries bound n by the file's size before A (n x n, or n + 1 column
+  // pointers) is allocated.
   p.b = vectorField(doc, "b", n, source, 0, true);
+  setMatrix(p, doc["A"], n, source);
   p.lo = vectorField(doc, "lo", n, source, 0, false);
   p.hi = vectorField(doc, "hi", n, source, kInf, false);
   if (doc.contains("findex")) {
@@ -199,7 +219,12 @@ namespace {
 // Whitespace-separated tokens of a Siconos .dat file, with the file name in every error.
 class Tokens {
  public:
-  Tokens(const std::string& text, std::string source) : in_(text), source_(std::move(source)) {}
+  Tokens(const std::string& text, std::string source)
+      : in_(text), source_(std::move(source)), maxCount_((text.size() + 1) / 2) {}
+
+  // The most numbers the text can still hold (each takes a character and a separator): a
+  // bound on every count read, checked before anything of that size is allocated.
+  long long maxCount() const { return maxCount_; }
 
   long long integer(const char* what) {
     std::string tok = next(what);
@@ -211,7 +236,7 @@ class Tokens {
       used = 0;
     }
     if (used != tok.size())
-      fail(source_, std::string("expected an integer for ") + what + ", got '" + tok + "'");
+      fail(source_, std::string("expected an integer for ") + what + ", got '" + capped(tok) + "'");
     return v;
   }
 
@@ -225,8 +250,9 @@ class Tokens {
       used = 0;
     }
     if (used != tok.size() || !std::isfinite(v))
-      fail(source_, std::string("expected a finite number for ") + what + ", got '" + tok + "'");
-    return v;
+      fail(source_,
+           std::string("expected a finite number for ") + what + ", got '" + capped(tok) + "'");
+    return checkedEntry(v, source_, what);
   }
 
   const std::string& source() const { return source_; }
@@ -239,6 +265,7 @@ class Tokens {
   }
   std::istringstream in_;
   std::string source_;
+  long long maxCount_;
 };
 
 long long checkedSize(Tokens& t, const char* what, long long maxValue) {
@@ -251,6 +278,9 @@ long long checkedSize(Tokens& t, const char* what, long long maxValue) {
 // Siconos writes its column-major storage in sequence (NM_write_in_file), so each printed
 // line is a column; the block files agree only when read this way.
 DenseMatrix readColumnMajor(Tokens& t, int rows, int cols, const char* what) {
+  if (static_cast<long long>(rows) * cols > t.maxCount())
+    fail(t.source(), "a " + std::to_string(rows) + "x" + std::to_string(cols) +
+                         " matrix needs more entries than the file holds");
   DenseMatrix M(rows, cols);
   for (int j = 0; j < cols; ++j)
     for (int i = 0; i < rows; ++i) M(i, j) = t.real(what);
@@ -273,7 +303,7 @@ DenseMatrix readSiconosDense(Tokens& t, int n) {
 SparseMatrix readSiconosBlock(Tokens& t, int n) {
   const long long size0 = t.integer("matrix rows"), size1 = t.integer("matrix cols");
   if (size0 != n || size1 != n) fail(t.source(), "block matrix size does not match n");
-  const long long nbBlocks = checkedSize(t, "number of blocks", 1LL << 30);
+  const long long nbBlocks = checkedSize(t, "number of blocks", t.maxCount());
   const long long nRowBlocks = checkedSize(t, "number of block rows", n);
   const long long nColBlocks = checkedSize(t, "number of block columns", n);
   std::vector<long long> rowEnd(nRowBlocks), colEnd(nColBlocks);
@@ -317,9 +347,11 @@ SparseMatrix readSiconosBlock(Tokens& t, int n) {
 
 }  // namespace
 
-Problem readSiconosLcp(const std::string& path) {
-  Tokens t(slurp(path), path);
-  const int n = static_cast<int>(checkedSize(t, "n", 10000000));
+Problem readSiconosLcp(const std::string& path) { return parseSiconosLcp(slurp(path), path); }
+
+Problem parseSiconosLcp(const std::string& text, const std::string& path) {
+  Tokens t(text, path);
+  const int n = static_cast<int>(checkedSize(t, "n", std::min(10000000LL, t.maxCount())));
   const long long storage = t.integer("storage type");
   Problem p;
   if (storage == 0) {
@@ -385,6 +417,9 @@ void readMlcpStorage1(Tokens& t, long long size, Problem& p) {
 // prints and reads them with the row index outermost), then a (n) and b (m), assembled into
 // M = [[A, C], [D, B]] and q = [a; b].
 DenseMatrix readRowMajor(Tokens& t, int rows, int cols, const char* what) {
+  if (static_cast<long long>(rows) * cols > t.maxCount())
+    fail(t.source(), "a " + std::to_string(rows) + "x" + std::to_string(cols) +
+                         " matrix needs more entries than the file holds");
   DenseMatrix M(rows, cols);
   for (int i = 0; i < rows; ++i)
     for (int j = 0; j < cols; ++j) M(i, j) = t.real(what);
@@ -423,8 +458,9 @@ Problem readSiconosMlcp(const std::string& path) {
   if ((storage1 != 0 && storage1 != 1) || (storage2 != 0 && storage2 != 1) ||
       storage1 + storage2 == 0)
     fail(path, "the storage flags are not 0/1 with at least one set");
-  const int n = static_cast<int>(checkedSize(t, "n", 10000000));
-  const int m = static_cast<int>(checkedSize(t, "m", 10000000 - n));
+  const long long limit = std::min(10000000LL, t.maxCount());
+  const int n = static_cast<int>(checkedSize(t, "n", limit));
+  const int m = static_cast<int>(checkedSize(t, "m", limit - n));
   Problem p;
   if (storage1) {
     readMlcpBlocks(t, n + m, p);
@@ -463,12 +499,7 @@ Problem readProblem(const std::string& path) {
 }
 
 Vector readVectorJson(const std::string& path) {
-  json doc;
-  try {
-    doc = json::parse(slurp(path));
-  } catch (const json::exception& e) {
-    fail(path, std::string("not valid JSON: ") + e.what());
-  }
+  json doc = parseDocument(slurp(path), path);
   if (doc.is_object() && doc.contains("x")) doc = doc["x"];
   if (!doc.is_array()) fail(path, "expected an array of numbers (or an object with \"x\")");
   Vector v(doc.size());

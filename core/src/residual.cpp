@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace mlcp {
 
@@ -25,5 +26,83 @@ Accuracy accuracy(const Problem& problem, const Vector& x) {
 }
 
 double residual(const Problem& problem, const Vector& x) { return accuracy(problem, x).residual; }
+
+namespace {
+
+constexpr double kUnitRoundoff = 0x1p-53;
+
+// Error-free transformations: a + b = s + e and a * b = p + e exactly.
+void twoSum(double a, double b, double& s, double& e) {
+  s = a + b;
+  const double bv = s - a;
+  e = (a - (s - bv)) + (b - bv);
+}
+void twoProduct(double a, double b, double& p, double& e) {
+  p = a * b;
+  e = std::fma(a, b, -p);
+}
+
+// ||A||_inf, the largest absolute row sum.
+double rowSumNorm(const Problem& problem) {
+  if (problem.size() == 0) return 0;
+  if (!problem.isSparse()) return problem.denseA().cwiseAbs().rowwise().sum().maxCoeff();
+  Vector sums = Vector::Zero(problem.size());
+  const SparseMatrix& A = problem.sparseA();
+  for (int k = 0; k < A.outerSize(); ++k)
+    for (SparseMatrix::InnerIterator it(A, k); it; ++it) sums[it.row()] += std::abs(it.value());
+  return sums.maxCoeff();
+}
+
+// Dot2 of row i of A with x, plus b_i.
+class CompensatedRow {
+ public:
+  explicit CompensatedRow(double b) : sum_(b) {}
+  void add(double a, double x) {
+    double p, ep, es;
+    twoProduct(a, x, p, ep);
+    twoSum(sum_, p, sum_, es);
+    error_ += ep + es;
+  }
+  double value() const { return sum_ + error_; }
+
+ private:
+  double sum_, error_ = 0;
+};
+
+}  // namespace
+
+Vector compensatedSlack(const Problem& problem, const Vector& x) {
+  const int n = problem.size();
+  std::vector<CompensatedRow> rows;
+  rows.reserve(n);
+  for (int i = 0; i < n; ++i) rows.emplace_back(problem.b[i]);
+  if (problem.isSparse()) {
+    const SparseMatrix& A = problem.sparseA();
+    for (int k = 0; k < A.outerSize(); ++k)
+      for (SparseMatrix::InnerIterator it(A, k); it; ++it)
+        rows[it.row()].add(it.value(), x[it.col()]);
+  } else {
+    const DenseMatrix& A = problem.denseA();
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) rows[i].add(A(i, j), x[j]);
+  }
+  Vector w(n);
+  for (int i = 0; i < n; ++i) w[i] = rows[i].value();
+  return w;
+}
+
+Accuracy checkedAccuracy(const Problem& problem, const Vector& x, const Vector& w,
+                         double tolerance) {
+  const Accuracy plain = accuracy(problem, x, w);
+  if (!plain.finite || problem.size() == 0) return plain;
+  const double n = problem.size();
+  const double gamma = (n + 1) * kUnitRoundoff / (1 - (n + 1) * kUnitRoundoff);
+  const double xNorm = x.lpNorm<Eigen::Infinity>(), bNorm = problem.b.lpNorm<Eigen::Infinity>();
+  const double bound = gamma * (rowSumNorm(problem) * xNorm + bNorm) +
+                       3 * kUnitRoundoff * (xNorm + w.lpNorm<Eigen::Infinity>());
+  // The bound itself is rounded: 1% more covers that many times over.
+  if (std::abs(plain.residual - tolerance) > 1.01 * bound / (1 + bNorm)) return plain;
+  return accuracy(problem, x, compensatedSlack(problem, x));
+}
 
 }  // namespace mlcp

@@ -108,7 +108,8 @@ Result Solver::runChecked(const Problem& problem, Vector& x) {
   else
     slack_.noalias() = problem.denseA() * start_;
   slack_ += problem.b;
-  applyAccuracy(r, accuracy(problem, start_, slack_), options_.tolerance);
+  applyAccuracy(r, checkedAccuracy(problem, start_, slack_, options_.tolerance),
+                options_.tolerance);
   x.swap(start_);
   r.seconds = elapsed();
   return r;

@@ -12,6 +12,9 @@
 
 #include "mlcp/scene/convex_hull.hpp"
 
+#include "mlcp/input_limits.hpp"
+#include "mlcp/scene/scene_limits.hpp"
+
 namespace mlcp::scene {
 
 using nlohmann::json;
@@ -20,7 +23,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 // A typo such as "count": 1e6 should fail fast rather than allocate for minutes.
-constexpr long long kMaxGeneratedBodies = 100000;
+constexpr long long kMaxGeneratedBodies = limits::kMaxBodies;
 
 double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 double norm(const Vec3& a) { return std::sqrt(dot(a, a)); }
@@ -31,7 +34,8 @@ std::string shortDump(const json& v) {
   return s;
 }
 
-std::string inQuotes(const std::string& s) { return "\"" + s + "\""; }
+// Names and keys come from the file: quoted capped, so that a message stays one short line.
+std::string inQuotes(const std::string& s) { return "\"" + io::capped(s) + "\""; }
 
 std::string joinNames(std::initializer_list<const char*> names) {
   std::string s;
@@ -47,7 +51,9 @@ class Node {
       : v_(value), path_(std::move(path)), source_(source) {}
 
   [[noreturn]] void fail(const std::string& what) const {
-    throw FormatError(source_ + ": " + (path_.empty() ? "top level" : path_) + ": " + what);
+    const std::string where =
+        path_.empty() ? "top level" : io::capped(path_, 2 * io::kMaxEchoChars);
+    throw FormatError(source_ + ": " + where + ": " + what);
   }
 
   const json& value() const { return v_; }
@@ -147,6 +153,9 @@ class Node {
   }
   Vec3 unitVec3() const {
     Vec3 r = vec3("a direction (3 numbers, not all 0)");
+    // Scaled by the largest component first: the norm of [-1e308, -1, 0] overflows.
+    const double big = std::max({std::abs(r[0]), std::abs(r[1]), std::abs(r[2])});
+    if (big > 0) r = {r[0] / big, r[1] / big, r[2] / big};
     double n = norm(r);
     if (n < 1e-12) fail("expected a direction (3 numbers, not all 0), got " + shortDump(v_));
     return {r[0] / n, r[1] / n, r[2] / n};
@@ -686,14 +695,6 @@ std::string stem(const std::string& source) {
   return p.extension() == ".json" ? p.stem().string() : p.filename().string();
 }
 
-std::string withoutJsonPrefix(const std::string& what) {
-  // nlohmann's messages start with "[json.exception.parse_error.101] ".
-  auto close = what.find("] ");
-  return what.rfind("[json.exception", 0) == 0 && close != std::string::npos
-             ? what.substr(close + 2)
-             : what;
-}
-
 }  // namespace
 
 Vec3 rotate(const Quat& q, const Vec3& v) {
@@ -798,11 +799,12 @@ int Scene::dynamicBodyCount() const {
 }
 
 Scene parseScene(const std::string& text, const std::string& sourceName) {
+  io::checkJsonNesting(text, sourceName);
   json doc;
   try {
     doc = json::parse(text);
-  } catch (const json::parse_error& e) {
-    throw FormatError(sourceName + ": not valid JSON: " + withoutJsonPrefix(e.what()));
+  } catch (const json::exception& e) {  // syntax errors, and out_of_range for "1e309"
+    throw FormatError(sourceName + ": " + io::jsonErrorText(e));
   }
   const Node root(doc, "", sourceName);
   root.allowOnly({"format", "name", "description", "gravity", "settings", "solver", "materials",
@@ -850,15 +852,12 @@ Scene parseScene(const std::string& text, const std::string& sourceName) {
     for (std::size_t i = 0; i < joints.arraySize(); ++i)
       scene.joints.push_back(parseJoint(joints.item(i), i, scene));
   }
+  checkSceneLimits(scene);
   return scene;
 }
 
 Scene loadScene(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw FormatError(path + ": cannot open file");
-  std::ostringstream os;
-  os << in.rdbuf();
-  return parseScene(os.str(), path);
+  return parseScene(io::readInputFile(path, io::kMaxSceneFileBytes, "scene file"), path);
 }
 
 std::vector<std::string> listSceneFiles(const std::string& folder) {

@@ -38,5 +38,33 @@ check seed-auto 0 'converged' -- "$mlcp" solve "$data/seed_lemke.json" --solver 
 check chain 0 'converged' -- "$mlcp" solve "$data/seed_lemke.json" --solver 'pgs>lemke'
 check table-markdown 0 '\| lcp_deudeu.dat \| 2 \|' -- "$mlcp" table --markdown "$siconos/lcp/lcp_deudeu.dat" --solvers pgs,lemke
 check table 0 'lcp_deudeu.dat' -- "$mlcp" table "$siconos/lcp/lcp_deudeu.dat" --solvers pgs
+# Bad input of any kind: exit 2 and one short line naming the file and what is wrong.
+one_line() {  # one_line NAME WANT_CODE PATTERN -- command...
+  local name=$1
+  check "$@"
+  shift 4
+  local out
+  out=$("$@" 2>&1)
+  if [ "$(wc -l <<< "$out")" -eq 1 ] && [ "${#out}" -le 300 ]; then
+    passed=$((passed + 1))
+  else
+    failed=$((failed + 1)); echo "FAIL $name-one-line: ${#out} characters: ${out:0:300}"
+  fi
+}
+one_line dev-zero 2 '/dev/zero: not a regular file' -- "$mlcp" solve /dev/zero
+one_line directory 2 'not a regular file' -- "$mlcp" solve "$data"
+one_line tol-denormal 2 "--tol: expected a number in \[1e-300, 1e300\], got '5e-324'" -- \
+  "$mlcp" solve "$data/spd.json" --tol 5e-324
+one_line tol-negative 2 "expected a number in \[1e-300, 1e300\]" -- "$mlcp" solve "$data/spd.json" --tol -1
+one_line max-iter-negative 2 "--max-iter: expected a number in \[0, 1e300\]" -- \
+  "$mlcp" solve "$data/spd.json" --max-iter -3
+one_line fuzz-overflow 2 'problem_number_overflow_1e309.json: not valid JSON: number overflow' -- \
+  "$mlcp" solve "$data/fuzz/problem_number_overflow_1e309.json"
+one_line fuzz-nested 2 'problem_nested_5000.json: JSON nested deeper than 64 levels' -- \
+  "$mlcp" solve "$data/fuzz/problem_nested_5000.json"
+one_line fuzz-entry 2 'A\[0\]\[0\] = 1e\+300 is outside' -- "$mlcp" solve "$data/fuzz/problem_entry_1e300.json"
+one_line fuzz-sparse-n 2 'problem_sparse_n_1e8.json' -- "$mlcp" solve "$data/fuzz/problem_sparse_n_1e8.json"
+one_line fuzz-siconos-n 2 'n = 10000000 is out of range' -- "$mlcp" solve "$data/fuzz/problem_siconos_n_1e7.dat"
+one_line fuzz-siconos-blocks 2 'out of range' -- "$mlcp" solve "$data/fuzz/problem_siconos_blocks_1e9.dat"
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

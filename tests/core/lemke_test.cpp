@@ -37,7 +37,7 @@ Result solveChecked(const Problem& p, Vector& x, const Options& opt = Options())
   lemke.setOptions(opt);
   const Result r = lemke.solve(p, x);
   if (r.status != Status::Unsupported && r.status != Status::InvalidInput) {
-    const Accuracy a = accuracy(p, x);
+    const Accuracy a = checkedAccuracy(p, x, p.slack(x), opt.tolerance);
     EXPECT_DOUBLE_EQ(r.residual, a.residual);
     if (r.converged()) {
       EXPECT_LE(a.residual, opt.tolerance);

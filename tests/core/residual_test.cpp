@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include "common/generators.hpp"
+#include "mlcp/io.hpp"
+#include "mlcp/registry.hpp"
 
 namespace mlcp {
 namespace {
@@ -58,6 +60,70 @@ TEST(Residual, EqualityRowsMeasureW) {
   p.b << 3, 0;
   // x - clamp(x - w, -inf, inf) = w = x + b.
   EXPECT_DOUBLE_EQ(residual(p, Vector::Zero(2)), 3.0 / 4);
+}
+
+// tests/data/fuzz/solver_scaled_1e12_cancellation.json: row 0 is 1e12 x0 + x1 - 1e12 x2 + b0
+// with b0 = -(fl(1e12 + 0.1) - 1e12). At x = (1, 0.1, 1) the plain sum gives w0 = 0 exactly; the
+// exact w0 is 2.44e-5 (0.1's low bits vanish in 1e12 + 0.1), so the scaled residual is 1.2e-5,
+// not 0, and no double x0 brings it under 1e-6 (x0's ulp moves w0 by 2.2e-4).
+Problem scaledCancellation() {
+  return io::readProblem(std::string(MLCP_SOURCE_DIR) +
+                         "/tests/data/fuzz/solver_scaled_1e12_cancellation.json");
+}
+
+TEST(ResidualFuzzRegression, Scaled1e12CancellationIsMeasuredExactly) {
+  const Problem p = scaledCancellation();
+  const Vector x = (Vector(3) << 1, 0.1, 1).finished();
+  // w0 summed left to right, as a plain product does for 3 terms: the rounding guarded against.
+  Vector plainW = p.b;
+  plainW[0] = ((1e12 * x[0] + 1 * x[1]) + -1e12 * x[2]) + p.b[0];
+  plainW[1] = x[1] + p.b[1];
+  plainW[2] = x[2] + p.b[2];
+  EXPECT_EQ(accuracy(p, x, plainW).residual, 0);
+  const double exact = 2.441406250000555e-05 / 2;
+  // Within the natural map's own rounding, u (|x| + |w|) / (1 + |b|).
+  EXPECT_NEAR(checkedAccuracy(p, x, plainW, 1e-6).residual, exact, 1.2e-16);
+  EXPECT_NEAR(compensatedSlack(p, x)[0], 2.441406250000555e-05, 1e-20);
+  // Far from the tolerance the plain residual stands (no compensated pass needed).
+  EXPECT_EQ(checkedAccuracy(p, x, plainW, 1.0).residual, 0);
+}
+
+TEST(ResidualFuzzRegression, Scaled1e12CancellationIsNeverCalledConverged) {
+  const Problem p = scaledCancellation();
+  for (const char* name : {"ldlt", "gs", "dantzig", "lemke", "pgs", "auto"}) {
+    auto solver = makeSolver(name);
+    solver->options().tolerance = 1e-6;
+    Vector x;
+    const Result r = solver->solve(p, x);
+    if (r.status == Status::InvalidInput || r.status == Status::Unsupported) continue;
+    ASSERT_EQ(x.size(), 3) << name;
+    const double exact = std::abs(compensatedSlack(p, x)[0]) / 2;  // rows 1, 2 are exact
+    if (r.converged()) {
+      EXPECT_LE(exact, 1e-6) << name << ": residual " << r.residual;
+    }
+    if (std::string(name) == "ldlt") {  // solves the system: x = (1, 0.1, 1), within an ulp
+      EXPECT_FALSE(r.converged()) << r.message;
+      EXPECT_NEAR(r.residual, exact, 1e-15);
+    }
+  }
+}
+
+TEST(ResidualFuzzRegression, CompensatedSlackMatchesExactSumsDenseAndSparse) {
+  test::Generator g(11);
+  test::KnownProblem kp = g.friction(6);
+  for (bool sparse : {false, true}) {
+    Problem p = kp.problem;
+    p.b *= 1e12;
+    if (sparse) p.setA(p.toSparse());
+    const Vector x = Vector::LinSpaced(p.size(), -3, 5);
+    const Vector w = compensatedSlack(p, x);
+    const DenseMatrix A = p.toDense();
+    for (int i = 0; i < p.size(); ++i) {
+      long double e = p.b[i];
+      for (int j = 0; j < p.size(); ++j) e += (long double)A(i, j) * x[j];
+      EXPECT_NEAR(w[i], double(e), 1e-15 * std::abs(double(e)) + 1e-300) << i;
+    }
+  }
 }
 
 }  // namespace

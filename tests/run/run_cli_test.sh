@@ -61,5 +61,34 @@ if "$mlcp" run --help | grep -q ode; then
   fi
 fi
 check unknown-engine 2 "unknown engine 'physx'" -- "$mlcp" run "$scenes/stack_10.json" --engine physx --steps 1
+
+# Scene files that once crashed the loader or ODE (tests/data/fuzz), and inputs that are not files.
+fuzz=$scenes/../tests/data/fuzz
+check dev-urandom 2 '/dev/urandom: not a regular file' -- "$mlcp" run /dev/urandom --engine ode --steps 1
+check fuzz-overflow 2 'scene_number_overflow_1e309.json: not valid JSON: number overflow' -- \
+  "$mlcp" run "$fuzz/scene_number_overflow_1e309.json" --engine ode --steps 1
+check fuzz-box-size 2 'body "box": shape.size: 1e\+300 is outside' -- \
+  "$mlcp" run "$fuzz/scene_box_size_1e308.json" --engine ode --steps 1
+check fuzz-nested 2 'JSON nested deeper than 64 levels' -- \
+  "$mlcp" run "$fuzz/scene_nested_5000.json" --engine bullet --steps 1
+for engine in bullet ode; do
+  if ! "$mlcp" run --help | grep -q "$engine"; then continue; fi
+  check "fuzz-hinge-axis-$engine" 0 'with auto: 20 steps' -- \
+    "$mlcp" run "$fuzz/scene_hinge_axis_1e308.json" --engine "$engine" --steps 20
+done
+
+# A run cut short (killed) leaves whole CSV rows: every line of 17 fields, the last one ended.
+"$mlcp" run "$scenes/pyramid_55.json" --engine ode --solver pgs --steps 1000000 --csv "$tmp/killed.csv" \
+  > /dev/null 2>&1 &
+pid=$!
+sleep 1.5
+kill -9 "$pid" 2> /dev/null
+wait "$pid" 2> /dev/null
+if [ "$(wc -l < "$tmp/killed.csv")" -gt 2 ] && [ "$(tail -c 1 "$tmp/killed.csv" | od -An -c | tr -d ' ')" = '\n' ] &&
+   awk -F, 'NF != 17 { bad = 1 } END { exit bad }' "$tmp/killed.csv"; then
+  passed=$((passed + 1))
+else
+  failed=$((failed + 1)); echo "FAIL killed-run-csv: $(wc -l < "$tmp/killed.csv") lines, last: $(tail -c 80 "$tmp/killed.csv")"
+fi
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -85,6 +85,21 @@ TEST_F(TrajectoryFile, ErrorsNameFileAndLine) {
   EXPECT_NE(error(kHeader + "s,ode,pgs,0,a,0,zero,1,1,0,0,0\n")
                 .find(": line 2: column 7: not a number: 'zero'"),
             std::string::npos);
+  EXPECT_NE(
+      error(kHeader + "s,ode,pgs,0,a,0,nan,1,1,0,0,0\n").find(": line 2: column 7: not finite"),
+      std::string::npos);
+  EXPECT_NE(error(kHeader + "s,ode,pgs,0,a,0,0,1,2,0,0,0\n")
+                .find("quaternion (qw, qx, qy, qz) is not of length 1"),
+            std::string::npos);
+  try {
+    readTrajectoryCsv("/dev/zero");
+    ADD_FAILURE() << "/dev/zero read";
+  } catch (const scene::FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find("/dev/zero: not a regular file"), std::string::npos);
+  }
+  EXPECT_LT(
+      error(kHeader + "s,ode,pgs,0,a,0," + std::string(1 << 20, '7') + "x,1,1,0,0,0\n").size(),
+      300u);
   EXPECT_NE(error(kHeader + ok + "s,ode,pgs,1,b,0,0,1,1,0,0,0\n")
                 .find(": line 3: body 'b' where the first step has 'a'"),
             std::string::npos);

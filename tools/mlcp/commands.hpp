@@ -34,6 +34,12 @@ struct SolverSettings {
   double relaxation = 1.0;
 };
 void addSolverSettings(CLI::App& cmd, SolverSettings& s);
+
+// Option checks with one-line messages that echo at most a few characters of the value
+// (CLI11's own PositiveNumber / NonNegativeNumber print their bounds with 309 digits):
+// a number in [1e-300, 1e300] (positive), or in [0, 1e300] (non-negative).
+CLI::Validator positiveNumber();
+CLI::Validator nonNegativeNumber();
 void applySettings(const SolverSettings& s, Options& options);
 
 }  // namespace mlcp::cli

@@ -201,15 +201,15 @@ Runner addDiffCommand(CLI::App& app) {
                   "scene mode: iterations per solve, one value for both or A,B (default: the "
                   "scene's solver.iterations)")
       ->delimiter(',')
-      ->check(CLI::NonNegativeNumber);
+      ->check(nonNegativeNumber());
   cmd->add_option("--steps", args->steps, "scene mode: steps (default: the scene's)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(nonNegativeNumber());
   cmd->add_option("--tol", args->tol, "position tolerance (m)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(nonNegativeNumber())
       ->capture_default_str();
   cmd->add_option("--angle-tol", args->angleTol,
                   "orientation tolerance (rad; default: the value of --tol)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(nonNegativeNumber());
   cmd->add_option("--csv", args->csv,
                   "per-step CSV to write: step,body,position_deviation,orientation_deviation");
   return [args] { return runDiff(*args); };

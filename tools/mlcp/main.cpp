@@ -3,6 +3,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "mlcp/input_limits.hpp"
 #include "mlcp/registry.hpp"
 #include "mlcp/scene/world.hpp"
 
@@ -27,8 +28,10 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : mlcp::cli::kInvalidInput;
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help
+    // One line, the value echoed short: an option's text can be anything.
+    std::cerr << "mlcp: " << mlcp::io::capped(e.what(), 200) << " (see --help)\n";
+    return mlcp::cli::kInvalidInput;
   }
   // An engine that cannot express a scene's feature may say so at any step (ODE meets a pair
   // of shapes it has no collider for only when they come close): exit 2 as for bad input.

@@ -150,13 +150,13 @@ Runner addRunCommand(CLI::App& app) {
                   "bullet-nncg, bullet-mlcp-pgs, bullet-mlcp-dantzig, bullet-mlcp-lemke, "
                   "ode-world, ode-quick (default: the scene's solver.name)");
   cmd->add_option("--steps", args->steps, "steps to take (default: the scene's settings.steps)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(nonNegativeNumber());
   cmd->add_option("--iterations", args->iterations,
                   "sweeps / outer iterations per solve (default: the scene's solver.iterations)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(nonNegativeNumber());
   cmd->add_option("--tol", args->tolerance,
                   "tolerance of the scaled residual (default: the scene's solver.tolerance)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(nonNegativeNumber());
   cmd->add_flag("--no-warm-start", args->noWarmStart, "start every solve from zero");
   cmd->add_flag("--engine-iterations", args->engineIterations,
                 "pgs/gs run exactly --iterations sweeps, checked once at the end, as the "
@@ -165,7 +165,7 @@ Runner addRunCommand(CLI::App& app) {
                   "core solver run when an answer is rejected, or none (default pgs)");
   cmd->add_option("--fallback-residual", args->fallbackResidual,
                   "scaled residual above which an answer is rejected (default 1e-3)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(nonNegativeNumber());
   cmd->add_option("--csv", args->csv, "CSV file to write (one row per step)");
   cmd->add_option("--trajectory", args->trajectory,
                   "trajectory CSV to write, one row per step and dynamic body: " +
@@ -174,7 +174,7 @@ Runner addRunCommand(CLI::App& app) {
                   "write each island's MLCP of this step (0-based) as mlcp-problem/1 files, "
                   "which mlcp solve replays (our solvers only; exit 2 where the engine/solver "
                   "cannot capture)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(nonNegativeNumber());
   cmd->add_option("--capture-dir", args->captureDir,
                   "folder for the --capture files (created if missing)")
       ->capture_default_str();

@@ -4,6 +4,8 @@
 #include <ostream>
 #include <stdexcept>
 
+#include "csv_rows.hpp"
+
 #ifdef MLCP_HAVE_BULLET
 #include "mlcp/bullet/scene_loader.hpp"
 #endif
@@ -54,10 +56,12 @@ void writeStepCsv(std::ostream& out, const scene::World& world, const std::strin
 
 void writeStepCsv(std::ostream& out, const std::string& scene, const std::string& engine,
                   const std::string& solver, int step, const scene::StepMeasures& m) {
-  out << scene << ',' << engine << ',' << solver << ',' << step << ',' << m.solverMs << ','
-      << m.stepMs << ',' << m.residual << ',' << m.iterations << ',' << m.status << ','
-      << m.fallbacks << ',' << m.choice << ',' << m.contacts << ',' << m.maxPenetration << ','
-      << m.jointError << ',' << m.energy << ',' << m.momentum << ',' << m.maxSpeed << "\n";
+  writeWholeRows(out, [&](std::ostream& row) {
+    row << scene << ',' << engine << ',' << solver << ',' << step << ',' << m.solverMs << ','
+        << m.stepMs << ',' << m.residual << ',' << m.iterations << ',' << m.status << ','
+        << m.fallbacks << ',' << m.choice << ',' << m.contacts << ',' << m.maxPenetration << ','
+        << m.jointError << ',' << m.energy << ',' << m.momentum << ',' << m.maxSpeed << "\n";
+  });
 }
 
 RunSummary runWorld(scene::World& world, int steps,

@@ -5,19 +5,43 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "mlcp/input_limits.hpp"
 #include "mlcp/io.hpp"
 #include "mlcp/registry.hpp"
 #include "mlcp/residual.hpp"
 
 namespace mlcp::cli {
 
+namespace {
+
+CLI::Validator numberIn(double lo, double hi, const std::string& range) {
+  return CLI::Validator(
+      [lo, hi, range](std::string& text) -> std::string {
+        std::size_t used = 0;
+        double v = 0;
+        try {
+          v = std::stod(text, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used != 0 && used == text.size() && v >= lo && v <= hi) return "";
+        return "expected a number in " + range + ", got '" + io::capped(text, 24) + "'";
+      },
+      range);
+}
+
+}  // namespace
+
+CLI::Validator positiveNumber() { return numberIn(1e-300, 1e300, "[1e-300, 1e300]"); }
+CLI::Validator nonNegativeNumber() { return numberIn(0, 1e300, "[0, 1e300]"); }
+
 void addSolverSettings(CLI::App& cmd, SolverSettings& s) {
   cmd.add_option("--tol", s.tolerance, "target scaled natural-map residual")
-      ->check(CLI::PositiveNumber)
+      ->check(positiveNumber())
       ->capture_default_str();
   cmd.add_option("--max-iter", s.maxIterations,
                  "iteration limit (sweeps; outer iterations of pivoting methods)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(nonNegativeNumber())
       ->capture_default_str();
   cmd.add_option("--relaxation", s.relaxation, "SOR factor of gs/pgs, in (0, 2)")
       ->capture_default_str();

@@ -251,27 +251,27 @@ Runner addStabilityCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--heights", args->heights, "mass grid: stack heights (boxes, >= 1)")
       ->delimiter(',')
-      ->check(CLI::PositiveNumber)
+      ->check(positiveNumber())
       ->capture_default_str();
   cmd->add_option("--time-steps", args->timeSteps, "step grid: time steps (s)")
       ->delimiter(',')
-      ->check(CLI::PositiveNumber)
+      ->check(positiveNumber())
       ->capture_default_str();
   cmd->add_option("--iteration-counts", args->iterationCounts, "step grid: iterations per solve")
       ->delimiter(',')
-      ->check(CLI::NonNegativeNumber)
+      ->check(nonNegativeNumber())
       ->capture_default_str();
   cmd->add_option("--step-height", args->stepHeight, "step grid: stack height (boxes)")
-      ->check(CLI::PositiveNumber)
+      ->check(positiveNumber())
       ->capture_default_str();
   cmd->add_option("--step-ratio", args->stepRatio, "step grid: top/bottom mass ratio")
-      ->check(CLI::PositiveNumber)
+      ->check(positiveNumber())
       ->capture_default_str();
   cmd->add_option("--seconds", args->seconds, "simulated time per cell (s)")
-      ->check(CLI::PositiveNumber)
+      ->check(positiveNumber())
       ->capture_default_str();
   cmd->add_option("--iterations", args->iterations, "mass grid: iterations per solve")
-      ->check(CLI::NonNegativeNumber)
+      ->check(nonNegativeNumber())
       ->capture_default_str();
   cmd->add_option("--fallback", args->fallback,
                   "core solver run when our adapters reject an answer, or none: each solver "
@@ -287,7 +287,7 @@ Runner addStabilityCommand(CLI::App& app) {
                   "also draw the heat maps into this folder (tools/chart.py heatmap through "
                   "the venv, as mlcp chart does)");
   cmd->add_option("--max-speed", args->thresholds.maxSpeed, "exploded above this speed (m/s)")
-      ->check(CLI::PositiveNumber)
+      ->check(positiveNumber())
       ->capture_default_str();
   cmd->add_option("--failure-share", args->thresholds.failureShare,
                   "solver-failure above this share of failed or fallback steps")
@@ -295,15 +295,15 @@ Runner addStabilityCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--collapse-fraction", args->thresholds.collapseFraction,
                   "collapsed when a box moved more than this fraction of its edge")
-      ->check(CLI::PositiveNumber)
+      ->check(positiveNumber())
       ->capture_default_str();
   cmd->add_option("--collapse-penetration", args->thresholds.collapsePenetration,
                   "collapsed above this penetration (m)")
-      ->check(CLI::PositiveNumber)
+      ->check(positiveNumber())
       ->capture_default_str();
   cmd->add_option("--drift", args->thresholds.drift,
                   "drifting when the top box moved more than this (m)")
-      ->check(CLI::PositiveNumber)
+      ->check(positiveNumber())
       ->capture_default_str();
   return [args] { return runStability(*args); };
 }

@@ -28,6 +28,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -35,6 +36,7 @@
 #include <sstream>
 
 #include "commands.hpp"
+#include "mlcp/input_limits.hpp"
 #include "mlcp/scene/scene.hpp"
 #include "mlcp/scene/world.hpp"
 #include "progress.hpp"
@@ -94,7 +96,7 @@ bool parseValues(const SweepArgs& args, std::vector<double>& out, std::string& e
     const bool whole = std::isfinite(v) && v == std::floor(v) && v >= 1 && v <= 1e9;
     if (used == 0 || used != text.size() || !std::isfinite(v) ||
         (args.setting == "iterations" ? !whole : v <= 0)) {
-      error = "--values: '" + text + "' is not " +
+      error = "--values: '" + io::capped(text, 24) + "' is not " +
               (args.setting == "iterations" ? "a whole number of iterations >= 1"
                                             : "a positive tolerance");
       return false;
@@ -203,7 +205,13 @@ int runSweep(const SweepArgs& args) {
 
   const std::string header = std::string(kSweepColumns) + kStepCsvHeader;
   bool fresh = true;
-  if (args.append) {
+  if (args.append && std::filesystem::exists(args.csv)) {
+    try {  // a FIFO or /dev/zero would be read forever for its first line
+      io::checkInputFile(args.csv, io::kMaxTrajectoryFileBytes, "sweep CSV");
+    } catch (const io::FormatError& e) {
+      std::cerr << me << "--append: " << e.what() << "\n";
+      return kInvalidInput;
+    }
     std::ifstream old(args.csv);
     std::string first;
     if (old && std::getline(old, first)) {
@@ -357,7 +365,7 @@ Runner addSweepCommand(CLI::App& app) {
       ->delimiter(',')
       ->required();
   cmd->add_option("--steps", args->steps, "steps per run (default: each scene's settings.steps)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(nonNegativeNumber());
   cmd->add_flag("--no-warm-start", args->noWarmStart, "start every solve from zero");
   cmd->add_option("--fallback", args->fallback,
                   "core solver run when an answer is rejected, or none (default pgs)");

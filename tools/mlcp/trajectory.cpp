@@ -5,6 +5,9 @@
 #include <ostream>
 #include <sstream>
 
+#include "csv_rows.hpp"
+#include "mlcp/input_limits.hpp"
+
 namespace mlcp::cli {
 
 const char* const kTrajectoryCsvHeader = "scene,engine,solver,step,body,x,y,z,qw,qx,qy,qz";
@@ -13,14 +16,16 @@ void writeTrajectoryCsv(std::ostream& out, const scene::World& world, const std:
                         int step) {
   const scene::Scene& s = world.scene();
   const std::vector<scene::BodyState> states = world.states();
-  for (std::size_t i = 0; i < states.size(); ++i) {
-    if (s.bodies[i].isStatic()) continue;
-    const scene::BodyState& b = states[i];
-    out << s.name << ',' << world.engine() << ',' << solver << ',' << step << ','
-        << s.bodies[i].name << ',' << b.position[0] << ',' << b.position[1] << ',' << b.position[2]
-        << ',' << b.orientation.w << ',' << b.orientation.x << ',' << b.orientation.y << ','
-        << b.orientation.z << "\n";
-  }
+  writeWholeRows(out, [&](std::ostream& rows) {  // a step's rows together: diff needs them all
+    for (std::size_t i = 0; i < states.size(); ++i) {
+      if (s.bodies[i].isStatic()) continue;
+      const scene::BodyState& b = states[i];
+      rows << s.name << ',' << world.engine() << ',' << solver << ',' << step << ','
+           << s.bodies[i].name << ',' << b.position[0] << ',' << b.position[1] << ','
+           << b.position[2] << ',' << b.orientation.w << ',' << b.orientation.x << ','
+           << b.orientation.y << ',' << b.orientation.z << "\n";
+    }
+  });
 }
 
 void Trajectory::record(const scene::World& world, int step) {
@@ -52,6 +57,7 @@ std::vector<std::string> splitCsv(const std::string& line) {
 }  // namespace
 
 Trajectory readTrajectoryCsv(const std::string& path) {
+  io::checkInputFile(path, io::kMaxTrajectoryFileBytes, "trajectory file");
   std::ifstream in(path);
   if (!in) throw scene::FormatError(path + ": cannot open");
   Trajectory t;
@@ -66,7 +72,7 @@ Trajectory readTrajectoryCsv(const std::string& path) {
   if (!line.empty() && line.back() == '\r') line.pop_back();
   if (line != kTrajectoryCsvHeader)
     fail("expected the trajectory header '" + std::string(kTrajectoryCsvHeader) + "' (from mlcp " +
-         "run --trajectory), got '" + line + "'");
+         "run --trajectory), got '" + io::capped(line) + "'");
   std::size_t bodyInStep = 0;
   while (std::getline(in, line)) {
     ++lineNo;
@@ -83,15 +89,20 @@ Trajectory readTrajectoryCsv(const std::string& path) {
         used = 0;
       }
       if (used == 0 || used != f[5 + k].size())
-        fail("column " + std::to_string(6 + k) + ": not a number: '" + f[5 + k] + "'");
+        fail("column " + std::to_string(6 + k) + ": not a number: '" + io::capped(f[5 + k]) + "'");
+      if (!std::isfinite(v[k]))
+        fail("column " + std::to_string(6 + k) + ": not finite: '" + io::capped(f[5 + k]) + "'");
     }
+    // Engines keep orientations unit length; anything far from it was not written by a run.
+    if (std::abs(std::sqrt(v[3] * v[3] + v[4] * v[4] + v[5] * v[5] + v[6] * v[6]) - 1) > 1e-3)
+      fail("columns 9-12: the quaternion (qw, qx, qy, qz) is not of length 1");
     int step = 0;
     try {
       std::size_t used = 0;
       step = std::stoi(f[3], &used);
       if (used != f[3].size() || step < 0) throw std::invalid_argument("step");
     } catch (const std::exception&) {
-      fail("step: not a step index: '" + f[3] + "'");
+      fail("step: not a step index: '" + io::capped(f[3]) + "'");
     }
     const bool newStep = t.steps.empty() || step != t.steps.back();
     if (newStep) {
@@ -110,11 +121,13 @@ Trajectory readTrajectoryCsv(const std::string& path) {
     const std::string& body = f[4];
     if (t.steps.size() == 1) {
       for (const std::string& b : t.bodies)
-        if (b == body) fail("body '" + body + "' twice in step " + std::to_string(step));
+        if (b == body)
+          fail("body '" + io::capped(body) + "' twice in step " + std::to_string(step));
       t.bodies.push_back(body);
     } else if (bodyInStep >= t.bodies.size() || t.bodies[bodyInStep] != body) {
-      fail("body '" + body + "' where the first step has " +
-           (bodyInStep < t.bodies.size() ? "'" + t.bodies[bodyInStep] + "'" : "no more bodies"));
+      fail("body '" + io::capped(body) + "' where the first step has " +
+           (bodyInStep < t.bodies.size() ? "'" + io::capped(t.bodies[bodyInStep]) + "'"
+                                         : "no more bodies"));
     }
     ++bodyInStep;
     t.poses.back().push_back({{v[0], v[1], v[2]}, {v[3], v[4], v[5], v[6]}});

@@ -26,6 +26,11 @@
 // 1e-12 relative (the printed digits); a rectangular M (more equations than unknowns) is an
 // UnsupportedProblem, since the canonical form pairs each row with one unknown.
 //
+// Every reader runs the guards of mlcp/input_limits.hpp (regular files of at most 256 MiB, JSON
+// nesting of at most 64 levels, messages that quote at most 60 characters of the input) and
+// takes entries of A and b, and finite bounds, of magnitude at most 1e100: products of two
+// entries and sums of many such products stay finite.
+//
 // Errors are thrown as FormatError, whose message names the file and what is wrong. A file
 // that parses but describes an invalid problem (lo > hi, findex out of range, ...) is reported
 // too: readers return only problems that pass Problem::validate().
@@ -55,6 +60,7 @@ std::string problemToJson(const Problem& problem);
 
 // Reads a Siconos LCP .dat file (dense or sparse-block storage).
 Problem readSiconosLcp(const std::string& path);
+Problem parseSiconosLcp(const std::string& text, const std::string& sourceName = "<string>");
 
 // Reads a Siconos MLCP .dat file (storage 1, storage 2, or both).
 Problem readSiconosMlcp(const std::string& path);

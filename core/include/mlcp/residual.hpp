@@ -33,6 +33,28 @@ Accuracy accuracy(const Problem& problem, const Vector& x, const Vector& w);
 // Shorthand for accuracy(problem, x).residual.
 double residual(const Problem& problem, const Vector& x);
 
+// The accuracy that decides a solve's status (Solver's final check): accuracy(problem, x, w)
+// for w = fl(A x + b) as computed in plain floating point, unless the rounding of that w could
+// put the residual on either side of `tolerance`; then w is recomputed by compensatedSlack()
+// and the accuracy comes from it.
+//
+// Why: w's rounding error is up to gamma_{n+1} (||A||_inf ||x||_inf + ||b||_inf), gamma_k =
+// k u / (1 - k u), u = 2^-53, and the natural map is 1-Lipschitz in w. Where A x is large
+// against 1 + ||b||_inf (a problem scaled by 1e12 with b of order 1), that error alone exceeds a
+// tolerance of 1e-6, and a plain residual can call converged what is not (or the reverse).
+// The bound (plus 3u (||x||_inf + ||w||_inf) for the subtractions of the natural map), scaled
+// like the residual, is compared with |residual - tolerance|: outside it the plain answer
+// stands, so the usual solve pays one pass over A for ||A||_inf and nothing more.
+Accuracy checkedAccuracy(const Problem& problem, const Vector& x, const Vector& w,
+                         double tolerance);
+
+// w = A x + b with each row's sum compensated (Ogita, Rump and Oishi's Dot2: every product
+// split exactly by an fma, every addition's error kept by TwoSum, the errors summed and added
+// at the end). The result is as accurate as if computed in twice the working precision, then
+// rounded: |w_i - fl(w_i)| <= u |w_i| + gamma_n^2 (|A| |x| + |b|)_i. Cost: about 4x a plain
+// product (row by row over a column-major A).
+Vector compensatedSlack(const Problem& problem, const Vector& x);
+
 // The per-row rule all of the accuracy() functions run, for a solver that has w one row at a
 // time (RowPgs' check computes w_i from its packed rows and feeds it here: one pass, no w
 // vector). add() every row (with its findex, or with its effective bounds), then result().
