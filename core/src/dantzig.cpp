@@ -5,11 +5,8 @@
 #include <cstring>
 #include <sstream>
 
-#include "dantzig_block.hpp"
 #include "dantzig_small.hpp"
-#include "mlcp/pgs.hpp"
 #include "mlcp/residual.hpp"
-#include "mlcp/rows.hpp"
 #include "sparse_pattern.hpp"
 
 namespace mlcp {
@@ -33,13 +30,6 @@ constexpr double kTrustedGuess = 1e-2;
 // Sizes (rows of a product or of the clamped block) up to which plain loops beat Eigen's
 // vectorized kernels: islands of a few joints.
 constexpr int kSmall = 8;
-
-// Projected Gauss-Seidel sweeps (pgs.hpp) over x; none when a diagonal entry is not positive.
-void preSweeps(const Problem& problem, int sweeps, Vector& x) {
-  Vector invDiag;
-  if (detail::inverseDiagonal(problem, invDiag) >= 0) return;
-  for (int k = 0; k < sweeps; ++k) detail::pgsSweep(problem, invDiag, 1.0, x);
-}
 
 }  // namespace
 
@@ -704,26 +694,12 @@ void DantzigSolver::Workspace::setFrictionBounds(const Vector& nu) {
 
 // ======================================================================= the solver
 
-DantzigSolver::DantzigSolver()
-    : ws_(std::make_unique<Workspace>()), block_(std::make_unique<detail::BlockPivoting>()) {}
+DantzigSolver::DantzigSolver() : ws_(std::make_unique<Workspace>()) {}
 DantzigSolver::~DantzigSolver() = default;
 DantzigSolver::DantzigSolver(DantzigSolver&&) noexcept = default;
 DantzigSolver& DantzigSolver::operator=(DantzigSolver&&) noexcept = default;
 
 int DantzigSolver::passes() const { return ws_->passes; }
-
-bool DantzigSolver::wantsBlockStage(const Problem& problem) const {
-  const int n = problem.size();
-  if (n == 0 || params_.blockStage == DantzigParams::BlockStage::Never ||
-      options().frictionBounds == FrictionBounds::FixedOnce)
-    return false;
-  if (params_.blockStage == DantzigParams::BlockStage::Always) return true;
-  if (n < params_.autoMinRows) return false;
-  const double nonZeros = problem.isSparse()
-                              ? static_cast<double>(problem.sparseA().nonZeros())
-                              : static_cast<double>((problem.denseA().array() != 0).count());
-  return nonZeros <= params_.autoMaxDensity * double(n) * n;
-}
 
 void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
   Workspace& ws = *ws_;
@@ -733,122 +709,30 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
     result.message = "empty problem";
     return;
   }
-  blockSteps_ = 0;
-  blockFactorizations_ = 0;
-  blockBodyFactorizations_ = 0;
-  blockSettled_ = false;
-  const bool warm = !x.isZero(0.0);
-  if (!wantsBlockStage(problem)) {
-    // A tiny island's guessed index sets (warm, or the cold guess of dantzig_small.hpp): the
-    // same steps on fixed-size arrays, else the general path.
-    if (detail::smallDenseApplies(problem) &&
-        detail::solveSmallDense(problem, options().pivotTolerance, x)) {
-      ws.passes = 1;
-      result.status = Status::Converged;
-      result.iterations = 0;
-      result.message = "tiny-island path: guessed index sets (at most two block corrections)";
-      return;
-    }
-    runPivoting(problem, x, result, false);
-    return;
-  }
-  std::string blockMessage;
-  auto settle = [&](const detail::BlockPivoting::Report& rep) {
-    blockSettled_ = true;
+  // A tiny island's guessed index sets (warm, or the cold guess of dantzig_small.hpp): the same
+  // steps on fixed-size arrays, else the general path.
+  if (params_.tinyIslandPath && detail::smallDenseApplies(problem) &&
+      detail::solveSmallDense(problem, options().pivotTolerance, x)) {
     ws.passes = 1;
     result.status = Status::Converged;
-    result.iterations = blockSteps_;
-    result.message = blockMessage.empty() ? rep.message : blockMessage + "; " + rep.message;
-  };
-  bool symmetric = false;  // known after a first run of the block stage
-  // Body-space steps cost a fraction of an A_CC factorization: more of them before the hand-over.
-  const bool bodySpace =
-      params_.blockBodySpace && rows_ != nullptr && rows_->size() == problem.size();
-  const int maxSteps = std::max(1, bodySpace ? params_.maxBodyBlockSteps : params_.maxBlockSteps);
-  block_->setRows(params_.blockBodySpace ? rows_ : nullptr);
-  block_->setLimits({params_.blockWoodburyRows, params_.blockUpdateRows, params_.blockDescentSteps,
-                     params_.blockBreakCycles, params_.blockBodyMinDiagonal});
-  // Auto first tries a few full steps from the cold guess (every row clamped): resting piles
-  // (ODE) settle in one step there, often sooner than from a warm guess whose sets are off by
-  // a few rows; when they do not settle the trial is dropped (its iterate is a worse start than
-  // none: synthetic pyramids from cold), so it costs at most autoColdSteps factorizations.
-  // A guess within kTrustedGuess (an engine's own last answers at rest) skips it: its sets are
-  // right up to a few rows, where the cold sets are not (Bullet's resting pyramid).
-  // A warm solve also skips it while the last trial of this solver missed (an engine whose
-  // cold sets are never right: Bullet's moving pyramid), re-trying every autoColdRetry solves.
-  const bool autoStage = params_.blockStage == DantzigParams::BlockStage::Auto;
-  const double guessResidual = warm ? residual(problem, x) : kInf;
-  const bool trusted = autoStage && guessResidual <= kTrustedGuess;
-  const bool setsAtGuess =
-      params_.blockTrustedSets && warm && guessResidual <= params_.blockSetsAtGuessResidual;
-  bool coldTrial = autoStage && !trusted;
-  bool continued = false;  // the cold trial's iterate is the block stage's start
-  if (coldTrial && warm && coldMissed_ > 0 && coldMissedRows_ == problem.size()) {
-    coldTrial = coldMissed_ % std::max(1, params_.autoColdRetry) == 0;
-    ++coldMissed_;
+    result.iterations = 0;
+    result.message = "tiny-island path: guessed index sets (at most two block corrections)";
+    return;
   }
-  if (coldTrial) {
-    Vector trial = Vector::Zero(problem.size());
-    const detail::BlockPivoting::Report rep = block_->run(
-        problem, trial, options(), std::max(1, std::min(params_.autoColdSteps, maxSteps)), true);
-    symmetric = rep.symmetric;
-    blockSteps_ += rep.steps;
-    blockFactorizations_ += rep.factorizations;
-    blockBodyFactorizations_ += rep.bodyFactorizations;
-    coldMissed_ = rep.settled ? 0 : 1;
-    coldMissedRows_ = problem.size();
-    if (rep.settled) {
-      x = trial;
-      settle(rep);
-      return;
-    }
-    blockMessage = "cold trial: " + rep.message;
-    // A cold solve whose trial came within kTrustedGuess continues from the trial's best iterate
-    // (Bullet's first step of a new pyramid: a few steps, where pivoting from zero took ~5600).
-    if (!warm && params_.autoColdContinue && problem.size() >= params_.autoWarmMinRows &&
-        residual(problem, trial) <= kTrustedGuess) {
-      x = trial;
-      continued = true;
-    }
-  }
-  const bool warmStage =
-      (warm || continued) && (trusted || problem.size() >= params_.autoWarmMinRows);
-  const bool blockIterate = warmStage || params_.blockStage == DantzigParams::BlockStage::Always;
-  if (blockIterate) {
-    // A guess far from the answer (Bullet's pyramid right after the switch from SI) starts the
-    // block stage from a few projected Gauss-Seidel sweeps over it ("Pre-sweeps" in dantzig.hpp).
-    if (warm && params_.blockPgsSweeps > 0 && guessResidual > params_.blockPgsResidual)
-      preSweeps(problem, params_.blockPgsSweeps, x);
-    const detail::BlockPivoting::Report rep =
-        block_->run(problem, x, options(), maxSteps, false, symmetric, setsAtGuess);
-    blockSteps_ += rep.steps;
-    blockFactorizations_ += rep.factorizations;
-    blockBodyFactorizations_ += rep.bodyFactorizations;
-    if (rep.settled) {
-      settle(rep);
-      return;
-    }
-    // x holds the best iterate: its index sets warm start the incremental pivoting.
-    blockMessage += (blockMessage.empty() ? "" : "; ") + rep.message;
-  }
-  runPivoting(problem, x, result, blockIterate);
-  result.iterations += blockSteps_;
-  result.message = "block stage: " + blockMessage + "; pivoting: " + result.message;
+  runPivoting(problem, x, result);
 }
 
-void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& result, bool fromBlock) {
+void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& result) {
   const Options& opt = options();
   Workspace& ws = *ws_;
   const int n = problem.size();
   const bool exact = opt.frictionBounds == FrictionBounds::Exact;
   const bool useGuess = !x.isZero(0.0);
   // A guess's friction values fix the first pass's friction bounds only when the guess is
-  // close (the block stage's iterate, or a residual within kTrustedGuess): Bullet's cached
-  // impulses (residual 0.1-0.7, friction directions that turn between steps) gave bounds so far
-  // off that the second pass redid most pivots, where the first pass's cold bounds (as
-  // FixedOnce) needed half as many pivots in all.
-  const bool trustFriction = useGuess && exact && problem.hasFindex() &&
-                             (fromBlock || residual(problem, x) <= kTrustedGuess);
+  // close (residual within kTrustedGuess); a farther guess (an engine's cached impulses whose
+  // friction directions turned) takes the cold bounds of FixedOnce's first pass ("Friction").
+  const bool trustFriction =
+      useGuess && exact && problem.hasFindex() && residual(problem, x) <= kTrustedGuess;
   ws.build(problem, x, useGuess, trustFriction);
   ws.pivTol *= opt.pivotTolerance;
   ws.pivots = 0;
@@ -870,7 +754,7 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
   };
   int totalPivots = 0;
   const int nf = static_cast<int>(ws.frictionRows.size());
-  constexpr int depth = 6;
+  const int depth = std::max(1, params_.andersonDepth);
   int stored = 0;
   double bestF = kInf, damping = 1.0;
   int lastGain = 0;
@@ -935,8 +819,9 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
     if (fNorm < bestF) {
       bestF = fNorm;
       lastGain = it;
-    } else if (it - lastGain > 20 && damping == 1.0) {
-      damping = 0.3;  // stalled (a cycle between active sets): plain damped iteration
+    } else if (it - lastGain > params_.stallPasses && damping == 1.0) {
+      damping =
+          params_.stallDamping;  // stalled (a cycle between active sets): plain damped iteration
       stored = 0;
     }
     if (stored == depth) {

@@ -41,7 +41,7 @@ class GaussSeidelSolver : public PgsSolver {
 
 namespace detail {
 // One sweep (the update above) over the rows in order, with invDiag[i] = 1 / A_ii and omega the
-// relaxation; shared with dantzig's pre-sweeps (DantzigParams::blockPgsSweeps).
+// relaxation; shared with newton's sweeps (NewtonParams::coldSweeps, stepSweeps).
 void pgsSweep(const Problem& problem, const Vector& invDiag, double omega, Vector& x);
 // invDiag[i] = 1 / A_ii for the sweep; returns the first row whose A_ii is not positive (invDiag
 // then unusable), or -1.

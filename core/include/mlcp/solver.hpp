@@ -50,9 +50,10 @@ class Solver {
   Result solveWithGuess(const Problem& problem, const Vector& guess, Vector& x);
 
   // The rows (rows.hpp) the next solves' problem was assembled from, or nullptr (the default: a
-  // Problem alone). A solver may use them for the same answers at less cost (dantzig's block
-  // steps in body space); the default ignores them. Not owned: the caller clears it (nullptr)
-  // before the rows go away or describe another problem (RowSolver sets it around each solve).
+  // Problem alone). A solver may use them for the same answers at less cost (products in
+  // factored form); the default, and every solver today, ignores them. Not owned: the caller clears
+  // it (nullptr) before the rows go away or describe another problem (RowSolver sets it around each
+  // solve).
   virtual void useRows(const RowSystem* /*rows*/) {}
 
  protected:
