@@ -78,6 +78,31 @@ int freeRows(const Vector& x, const Vector& w, const Vector& lo, const Vector& h
 
 }  // namespace
 
+// One step from x (w, lo, hi of x in the work vectors): the free rows' direction and the
+// projected Armijo search on f along it (newton.hpp "Step"); on success the new point is in
+// work_->xt. A direction without an acceptable step length is recomputed with a larger mu.
+bool NewtonSolver::search(const Problem& pb, const Vector& x, double res, double dMax, double& mu) {
+  Work& wk = *work_;
+  const NewtonParams& par = params_;
+  const double f = quadratic(pb, x, wk.w);
+  for (;;) {
+    const int free = freeRows(x, wk.w, wk.lo, wk.hi, wk.inC, wk.dx);
+    const double rho = mu * dMax * std::min(1.0, res);
+    ++factorizations_;
+    const bool solved = free > 0 && wk.system.factor(wk.inC, rho) && wk.system.solve(wk.dx);
+    for (int h = 0; solved && h <= par.maxHalvings; ++h) {
+      wk.xt = (x + std::ldexp(1.0, -h) * wk.dx).cwiseMax(wk.lo).cwiseMin(wk.hi);
+      wk.wt = pb.slack(wk.xt);
+      if (quadratic(pb, wk.xt, wk.wt) <= f + 1e-4 * wk.w.dot(wk.xt - x)) {
+        if (h == 0) mu = std::max(mu * 0.1, 1e-12);
+        return true;
+      }
+    }
+    if (mu >= par.proximalMax) return false;
+    mu *= 10;
+  }
+}
+
 void NewtonSolver::run(const Problem& pb, Vector& x, Result& result) {
   const Options& opt = options();
   const NewtonParams& par = params_;
@@ -154,29 +179,7 @@ void NewtonSolver::run(const Problem& pb, Vector& x, Result& result) {
       break;
     }
     result.iterations = step + 1;
-    const double f = quadratic(pb, x, wk.w);
-    bool moved = false;
-    while (!moved) {
-      // The direction on the free rows: (A_CC + rho I) dx_C = -w_C, dx_N = 0.
-      const int free = freeRows(x, wk.w, wk.lo, wk.hi, wk.inC, wk.dx);
-      const double rho = mu * dMax * std::min(1.0, res);
-      ++factorizations_;
-      const bool solved = free > 0 && wk.system.solve(wk.inC, rho, wk.dx);
-      // Projected Armijo search on f along dx (Bertsekas' rule), bounds held.
-      for (int h = 0; solved && h <= par.maxHalvings && !moved; ++h) {
-        const double len = std::ldexp(1.0, -h);
-        wk.xt = (x + len * wk.dx).cwiseMax(wk.lo).cwiseMin(wk.hi);
-        wk.wt = pb.slack(wk.xt);
-        const double ft = quadratic(pb, wk.xt, wk.wt);
-        if (ft <= f + 1e-4 * wk.w.dot(wk.xt - x)) {
-          moved = true;
-          if (h == 0) mu = std::max(mu * 0.1, 1e-12);
-        }
-      }
-      if (moved) break;
-      if (mu >= par.proximalMax) break;
-      mu *= 10;
-    }
+    const bool moved = search(pb, x, res, dMax, mu);
     if (!moved) {
       if (++stalls > par.maxStalls) {
         result.status = Status::Failed;

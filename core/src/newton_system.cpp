@@ -107,14 +107,25 @@ double NewtonSystem::entry(int i, int j) const {
   return pb.isSparse() ? pb.sparseA().coeff(i, j) : pb.denseA()(i, j);
 }
 
-bool NewtonSystem::solve(const std::vector<char>& inC, double rho, Vector& rhs) {
+bool NewtonSystem::factor(const std::vector<char>& inC, double rho) {
   const int m = static_cast<int>(std::count(inC.begin(), inC.end(), 1));
   lastSparse_ = a_ != nullptr && m > denseMaxRows_;
-  const bool ok = lastSparse_ ? solveSparse(inC, rho, rhs) : solveDense(inC, rho, rhs);
-  return ok && rhs.allFinite();
+  return lastSparse_ ? factorSparse(inC, rho) : factorDense(inC, rho);
 }
 
-bool NewtonSystem::solveDense(const std::vector<char>& inC, double rho, Vector& rhs) {
+bool NewtonSystem::solve(Vector& rhs) {
+  if (lastSparse_) {
+    cholmod_.solve(rhs);
+  } else if (!clamped_.empty()) {
+    const int m = static_cast<int>(clamped_.size());
+    for (int c = 0; c < m; ++c) sub_[c] = rhs[clamped_[c]];
+    sub_ = llt_.solve(sub_);
+    for (int c = 0; c < m; ++c) rhs[clamped_[c]] = sub_[c];
+  }
+  return rhs.allFinite();
+}
+
+bool NewtonSystem::factorDense(const std::vector<char>& inC, double rho) {
   const Problem& pb = *problem_;
   const int n = pb.size();
   clamped_.clear();
@@ -125,27 +136,23 @@ bool NewtonSystem::solveDense(const std::vector<char>& inC, double rho, Vector& 
   block_.resize(m, m);
   sub_.resize(m);
   if (pb.isSparse()) {
-    std::vector<int> pos(n, -1);
-    for (int c = 0; c < m; ++c) pos[clamped_[c]] = c;
+    pos_.assign(n, -1);
+    for (int c = 0; c < m; ++c) pos_[clamped_[c]] = c;
     block_.setZero();
     const SparseMatrix& a = pb.sparseA();
     for (int c = 0; c < m; ++c)
       for (SparseMatrix::InnerIterator it(a, clamped_[c]); it; ++it)
-        if (pos[it.col()] >= 0) block_(c, pos[it.col()]) = it.value();
+        if (pos_[it.col()] >= 0) block_(c, pos_[it.col()]) = it.value();
   } else {
     for (int c = 0; c < m; ++c)
       for (int d = 0; d < m; ++d) block_(c, d) = entry(clamped_[c], clamped_[d]);
   }
   block_.diagonal().array() += rho;
-  for (int c = 0; c < m; ++c) sub_[c] = rhs[clamped_[c]];
-  Eigen::LLT<DenseMatrix> llt(block_);
-  if (llt.info() != Eigen::Success) return false;
-  sub_ = llt.solve(sub_);
-  for (int c = 0; c < m; ++c) rhs[clamped_[c]] = sub_[c];
-  return true;
+  llt_.compute(block_);
+  return llt_.info() == Eigen::Success;
 }
 
-bool NewtonSystem::solveSparse(const std::vector<char>& inC, double rho, Vector& rhs) {
+bool NewtonSystem::factorSparse(const std::vector<char>& inC, double rho) {
   const double* a = a_->valuePtr();
   const size_t nnz = values_.size();
   for (size_t k = 0; k < nnz; ++k) {
@@ -155,9 +162,7 @@ bool NewtonSystem::solveSparse(const std::vector<char>& inC, double rho, Vector&
     else
       values_[k] = inC[i] && inC[j] ? a[source_[k]] : 0.0;
   }
-  if (!cholmod_.factor(values_)) return false;
-  cholmod_.solve(rhs);
-  return true;
+  return cholmod_.factor(values_);
 }
 
 }  // namespace mlcp::detail

@@ -21,15 +21,18 @@ class NewtonSystem {
   // Per solve, before the steps: the problem (symmetric A, kept by reference until the next
   // prepare). False (with why) when CHOLMOD rejects the pattern.
   bool prepare(const Problem& problem, int denseMaxRows, std::string& why);
-  // rhs: size n, the right-hand side r_C on the rows with inC[i], dx_N on the others; on return
-  // dx (both parts). False when the block is not positive definite or the solve is not finite.
-  bool solve(const std::vector<char>& inC, double rho, Vector& rhs);
-  // Whether the last solve went through CHOLMOD.
+  // Factors the system of the clamped rows inC with the proximal weight rho. False when the block
+  // is not positive definite.
+  bool factor(const std::vector<char>& inC, double rho);
+  // With the last factor: rhs (size n) holds r_C on the clamped rows and dx_N on the others; on
+  // return dx (both parts). False when the result is not finite.
+  bool solve(Vector& rhs);
+  // Whether the last factor is CHOLMOD's.
   bool lastSparse() const { return lastSparse_; }
 
  private:
-  bool solveDense(const std::vector<char>& inC, double rho, Vector& rhs);
-  bool solveSparse(const std::vector<char>& inC, double rho, Vector& rhs);
+  bool factorDense(const std::vector<char>& inC, double rho);
+  bool factorSparse(const std::vector<char>& inC, double rho);
   double entry(int i, int j) const;
 
   linalg::CholmodFactor& cholmod_;
@@ -42,8 +45,9 @@ class NewtonSystem {
   // index of its value in a_'s storage (-1: a diagonal A lacks, value 0).
   std::vector<int> colStart_, rowIndex_, source_, column_;
   std::vector<double> values_;
-  std::vector<int> clamped_;  // the dense path's gathered rows
+  std::vector<int> clamped_, pos_;  // the dense path's gathered rows and their positions
   DenseMatrix block_;
+  Eigen::LLT<DenseMatrix> llt_;
   Vector sub_;
 };
 

@@ -1,70 +1,74 @@
-// mlcp/newton.hpp: a semismooth Newton method on the natural map for boxed MLCPs with findex
-// (registry "newton"), the solver for large islands: each step is one sparse Cholesky solve of
-// the clamped rows, factored by CHOLMOD on a symbolic analysis kept while A's pattern holds.
+// mlcp/newton.hpp: a projected Newton method for boxed MLCPs with findex and a symmetric
+// positive semidefinite A (registry "newton"), meant for large islands: each step is one sparse
+// Cholesky factorization of the free rows, by CHOLMOD on a symbolic analysis kept while A's
+// pattern holds, so that a step costs what a factorization of A costs and grows with the island
+// as its fill does, not as pivot counts do.
 //
-// Map. With the effective bounds l(x), u(x) (findex applied: l_i = lo_i |x_j|, u_i = hi_i |x_j|
-// for a friction row i of normal j), x solves the problem exactly when the natural map
+// Problem. With symmetric A and fixed bounds l <= x <= u the MLCP is the optimality condition of
+// the convex box-constrained quadratic program
 //
-//     H(x) = x - clamp(x - w, l(x), u(x)),   w = A x + b,
+//     min f(x) = x^T A x / 2 + b^T x   subject to  l <= x <= u,     grad f = w = A x + b.
 //
-// is zero; residual.hpp's accuracy is ||H||_inf / (1 + ||b||_inf).
+// Friction rows (findex) have the bounds l_i = lo_i |x_j|, u_i = hi_i |x_j| of their normal j.
+// Inside one step they are constants, taken from the current normals; every step refreshes them
+// (an outer fixed point over the bounds, one refresh per step) and projects x onto them. The
+// accuracy measure is the natural map H(x) = x - clamp(x - w, l(x), u(x)) with the true, moving
+// bounds (residual.hpp): the solve converges when ||H||_inf <= Options::tolerance (1 + ||b||_inf).
 //
-// Step. At the iterate x the rows split as the natural map says: N holds the rows whose
-// x_i - w_i lies at or beyond a bound (target t_i that bound; rows with l_i = u_i always), C the
-// others (w_i = 0 wanted). The friction bounds are those of the current normals: inside one step
-// they are constants, and every step refreshes them (the outer refresh of a fixed point over the
-// bounds, done once per step). The Newton direction of H with those bounds is
+// Step (Bertsekas' projected Newton). At a feasible x a row is held when it is fixed (l = u) or at
+// a bound with w pushing outward (x = l, w > 0 or x = u, w < 0); the others are free (C). The
+// direction solves the free rows' Newton system with the held rows fixed,
 //
-//     dx_N = t_N - x_N,     (A_CC + rho I) dx_C = -w_C - A_CN dx_N,
+//     (A_CC + rho I) dx_C = -w_C,   dx_N = 0,
 //
-// a symmetric positive definite system whenever A is symmetric positive semidefinite and rho > 0
-// (substituting a sliding friction row's x_t = mu x_n into the system instead would make it
-// nonsymmetric; lagging the bound keeps it symmetric at the price of a linear rate in the coupling
-// while the sliding set changes, and quadratic convergence once the sets and the normals settle,
-// because the bound's error shrinks with the normal's step). rho is a proximal weight,
+// symmetric positive definite for rho > 0. The step is x(t) = P(x + t dx), P the projection onto
+// the step's bounds, with t = 1, 1/2, ... (at most NewtonParams::maxHalvings halvings) until
+// Armijo's rule on f holds, f(x(t)) <= f(x) + 1e-4 w^T (x(t) - x). f decreases at every accepted
+// step, so for fixed bounds the iteration converges to the QP's minimizer, identifies its active
+// set in finitely many steps and then converges quadratically (rho -> 0). rho is a proximal
+// (Levenberg-Marquardt) weight,
 //
-//     rho = mu_k max_i A_ii min(1, r_k),   r_k the scaled residual at x,
+//     rho = mu max_i A_ii min(1, r),   r the scaled residual at x,
 //
-// that keeps coplanar contacts' near-singular clamped blocks from throwing the null-space part
-// far away and vanishes as the residual does (Levenberg-Marquardt's choice: superlinear rate near
-// a solution). mu_k starts at NewtonParams::proximal, is divided by 10 after a full step and
-// multiplied by 10 after a step that finds no descent (at most NewtonParams::proximalMax).
+// that keeps the near-singular clamped blocks of coplanar contacts from throwing the null-space
+// part far away and vanishes with the residual. mu starts at NewtonParams::proximal, is divided
+// by 10 after a full step, and multiplied by 10 (up to NewtonParams::proximalMax) with the step
+// recomputed from the same x when no step length satisfies Armijo's rule; a step that finds none
+// even there counts as a stall, and NewtonParams::maxStalls of them in a row end the solve
+// (Failed). Before every step but the first NewtonParams::stepSweeps projected Gauss-Seidel sweeps
+// (pgs.hpp; coordinate descent on the same f) move the rows the Newton step would leave held.
 //
-// Linear algebra. Up to NewtonParams::denseMaxRows clamped rows, A_CC + rho I is gathered and
-// factored densely (Eigen's LLT). Larger systems factor the whole n x n matrix
+// Symmetric system. A friction row on its bound whose normal is free would, substituted as
+// x_t = mu x_n, make the system nonsymmetric (K = A_CC + U E^T). Lagging its bound keeps the
+// system symmetric positive definite, so one Cholesky factorization serves it; the price is that
+// the coupling converges only through the per-step refresh, linearly in the friction coefficient.
+//
+// Linear algebra. Up to NewtonParams::denseMaxRows free rows (and for every problem of at most
+// that many rows), A_CC + rho I is gathered and factored densely (Eigen's LLT). Larger systems
+// factor the whole n x n matrix
 //
 //     K = P_C (A + rho I) P_C + (I - P_C),     P_C the diagonal 0/1 projector on C,
 //
-// whose pattern is A's whatever C is (N's rows and columns hold explicit zeros and a unit
-// diagonal; the right-hand side holds dx_N there), so CHOLMOD's symbolic analysis (fill-reducing
-// order, elimination tree, supernodes; linalg/cholmod_factor.hpp) is done once per pattern of A
-// and reused by every step and every later solve of this object on the same pattern (an engine's
-// island keeps its pattern while its contacts persist: RowSolver keeps one solver per island).
-// Each step costs one numeric factorization (~ the flops of a Cholesky of A) and one solve; the
-// products with A (w, A dx) cost O(nnz A) each, one per step.
+// whose pattern is A's whatever C is (held rows and columns hold explicit zeros and a unit
+// diagonal, their right-hand side 0), so CHOLMOD's symbolic analysis (fill-reducing order,
+// elimination tree, supernodal or simplicial as CHOLMOD decides; linalg/cholmod_factor.hpp) is
+// done once per pattern of A and reused by every step and by later solves of this object on the
+// same pattern (RowSolver keeps one solver object per island key, so an island's analysis lives
+// in its slot as long as its contact pattern holds). A step costs one numeric factorization,
+// one solve, the sweeps (O(nnz A) each) and one product with A per trial step length.
 //
-// Globalization. Merit theta(x) = ||H(x)||_2^2 with the true (moving) bounds. Along dx the step
-// length halves from 1 (at most NewtonParams::maxHalvings times, each O(n): w moves as t A dx)
-// until theta decreases by Armijo's rule (1e-4 t theta); when none does, the shortest step that
-// decreases theta at all is taken; when nothing decreases, rho grows and the step is recomputed
-// from the same x. After NewtonParams::maxStalls such steps in a row at the largest rho the
-// solve stops (Failed, "no descent"). The best iterate (lowest theta, the start included) is
-// returned: never worse than the start.
+// Starts. A warm start (Options::warmStart, solveWithGuess) is used as it is (projected onto its
+// bounds). A cold start (x = 0) first takes NewtonParams::coldSweeps projected Gauss-Seidel
+// sweeps; pivoting from zero never runs here.
 //
-// Starts. A warm start (Options::warmStart, solveWithGuess) is used as it is: an engine's last
-// answer settles in 1-3 steps when the contact sets barely change. A cold start (x = 0) first
-// takes NewtonParams::coldSweeps projected Gauss-Seidel sweeps (pgs.hpp), which place most rows
-// in their final sets; pivoting from zero over thousands of rows never runs here.
+// Limits. Options::maxIterations bounds the steps (MaxIterations), Options::timeBudget the wall
+// time (checked before each step; TimeLimit). Both return the best iterate by ||H||_2, the start
+// included, so never worse than the start; the base class reports its true residual.
+// Result::iterations counts the steps.
 //
-// Limits. Options::maxIterations bounds the Newton steps (MaxIterations), Options::timeBudget
-// the wall time (checked before each factorization; TimeLimit). Both return the best iterate
-// with its true residual (the base class recomputes it). Result::iterations counts the steps.
-//
-// Applies to symmetric A (checked each solve, O(nnz)); a nonsymmetric A is solved by the dense
-// path with a partially pivoted LU when n <= denseMaxRows, and is Unsupported above that. A
-// clamped block that is not positive definite even with the largest rho ends the solve (Failed).
-// No state carries from one solve to the next but the symbolic analysis, a function of A's
-// pattern only: the same problem and start give the same answer bit for bit.
+// Applies to symmetric A (checked each solve: O(nnz log) for sparse A, no transposed copy); a
+// nonsymmetric A is Unsupported. No state carries from one solve to the next except the symbolic
+// analysis, a function of A's pattern only: the same problem and start give the same answer.
 #pragma once
 
 #include <memory>
@@ -118,6 +122,7 @@ class NewtonSolver : public Solver {
 
  private:
   struct Work;
+  bool search(const Problem& problem, const Vector& x, double res, double dMax, double& mu);
   std::unique_ptr<Work> work_;
   std::unique_ptr<linalg::CholmodFactor> cholmod_;
   NewtonParams params_;
