@@ -36,13 +36,10 @@
 //     vector along the new direction), and it re-creates some points of a resting stack every
 //     step with no cached impulse. Without a remembered answer, friction rows start from the
 //     point's m_appliedImpulseLateral1/2 when the directions persist (direction caching, or
-//     directions not from the velocity). Measured (bullet_bench's 55-box pyramid, dantzig, 60
-//     steps after 30 SI steps): once the stack has come to rest under the exact answers (~30
-//     steps) the start's residual is 4e-5-1e-3 instead of 0.06-0.12 and the block stage settles
-//     in 3 steps (~15 ms CPU per island) instead of 6-24 (22-70 ms). The first ~20 steps after
-//     SI are unchanged: the stack moves from SI's approximate state to the exact answers'
-//     (answers change by 0.1-1 per step; start residual 0.2-0.7) and the block stage does not
-//     settle within its 40 steps.
+//     directions not from the velocity). Once a stack has come to rest under exact answers the
+//     start's residual is 4e-5-1e-3 instead of 0.06-0.12 (bullet_bench's 55-box pyramid after 30
+//     SI steps); the first ~20 steps after SI, while the stack moves from SI's approximate state
+//     to the exact answers', start at 0.2-0.7 (docs/benchmarks.md).
 //  5. solve and 6. check — mlcp::RowSolver (mlcp/row_solver.hpp), shared with the ODE adapter:
 //     it classifies the island (bilateral only, frictionless contacts, boxed, friction), runs
 //     the named solver or `auto`'s choice ("pgs" on the rows, others on an assembled A, dense up
