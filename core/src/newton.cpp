@@ -12,6 +12,9 @@ namespace mlcp {
 
 namespace {
 
+// The widest band inside a bound in which a row pushing outward is held (Bertsekas' eps).
+constexpr double kActiveBand = 1e-3;
+
 // Squared 2-norm of the natural map at (x, w) with the bounds at x; inf holds its inf-norm.
 double naturalMerit(const Problem& pb, const Vector& x, const Vector& w, double& inf) {
   double sum = 0;
@@ -61,16 +64,19 @@ double quadratic(const Problem& pb, const Vector& x, const Vector& w) {
   return 0.5 * x.dot(w + pb.b);
 }
 
-// Projected Newton's sets at a feasible x: a row is held (dx_i = 0) when it is fixed, or at a
-// bound with w pushing outward; the others are free (inC). Returns the free rows' count and
-// leaves -w on them in rhs (0 on the held ones).
+// Projected Newton's sets at a feasible x (Bertsekas' eps-active set): a row is held when it is
+// fixed, or within eps of a bound with w pushing outward; the others are free (inC). rhs gets -w
+// on the free rows, the scaled gradient step -w_i / A_ii on the held ones (0 on fixed rows), which
+// the projection ends at the bound. Returns the free rows' count.
 int freeRows(const Vector& x, const Vector& w, const Vector& lo, const Vector& hi,
-             std::vector<char>& inC, Vector& rhs) {
+             const Vector& invDiag, double eps, std::vector<char>& inC, Vector& rhs) {
   int free = 0;
   for (int i = 0; i < x.size(); ++i) {
-    const bool held = lo[i] == hi[i] || (x[i] <= lo[i] && w[i] > 0) || (x[i] >= hi[i] && w[i] < 0);
+    const bool fixed = lo[i] == hi[i];
+    const bool held =
+        fixed || (x[i] - lo[i] <= eps && w[i] > 0) || (hi[i] - x[i] <= eps && w[i] < 0);
     inC[i] = !held;
-    rhs[i] = held ? 0.0 : -w[i];
+    rhs[i] = !held ? -w[i] : fixed ? 0.0 : -w[i] * invDiag[i];
     free += !held;
   }
   return free;
@@ -85,8 +91,9 @@ bool NewtonSolver::search(const Problem& pb, const Vector& x, double res, double
   Work& wk = *work_;
   const NewtonParams& par = params_;
   const double f = quadratic(pb, x, wk.w);
+  const double band = std::min(kActiveBand, res * (1.0 + pb.b.lpNorm<Eigen::Infinity>()));
   for (;;) {
-    const int free = freeRows(x, wk.w, wk.lo, wk.hi, wk.inC, wk.dx);
+    const int free = freeRows(x, wk.w, wk.lo, wk.hi, wk.invDiag, band, wk.inC, wk.dx);
     const double rho = mu * dMax * std::min(1.0, res);
     ++factorizations_;
     const bool solved = free > 0 && wk.system.factor(wk.inC, rho) && wk.system.solve(wk.dx);

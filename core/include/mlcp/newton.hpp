@@ -15,11 +15,13 @@
 // accuracy measure is the natural map H(x) = x - clamp(x - w, l(x), u(x)) with the true, moving
 // bounds (residual.hpp): the solve converges when ||H||_inf <= Options::tolerance (1 + ||b||_inf).
 //
-// Step (Bertsekas' projected Newton). At a feasible x a row is held when it is fixed (l = u) or at
-// a bound with w pushing outward (x = l, w > 0 or x = u, w < 0); the others are free (C). The
-// direction solves the free rows' Newton system with the held rows fixed,
+// Step (Bertsekas' projected Newton). At a feasible x a row is held when it is fixed (l = u) or
+// within eps of a bound with w pushing outward (x - l <= eps, w > 0 or u - x <= eps, w < 0; eps =
+// min(1e-3, ||H||_inf), the eps-active set that lets rows near a bound leave the free set a step
+// sooner); the others are free (C). The direction solves the free rows' Newton system, the held
+// rows taking a diagonally scaled gradient step that the projection ends on their bound,
 //
-//     (A_CC + rho I) dx_C = -w_C,   dx_N = 0,
+//     (A_CC + rho I) dx_C = -w_C,   dx_i = -w_i / A_ii (i held, not fixed),   0 (fixed),
 //
 // symmetric positive definite for rho > 0. The step is x(t) = P(x + t dx), P the projection onto
 // the step's bounds, with t = 1, 1/2, ... (at most NewtonParams::maxHalvings halvings) until
