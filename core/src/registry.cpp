@@ -4,6 +4,7 @@
 #include "mlcp/fallback.hpp"
 #include "mlcp/ldlt.hpp"
 #include "mlcp/lemke.hpp"
+#include "mlcp/newton.hpp"
 #include "mlcp/pgs.hpp"
 
 namespace mlcp {
@@ -20,6 +21,8 @@ std::vector<SolverInfo>& registered() {
       {"pgs", "projected Gauss-Seidel / SOR for boxed problems with findex", &make<PgsSolver>},
       {"dantzig", "Dantzig principal pivoting for boxed problems with findex (ODE-style)",
        &make<DantzigSolver>},
+      {"newton", "semismooth Newton on the natural map, CHOLMOD-factored: large islands",
+       &make<NewtonSolver>},
       {"lemke", "Lemke's lexicographic complementary pivoting, dense; boxes, findex by fixed point",
        &make<LemkeSolver>},
       {"ldlt", "sparse LDL^T (or LU) direct solve for problems without bounds; pattern reused",

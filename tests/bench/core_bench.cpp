@@ -2,16 +2,16 @@
 // dense SPD boxed problems (n = 10 .. 1000) and one sparse block-banded problem (n = 1002).
 // Then box pyramids of 15 and 55 boxes (tests/common/contact_scenes.hpp) as engines hand them
 // over: per iteration one time step (perturb b, assemble A sparse from the rows, solve warm
-// from the previous step's answer), for dantzig with the block stage and without it
-// ("dantzig-dense"), cold and warm, and pgs for reference at a residual target of 1e-6.
+// from the previous step's answer), for dantzig and newton, cold and warm, and pgs for
+// reference at a residual target of 1e-6.
 // The residual of each answer (mlcp::residual, checked independently) is a counter; so are
 // the solver's iterations (sweeps or pivots) and whether it converged. Compare times within
 // one run: the machines are noisy.
 //
 // Captured engine islands (not in the repository): MLCP_BENCH_ISLANDS=base1,base2,... names
 // problems saved as base.json (mlcp-problem/1) with their warm start in base.start.json
-// (mlcp::io::readVectorJson); each is solved by dantzig (Auto and Never block stage) cold and
-// warm, with pivots, block steps and the residual as counters.
+// (mlcp::io::readVectorJson); each is solved by dantzig and newton cold and warm, with
+// iterations (pivots or Newton steps) and the residual as counters.
 #include <benchmark/benchmark.h>
 
 #include <cstdlib>
@@ -19,7 +19,6 @@
 #include <sstream>
 
 #include "../common/contact_scenes.hpp"
-#include "mlcp/dantzig.hpp"
 #include "mlcp/io.hpp"
 #include "mlcp/pgs.hpp"
 #include "mlcp/registry.hpp"
@@ -103,7 +102,7 @@ void registerAll() {
   problems.reserve(sizes.size() + 1);
   for (int n : sizes) problems.push_back(denseSpd(n, 1000u + n));
   problems.push_back(sparseBanded(7));
-  for (const char* name : {"pgs", "dantzig", "lemke"}) {
+  for (const char* name : {"pgs", "dantzig", "newton", "lemke"}) {
     if (!makeSolver(name)) continue;  // not built into this library
     for (size_t k = 0; k < problems.size(); ++k) {
       const Problem* p = &problems[k];
@@ -119,26 +118,20 @@ void registerAll() {
   }
 }
 
-// One time step per iteration: next b, assembly, solve (warm unless cold). stage: "block" or
-// "dense" for dantzig, "pgs" for pgs at tolerance 1e-6.
-void pyramidSteps(benchmark::State& state, int levels, const std::string& stage, bool warm) {
+// One time step per iteration: next b, assembly, solve (warm unless cold) by the named solver
+// (pgs at tolerance 1e-6, the others at their default).
+void pyramidSteps(benchmark::State& state, int levels, const std::string& name, bool warm) {
   test::PyramidSpec spec;
   spec.levels = levels;
   test::BoxPyramid pyramid(spec);
-  std::unique_ptr<Solver> solver;
-  if (stage == "pgs") {
-    solver = std::make_unique<PgsSolver>();
+  std::unique_ptr<Solver> solver = makeSolver(name);
+  if (name == "pgs") {
     solver->options().tolerance = 1e-6;
     solver->options().maxIterations = 5000;
-  } else {
-    auto d = std::make_unique<DantzigSolver>();
-    d->params().blockStage =
-        stage == "block" ? DantzigParams::BlockStage::Always : DantzigParams::BlockStage::Never;
-    solver = std::move(d);
   }
   // The previous answer comes from a solve to the default tolerance of the dense path.
   Vector x;
-  DantzigSolver().solve(pyramid.rows().assemble(true), x);
+  makeSolver("dantzig")->solve(pyramid.rows().assemble(true), x);
   Problem p;
   Result r;
   double worst = 0;
@@ -162,33 +155,30 @@ void pyramidSteps(benchmark::State& state, int levels, const std::string& stage,
 void registerPyramids() {
   for (int levels : {5, 10}) {
     const std::string boxes = std::to_string(levels * (levels + 1) / 2);
-    for (const char* stage : {"block", "dense", "pgs"})
+    for (const char* name : {"dantzig", "newton", "pgs"})
       for (bool warm : {false, true}) {
-        const std::string label = std::string(stage == std::string("pgs") ? "pgs" : "dantzig-") +
-                                  (stage == std::string("pgs") ? "" : stage) + "/pyramid" + boxes +
-                                  (warm ? "/warm" : "/cold");
+        const std::string label =
+            std::string(name) + "/pyramid" + boxes + (warm ? "/warm" : "/cold");
         auto* b = benchmark::RegisterBenchmark(
-            label.c_str(), [=](benchmark::State& st) { pyramidSteps(st, levels, stage, warm); });
+            label.c_str(), [=](benchmark::State& st) { pyramidSteps(st, levels, name, warm); });
         b->Unit(benchmark::kMillisecond);
-        if (levels == 10 && !(warm && std::string(stage) == "block")) b->Iterations(3);
+        if (levels == 10) b->Iterations(3);
       }
   }
 }
 
 void islandSolve(benchmark::State& state, const Problem& p, const Vector& start,
-                 DantzigParams::BlockStage stage, bool warm) {
-  DantzigSolver solver;
-  solver.params().blockStage = stage;
+                 const std::string& name, bool warm) {
+  std::unique_ptr<Solver> solver = makeSolver(name);
   Result r;
   Vector x;
   for (auto _ : state) {
-    r = warm ? solver.solveWithGuess(p, start, x) : solver.solve(p, x);
+    r = warm ? solver->solveWithGuess(p, start, x) : solver->solve(p, x);
   }
   state.counters["n"] = p.size();
   state.counters["residual"] = residual(p, x);
   state.counters["converged"] = r.converged();
   state.counters["iterations"] = r.iterations;
-  state.counters["block_steps"] = solver.blockSteps();
 }
 
 void registerIslands() {
@@ -200,13 +190,11 @@ void registerIslands() {
     if (base.empty()) continue;
     const Problem p = io::readProblemJson(base + ".json");
     const Vector start = io::readVectorJson(base + ".start.json");
-    for (auto [stage, tag] : {std::pair{DantzigParams::BlockStage::Auto, "auto"},
-                              std::pair{DantzigParams::BlockStage::Never, "never"}})
+    for (const char* name : {"dantzig", "newton"})
       for (bool warm : {false, true}) {
-        const std::string label =
-            "dantzig-" + std::string(tag) + "/" + base + (warm ? "/warm" : "/cold");
+        const std::string label = std::string(name) + "/" + base + (warm ? "/warm" : "/cold");
         benchmark::RegisterBenchmark(label.c_str(), [=](benchmark::State& st) {
-          islandSolve(st, p, start, stage, warm);
+          islandSolve(st, p, start, name, warm);
         })->Unit(benchmark::kMillisecond);
       }
   }

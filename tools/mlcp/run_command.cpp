@@ -103,7 +103,10 @@ int runScene(const RunArgs& args) {
   }
 
   const RunSummary sum = runWorld(*world, steps, [&](const scene::World& w, int i) {
-    if (csv.is_open()) writeStepCsv(csv, w, run.solver, i);
+    if (csv.is_open()) {
+      writeStepCsv(csv, w, run.solver, i);
+      csv.flush();  // a run stopped from outside (a time limit) keeps the steps it finished
+    }
     if (trajectory.is_open()) writeTrajectoryCsv(trajectory, w, run.solver, i);
     if (i + 1 == args.capture) world->captureNextStep(args.captureDir);
   });
