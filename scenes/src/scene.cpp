@@ -10,9 +10,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "mlcp/scene/convex_hull.hpp"
-
 #include "mlcp/input_limits.hpp"
+#include "mlcp/scene/convex_hull.hpp"
 #include "mlcp/scene/scene_limits.hpp"
 
 namespace mlcp::scene {

@@ -57,6 +57,13 @@ void checkShape(const Where& at, const Shape& s) {
       at.range("shape.radius", s.radius, kMinLength, kMaxLength, "m");
       at.range("shape.length", s.length, 0, kMaxLength, "m");
       return;
+    case ShapeType::Cylinder:
+      at.range("shape.radius", s.radius, kMinLength, kMaxLength, "m");
+      at.range("shape.length", s.length, kMinLength, kMaxLength, "m");
+      return;
+    case ShapeType::ConvexHull:
+      for (const Vec3& p : s.hullPoints) at.magnitude("shape.points", p, kMaxLength, "m");
+      return;
     case ShapeType::Plane:
       at.unit("shape.normal", length(s.normal));
       at.magnitude("shape.offset", s.offset, kMaxCoordinate, "m");
@@ -75,6 +82,28 @@ void checkBody(const Scene& scene, const Body& b) {
   at.magnitude("angular_velocity", b.angularVelocity, kMaxAngularSpeed, "rad/s");
 }
 
+void checkSpring(const Where& at, const char* field, const JointSpring& s) {
+  if (!s.enabled) return;
+  at.range(field, s.stiffness, 0, kMaxStiffness, "N/m or N m/rad");
+  at.range(field, s.damping, 0, kMaxStiffness, "N s/m or N m s/rad");
+}
+
+// The fields of the joint types beyond ball, hinge, slider and fixed.
+void checkJointExtras(const Where& at, const Joint& j) {
+  at.unit("axis2", length(j.axis2));
+  at.unit("normal", length(j.normal));
+  at.magnitude("anchor2", j.anchor2, kMaxCoordinate, "m");
+  for (double a : {j.cone.swing1, j.cone.swing2, j.cone.twist})
+    at.range("cone", a, 0, 3.14159265358979323846, "rad");
+  for (const AxisDof& d : j.dofs) {
+    at.magnitude("dof limit", d.lower, kMaxDofLimit, "rad or m");
+    at.magnitude("dof limit", d.upper, kMaxDofLimit, "rad or m");
+    checkSpring(at, "dof spring", d.spring);
+  }
+  checkSpring(at, "suspension", j.suspension);
+  at.magnitude("ratio", j.ratio, kMaxGearRatio, "");
+}
+
 void checkJoint(const Scene& scene, const Joint& j) {
   const Where at(scene, "joint \"" + io::capped(j.name) + "\"");
   at.magnitude("anchor", j.anchor, kMaxCoordinate, "m");
@@ -87,6 +116,7 @@ void checkJoint(const Scene& scene, const Joint& j) {
     at.magnitude("motor.velocity", j.motor.velocity, kMaxSpeed, "rad/s or m/s");
     at.range("motor.max_force", j.motor.maxForce, 0, kMaxForce, "N or N m");
   }
+  checkJointExtras(at, j);
 }
 
 void checkCounts(const Scene& scene) {

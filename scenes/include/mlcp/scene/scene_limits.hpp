@@ -27,9 +27,13 @@ inline constexpr double kMaxGravity = 1e4;       // m/s^2: |gravity| components
 inline constexpr double kMaxFriction = 100;      // friction coefficient
 inline constexpr double kMaxForce = 1e10;        // N or N m: motor max_force
 inline constexpr double kMaxJointLimit = 1e5;    // rad or m: |limits.lower|, |limits.upper|
-inline constexpr double kMinTimeStep = 1e-6;     // s
-inline constexpr double kMaxTimeStep = 1;        // s
-inline constexpr double kMaxCfm = 1;             // settings.cfm
+// rad or m: a six_dof axis limit; up to Bullet's SIMD_INFINITY (1e30), which stands for "none".
+inline constexpr double kMaxDofLimit = 1e30;
+inline constexpr double kMaxStiffness = 1e10;  // N/m or N m/rad: springs, suspensions (and damping)
+inline constexpr double kMaxGearRatio = 1e4;   // |gear ratio|
+inline constexpr double kMinTimeStep = 1e-6;   // s
+inline constexpr double kMaxTimeStep = 1;      // s
+inline constexpr double kMaxCfm = 1;           // settings.cfm
 inline constexpr long long kMaxSteps = 10000000;
 inline constexpr long long kMaxIterations = 1000000;
 inline constexpr double kMinTolerance = 1e-16;  // solver.tolerance
