@@ -28,6 +28,7 @@ struct RunArgs {
   bool noWarmStart = false;
   std::string fallback = "pgs";
   double fallbackResidual = -1;
+  double timeBudget = -1;  // -1: the adapters' default
   std::string csv;
   std::string trajectory;
   int capture = -1;  // -1: no capture
@@ -49,6 +50,7 @@ int runScene(const RunArgs& args) {
   if (args.noWarmStart) run.warmStart = false;
   run.fallback = args.fallback == "none" ? "" : args.fallback;
   if (args.fallbackResidual >= 0) run.fallbackResidual = args.fallbackResidual;
+  if (args.timeBudget >= 0) run.timeBudget = args.timeBudget;
   const int steps = args.steps >= 0 ? args.steps : s.settings.steps;
 
   std::unique_ptr<scene::World> world;
@@ -160,6 +162,11 @@ Runner addRunCommand(CLI::App& app) {
                   "core solver run when an answer is rejected, or none (default pgs)");
   cmd->add_option("--fallback-residual", args->fallbackResidual,
                   "scaled residual above which an answer is rejected (default 1e-3)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--time-budget", args->timeBudget,
+                  "wall-clock budget of one step's solves in seconds, 0 for none (core solvers "
+                  "only; default 0.02): islands solved after it ran out get a minimal share and "
+                  "answers stopped by it report time-limit")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--csv", args->csv, "CSV file to write (one row per step)");
   cmd->add_option("--trajectory", args->trajectory,

@@ -99,6 +99,7 @@ class BulletWorld : public scene::World {
       settings.warmStart = run.warmStart;
       settings.fallback = run.fallback;
       settings.acceptResidual = run.fallbackResidual;
+      settings.timeBudget = run.timeBudget;
       solver = scenes::makeBulletSolver(name, settings);  // throws for unknown names
       ours_ = static_cast<ConstraintSolver*>(solver.get());
     }

@@ -51,6 +51,20 @@ int mlcp_ode_stepper_set_max_iterations(mlcp_ode_stepper* s, int iterations) {
   return 1;
 }
 
+int mlcp_ode_set_time_budget(mlcp_ode_stepper* s, double seconds) {
+  if (!s) {
+    lastError = "mlcp_ode_set_time_budget: stepper is NULL";
+    return 0;
+  }
+  try {
+    s->stepper.setTimeBudget(seconds);
+    return 1;
+  } catch (const std::exception& e) {
+    lastError = std::string("mlcp_ode_set_time_budget: ") + e.what();
+    return 0;
+  }
+}
+
 int mlcp_ode_stepper_step(mlcp_ode_stepper* s, dWorldID world, dReal stepsize) {
   if (!s || !world || !(stepsize > 0)) return 0;
   return s->stepper.step(world, stepsize) ? 1 : 0;

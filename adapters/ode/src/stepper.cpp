@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <cmath>
 #include <iterator>
 #include <stdexcept>
 #include <utility>
@@ -102,6 +103,7 @@ Stepper::Stepper(const std::string& solver, const StepperOptions& options)
   rs.fallback = options.fallback;
   rs.fallbackOptions = options.fallbackOptions;
   rs.acceptResidual = options.acceptResidual;
+  rs.timeBudget = options.timeBudget;
   rs.denseMaxRows = options.denseMaxRows;
   if (!options.fallback.empty() && !RowSolver::known(options.fallback))
     throw std::invalid_argument("mlcp::ode::Stepper: fallback '" + options.fallback +
@@ -110,10 +112,11 @@ Stepper::Stepper(const std::string& solver, const StepperOptions& options)
   // fall back.
   impl_->primary = makeMethod(solver, rs);
   if (!options.reference.empty()) {
-    // The reference only measures: no fallback, every answer kept.
+    // The reference only measures: no fallback, every answer kept, no budget.
     RowSolverSettings ref = rs;
     ref.fallback = "";
     ref.acceptResidual = kInf;
+    ref.timeBudget = 0;
     impl_->reference = makeMethod(options.reference, ref);
     if (impl_->reference.forwards())
       throw std::invalid_argument("mlcp::ode::Stepper: reference '" + options.reference +
@@ -132,6 +135,14 @@ const std::vector<IslandProblem>& Stepper::lastProblems() const { return impl_->
 void Stepper::resetWarmStart() { impl_->warm.clear(); }
 RowSolver* Stepper::rowSolver() { return impl_->primary.solver.get(); }
 
+void Stepper::setTimeBudget(double seconds) {
+  if (RowSolver* rows = rowSolver())
+    rows->setTimeBudget(seconds);  // checks the value
+  else if (!(seconds >= 0) || !std::isfinite(seconds))
+    throw std::invalid_argument("mlcp::ode::Stepper: timeBudget must be finite and >= 0 seconds");
+  impl_->options.timeBudget = seconds;
+}
+
 bool Stepper::step(dWorldID world, dReal h) {
   if (!world) throw std::invalid_argument("mlcp::ode::Stepper::step: null world");
   if (!(h > 0)) throw std::invalid_argument("mlcp::ode::Stepper::step: step size must be > 0");
@@ -144,6 +155,7 @@ bool Stepper::step(dWorldID world, dReal h) {
     impl_->problems.clear();
   }
   ActiveScope scope(world, impl_.get());
+  if (RowSolver* rows = rowSolver()) rows->beginStep();  // the time budget is per step
   // dWorldStep's two calls, with our estimator and island stepper.
   dxWorldProcessIslandsInfo islands;
   bool ok = dxReallocateWorldProcessContext(world, islands, h, &Impl::estimateMemory) &&

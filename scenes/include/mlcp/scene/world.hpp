@@ -51,6 +51,9 @@ struct RunSettings {
   // is above this goes to the fallback; the better answer is kept). Default 1e-3, the adapters'
   // mlcp::kDefaultAcceptResidual; +inf accepts any finite answer.
   double fallbackResidual = kDefaultAcceptResidual;
+  // Wall-clock budget of one step's solves in seconds, 0 for none (core solvers only;
+  // RowSolverSettings::timeBudget). Default the adapters' kDefaultTimeBudget (0.02 s).
+  double timeBudget = kDefaultTimeBudget;
 
   static RunSettings fromScene(const Scene& scene);
 };

@@ -79,6 +79,10 @@ struct StepperOptions {
   // accepts any finite answer. Default mlcp::kDefaultAcceptResidual (1e-3), as in the Bullet
   // adapter.
   double acceptResidual = kDefaultAcceptResidual;
+  // Wall-clock budget of one step's island solves, in seconds (mlcp::RowSolverSettings::
+  // timeBudget, mlcp/row_solver.hpp); 0 for none. Default mlcp::kDefaultTimeBudget (0.02 s), as
+  // in the Bullet adapter.
+  double timeBudget = kDefaultTimeBudget;
   // Diagnostics: a second solver (any name the stepper accepts except the forwarding ones) run
   // on the same island problem after the primary; its residual and time go to IslandStats,
   // its answer is discarded. "" for none. Default "".
@@ -164,6 +168,9 @@ class Stepper {
   const StepperOptions& options() const;
   // The core solver's options (StepperOptions::solver), adjustable between steps.
   mlcp::Options& solverOptions();
+  // StepperOptions::timeBudget, adjustable between steps (seconds, finite, >= 0; throws
+  // std::invalid_argument otherwise). The "ode-..." solvers ignore it.
+  void setTimeBudget(double seconds);
   // Statistics of the last step (cleared at the start of each step).
   const StepStats& lastStep() const;
   // The islands with rows of the last step, in step order, when StepperOptions::keepProblems
