@@ -217,10 +217,7 @@ void RowSolver::keepStartIfBetter(const RowSystem& rows, const Vector& start, Ve
                                   double tolerance) {
   const Accuracy a = accuracy(start, rows.slack(start), rows.lo, rows.hi, rows.findex,
                               rows.b.lpNorm<Eigen::Infinity>());
-  if (!(a.residual < r.residual) && std::isfinite(r.residual)) return;
-  x = start;
-  applyAccuracy(r, a, tolerance);
-  r.message += "; the start's residual is lower: start returned";
+  if (takeStartIfBetter(r, a, tolerance)) x = start;
 }
 
 void RowSolver::assemble(const RowSystem& rows, bool sparse) {

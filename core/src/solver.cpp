@@ -99,13 +99,18 @@ void Solver::keepStartIfBetter(const Problem& problem, const Vector* start, Resu
   } else {
     a = accuracy(problem, Vector::Zero(problem.size()), slack);
   }
-  if (!(a.residual < r.residual) && std::isfinite(r.residual)) return;
+  if (!takeStartIfBetter(r, a, options_.tolerance)) return;
   if (start)
     start_ = *start;
   else
     start_.setZero(problem.size());
-  applyAccuracy(r, a, options_.tolerance);
+}
+
+bool takeStartIfBetter(Result& r, const Accuracy& start, double tolerance) {
+  if (!(start.residual < r.residual) && std::isfinite(r.residual)) return false;
+  applyAccuracy(r, start, tolerance);
   r.message += "; the start's residual is lower: start returned";
+  return true;
 }
 
 Result Solver::runChecked(const Problem& problem, Vector& x, const Vector* start) {

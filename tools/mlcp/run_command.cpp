@@ -165,7 +165,7 @@ Runner addRunCommand(CLI::App& app) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--time-budget", args->timeBudget,
                   "wall-clock budget of one step's solves in seconds, 0 for none (core solvers "
-                  "only; default 0.02): islands solved after it ran out get a minimal share and "
+                  "only; default 0.05): islands solved after it ran out get a minimal share and "
                   "answers stopped by it report time-limit")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--csv", args->csv, "CSV file to write (one row per step)");

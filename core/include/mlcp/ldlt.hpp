@@ -31,6 +31,9 @@
 //   10-12, 63 rows 8-16 vs 9-17, 96 rows 16-34 vs 13-20, 198 rows 75 vs 43; 5-row blocks 60 rows
 //   9-12 vs 13-20, 125 rows 28-37 vs 28-39. Dense wins to 60-100 rows on a thin band, further on
 //   a wider one and always on a full matrix: RowSolver's 64-row limit sits at the crossover.
+//
+// Options::timeBudget does not stop it: the answer is one factorization and two triangular
+// solves, with no iterate before they end (their cost is fixed by the pattern, not by the data).
 #pragma once
 
 #include <memory>

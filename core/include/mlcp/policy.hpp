@@ -17,17 +17,17 @@
 //                                                 ratio tests can divide by it
 //   contacts, rows <= smallIslandRows          -> "dantzig" exact pivoting answer (~1e-12)
 //   contacts, rows >  smallIslandRows:
-//     the step's time budget spent             -> "pgs"      (no fallback: no time for one)
+//     the step's time budget spent             -> "pgs"      (improves any start in any share)
 //     tolerance >= looseTolerance              -> "pgs"      (fallback "dantzig")
 //     otherwise                                -> largeIslandSolver ("dantzig" today; set
 //                                                 kLargeIslandSolver to "newton" once that
 //                                                 solver is registered)
-// ("contacts": StandardLcp, Boxed and Findex islands.) Why these rules, measured with
-// `mlcp run` on the scenes (docs/benchmarks.md, "auto's choices"): ldlt solves a 20-hinge chain
-// in ~0.016 ms at 5e-14 where pgs takes 1.35 ms to reach 1e-1; dantzig ends a 280-row pyramid at
-// 5e-15 in ~4.6 ms where 50 pgs sweeps reach 1e-3 in more time; above ~600 rows the pivot count
-// (quadratic-to-cubic cost) makes pgs the faster way to a loose answer, while a tight tolerance
-// still needs an exact method, bounded by the time budget (row_solver.hpp).
+// ("contacts": StandardLcp, Boxed and Findex islands.) Why: one LDL^T solve is exact and cheaper
+// than any iteration on joint chains; pivoting is exact and fastest on small contact islands,
+// but its pivot count grows with the rows, so above ~1000 rows an exact answer takes seconds a
+// step, where pgs reaches a loose tolerance in a bounded number of sweeps; a tight tolerance on
+// a large island still asks for an exact method, which the time budget bounds (row_solver.hpp).
+// The measurements: docs/benchmarks.md, "auto's choices and the time budget".
 //
 // The fallback rule (the same for a registry chain "a>b>c" and for RowSolver's primary and
 // fallback):
@@ -92,7 +92,8 @@ struct Policy {
                 bool budgetSpent = false) const;
   // Whether a rejected answer of a pivoting primary sends its island to pgs for the next
   // pgsAfterBreakdown solves: a breakdown (Failed, NumericalIssue, a non-finite residual) or a
-  // miss by more than nearMiss times acceptResidual.
+  // miss by more than nearMiss times acceptResidual (as a solve cut by the time budget usually
+  // is: the island then stops spending its budget on a method that does not finish in it).
   bool demotes(const Result& rejected, double acceptResidual) const;
 };
 

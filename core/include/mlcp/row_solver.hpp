@@ -60,12 +60,13 @@
 // stacks visibly sink (docs/benchmarks.md, "Acceptance limit"). +inf accepts any finite answer
 // (SI-like fixed-sweep pgs).
 //
-// timeBudget, default kDefaultTimeBudget (0.02 s): an engine step at 60 Hz has 16.7 ms of wall
-// time; a drop-in that takes up to ~20 ms for its solves on a pathological step drops one frame
-// instead of hanging the program for seconds (dantzig's 192,400 pivots on Bullet's BasicDemo),
-// while every scene of scenes/ up to 210 boxes solves within it untouched (docs/benchmarks.md,
-// "Time budget"). 0 disables it (reproducible runs: a budget makes the answer depend on the
-// machine's speed).
+// timeBudget, default kDefaultTimeBudget (0.05 s): three frames of a 60 Hz program. A drop-in
+// whose island cannot be solved exactly in time (dantzig on ODE's 210-box pyramid: ~4 s a step
+// unbounded) then runs at ~20 steps a second with the best answer found instead of hanging for
+// seconds or minutes, while the exact answers of the scenes up to 55 boxes (ODE: ~11 ms a step)
+// and every joint island (microseconds) stay untouched; a tighter default cut pyramid_55's
+// dantzig solves on a loaded machine (docs/benchmarks.md, "Time budget"). 0 disables it, for
+// reproducible runs: an answer cut by a budget depends on the machine's speed and load.
 #pragma once
 
 #include <cstdint>
@@ -110,10 +111,10 @@ struct RowSolverSettings {
   // answer. Default kDefaultAcceptResidual (1e-3).
   double acceptResidual = kDefaultAcceptResidual;
   // Wall-clock budget of one engine step's solves, in seconds (see above); 0 for none. Options'
-  // own timeBudget, when set, still bounds each solve. Default kDefaultTimeBudget (0.02 s).
+  // own timeBudget, when set, still bounds each solve. Default kDefaultTimeBudget (0.05 s).
   double timeBudget = kDefaultTimeBudget;
   // The smallest share of timeBudget an island's solve (and its fallback) gets, in (0, 1].
-  // Default kDefaultMinShare (0.05: 1 ms of a 20 ms budget, ~100 pgs sweeps of 1000 rows).
+  // Default kDefaultMinShare (0.05: 2.5 ms of a 50 ms budget, ~50 pgs sweeps of 1000 rows).
   double minShare = kDefaultMinShare;
   // Islands with at most this many rows give matrix-based solvers a dense A, larger ones a
   // sparse A (rows); ldlt then factors dense or sparse LDL^T accordingly. Default

@@ -87,6 +87,11 @@ struct Accuracy;
 // Converged; a Converged claim above the tolerance becomes Failed.
 void applyAccuracy(Result& r, const Accuracy& a, double tolerance);
 
+// A TimeLimit answer is never worse than its start: when the start's accuracy is better (a lower
+// residual, or r's is not finite) r takes it (with a note in the message) and true is returned;
+// the caller then returns the start as x.
+bool takeStartIfBetter(Result& r, const Accuracy& start, double tolerance);
+
 // Seconds on a monotonic clock (for timing and time budgets).
 double nowSeconds();
 

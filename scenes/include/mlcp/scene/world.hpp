@@ -52,7 +52,7 @@ struct RunSettings {
   // mlcp::kDefaultAcceptResidual; +inf accepts any finite answer.
   double fallbackResidual = kDefaultAcceptResidual;
   // Wall-clock budget of one step's solves in seconds, 0 for none (core solvers only;
-  // RowSolverSettings::timeBudget). Default the adapters' kDefaultTimeBudget (0.02 s).
+  // RowSolverSettings::timeBudget). Default the adapters' kDefaultTimeBudget (0.05 s).
   double timeBudget = kDefaultTimeBudget;
 
   static RunSettings fromScene(const Scene& scene);

@@ -23,7 +23,7 @@ void mlcp_ode_stepper_destroy(mlcp_ode_stepper* stepper);
  * Return 1, or 0 for an invalid value (the setting is then unchanged). */
 int mlcp_ode_stepper_set_tolerance(mlcp_ode_stepper* stepper, double tolerance);
 int mlcp_ode_stepper_set_max_iterations(mlcp_ode_stepper* stepper, int iterations);
-/* Wall-clock budget of one step's island solves in seconds, 0 for none (default 0.02; see
+/* Wall-clock budget of one step's island solves in seconds, 0 for none (default 0.05; see
  * mlcp/row_solver.hpp): when it runs out a solve returns its best answer so far, never worse
  * than its start. Returns 1, or 0 for a negative or non-finite value (unchanged then). */
 int mlcp_ode_set_time_budget(mlcp_ode_stepper* stepper, double seconds);

@@ -80,7 +80,7 @@ struct StepperOptions {
   // adapter.
   double acceptResidual = kDefaultAcceptResidual;
   // Wall-clock budget of one step's island solves, in seconds (mlcp::RowSolverSettings::
-  // timeBudget, mlcp/row_solver.hpp); 0 for none. Default mlcp::kDefaultTimeBudget (0.02 s), as
+  // timeBudget, mlcp/row_solver.hpp); 0 for none. Default mlcp::kDefaultTimeBudget (0.05 s), as
   // in the Bullet adapter.
   double timeBudget = kDefaultTimeBudget;
   // Diagnostics: a second solver (any name the stepper accepts except the forwarding ones) run
