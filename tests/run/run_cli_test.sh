@@ -27,6 +27,10 @@ for engine in bullet ode; do
   csv_ok "csv-$engine" "$tmp/$engine.csv" 7 "$engine" pgs
   check "unknown-solver-$engine" 2 "unknown solver 'nosuch'" -- \
     "$mlcp" run "$scenes/stack_10.json" --engine "$engine" --solver nosuch --steps 1
+  check "time-budget-$engine" 0 'stack_10 in '"$engine"' with auto: 5 steps' -- \
+    "$mlcp" run "$scenes/stack_10.json" --engine "$engine" --solver auto --steps 5 --time-budget 0.2
+  check "time-budget-bad-$engine" 2 'not in range' -- \
+    "$mlcp" run "$scenes/stack_10.json" --engine "$engine" --steps 1 --time-budget -0.5
 done
 check stock-bullet 0 'with bullet-si: 3 steps' -- \
   "$mlcp" run "$scenes/resting_box.json" --engine bullet --solver bullet-si --steps 3 --iterations 10
