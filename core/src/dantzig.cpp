@@ -83,7 +83,10 @@ struct DantzigSolver::Workspace {
   std::vector<int> queue, violators;
 
   int pivots = 0, pivotLimit = 0, passes = 0;
-  double startTime = 0, budget = 0;
+  // Options::timeBudget's deadline (+inf for none), read once per clockEvery pivots (a pivot
+  // costs O(n) to O(n |C|): 1024 / n pivots between reads keep a read under ~5% of the work).
+  double deadline = 0;
+  int clockEvery = 1;
   std::string message;
 
   // -------------------------------------------------------------------- set-up
@@ -474,7 +477,7 @@ Outcome DantzigSolver::Workspace::drive(int i) {
       message = os.str();
       return Outcome::PivotLimit;
     }
-    if (budget > 0 && nowSeconds() - startTime > budget) {
+    if (pivots % clockEvery == clockEvery - 1 && deadline != kInf && nowSeconds() > deadline) {
       message = "time budget spent";
       return Outcome::TimeUp;
     }
@@ -879,6 +882,12 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
     // x holds the best iterate: its index sets warm start the incremental pivoting.
     blockMessage += (blockMessage.empty() ? "" : "; ") + rep.message;
   }
+  if (outOfTime()) {  // the budget went to the block stage: its best iterate is the answer
+    result.status = Status::TimeLimit;
+    result.iterations = blockSteps_;
+    result.message = "block stage: " + blockMessage + "; time budget spent before pivoting";
+    return;
+  }
   runPivoting(problem, x, result, blockIterate);
   result.iterations += blockSteps_;
   result.message = "block stage: " + blockMessage + "; pivoting: " + result.message;
@@ -903,8 +912,8 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
   ws.pivTol *= opt.pivotTolerance;
   ws.pivots = 0;
   ws.pivotLimit = opt.maxPivots > 0 ? opt.maxPivots : 50 * n + 100;
-  ws.budget = opt.timeBudget;
-  ws.startTime = ws.budget > 0 ? nowSeconds() : 0.0;  // read only with a budget
+  ws.deadline = budgetDeadline(opt);  // the solve's (Solver sets budgetStart)
+  ws.clockEvery = std::max(1, 1024 / std::max(1, n));
   ws.message.clear();
   // Pass 1 guesses the equality rows and (warm) the rows inside their bounds as clamped.
   for (int p = 0; p < n; ++p) {
@@ -1033,7 +1042,7 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
       if (gamma.allFinite()) next -= dG * gamma;
     }
     ws.setFrictionBounds(next.cwiseMax(0.0));
-    if (opt.timeBudget > 0 && nowSeconds() - ws.startTime > opt.timeBudget) {
+    if (ws.deadline != kInf && nowSeconds() > ws.deadline) {
       result.status = Status::TimeLimit;
       result.message = "time budget spent between friction passes";
       return;

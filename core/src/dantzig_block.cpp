@@ -748,7 +748,7 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
     damped = true;
   };
   Vector bestX = x;
-  const double start = nowSeconds();
+  const double deadline = budgetDeadline(opt);
   std::ostringstream os;
   for (;;) {
     double res = accuracy(pb, x, w).residual;
@@ -781,7 +781,7 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
       os << "residual " << bestRes << " after " << rep.steps << " block steps";
       break;
     }
-    if (opt.timeBudget > 0 && nowSeconds() - start > opt.timeBudget) {
+    if (opt.timeBudget > 0 && nowSeconds() > deadline) {
       x = bestX;
       os << "time budget spent after " << rep.steps << " block steps";
       break;

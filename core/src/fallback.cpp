@@ -21,41 +21,38 @@ FallbackSolver::FallbackSolver(std::vector<std::unique_ptr<Solver>> chain)
 void FallbackSolver::run(const Problem& problem, Vector& x, Result& result) {
   const Vector start = x;
   std::ostringstream attempts;
-  Vector best;
-  Result bestResult;
-  bool haveBest = false;
+  Vector best, xk;
+  Result bestResult;  // residual NaN: any finite answer is better
   for (std::size_t k = 0; k < chain_.size(); ++k) {
     Solver& solver = *chain_[k];
     solver.setOptions(options());
-    Vector xk;
     Result rk = solver.solveWithGuess(problem, start, xk);
-    if (rk.converged()) {
-      x = std::move(xk);
-      const int earlier = static_cast<int>(k);
+    if (acceptable(rk, options().tolerance)) {
+      x.swap(xk);
       result = std::move(rk);
-      result.fallbacks += earlier;
-      if (earlier > 0) result.message += " (after " + attempts.str() + ")";
+      result.fallbacks += static_cast<int>(k);
+      if (k > 0) result.message += " (after " + attempts.str() + ")";
       return;
     }
     attempts << (k ? "; " : "") << solver.name() << ": " << toString(rk.status) << " ("
              << rk.message << ")";
-    const bool usable = xk.size() == problem.size() && std::isfinite(rk.residual);
-    if (usable && (!haveBest || rk.residual < bestResult.residual)) {
-      best = std::move(xk);
+    if (xk.size() == problem.size() && better(rk, bestResult)) {
+      best.swap(xk);
       bestResult = std::move(rk);
-      haveBest = true;
     }
   }
   result.fallbacks = static_cast<int>(chain_.size());
-  if (haveBest) {
-    x = std::move(best);
+  if (std::isfinite(bestResult.residual)) {
+    x.swap(best);
     result.status = bestResult.status;
     result.iterations = bestResult.iterations;
     result.solver = bestResult.solver;
+    result.message = "no answer acceptable, the best (" + result.solver + "'s) returned: ";
   } else {
-    result.status = Status::Failed;
+    result.status = Status::Failed;  // x is the start
+    result.message = "no solver found a finite answer, the start returned: ";
   }
-  result.message = "no solver converged: " + attempts.str();
+  result.message += attempts.str();
 }
 
 namespace {
@@ -71,24 +68,16 @@ Solver* cachedChain(std::vector<std::pair<std::string, std::unique_ptr<Solver>>>
   return cache.back().second.get();
 }
 
-bool registered(const char* name) {
+bool registered(const std::string& name) {
   for (const SolverInfo& info : solvers())
-    if (std::string(info.name) == name) return true;
+    if (name == info.name) return true;
   return false;
 }
 
-// Joins the registered names of `wanted` with '>'.
-std::string chainOf(std::initializer_list<const char*> wanted) {
-  std::string s;
-  for (const char* name : wanted)
-    if (registered(name)) s += (s.empty() ? "" : ">") + std::string(name);
-  return s;
-}
-
-bool hasNonPositiveDiagonal(const Problem& p) {
+bool positiveDiagonal(const Problem& p) {
   for (int i = 0; i < p.size(); ++i)
-    if (!(p.diagonal(i) > 0)) return true;
-  return false;
+    if (!(p.diagonal(i) > 0)) return false;
+  return true;
 }
 
 }  // namespace
@@ -100,22 +89,14 @@ void AutoSolver::run(const Problem& problem, Vector& x, Result& result) {
     result.message = "auto: empty problem";
     return;
   }
+  const Choice choice =
+      policy.choose(c, problem.size(), options().tolerance, positiveDiagonal(problem));
   std::string chain;
-  std::string why;
-  if (c == ProblemClass::Linear) {
-    chain = chainOf({"ldlt", "pgs"});
-    why = "linear";
-  } else if (hasNonPositiveDiagonal(problem)) {
-    chain = chainOf({"lemke", "dantzig"});
-    why = "zero or negative diagonal";
-  } else if (problem.size() <= pivotingLimit) {
-    chain = chainOf({"dantzig", "lemke", "pgs"});
-    why = std::string(toString(c)) + ", n <= " + std::to_string(pivotingLimit);
-  } else {
-    chain = chainOf({"pgs", "dantzig"});
-    why = std::string(toString(c)) + ", n > " + std::to_string(pivotingLimit);
-  }
+  for (const char* name : {choice.solver, choice.fallback})
+    if (registered(name)) chain += (chain.empty() ? "" : ">") + std::string(name);
   Solver* solver = chain.empty() ? nullptr : cachedChain(cache_, chain);
+  const std::string why = std::string(choice.why) + ", " + toString(c) + ", " +
+                          std::to_string(problem.size()) + " rows";
   if (!solver) {
     result.status = Status::Unsupported;
     result.message = "auto: no registered solver for this problem (" + why + ")";

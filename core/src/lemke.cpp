@@ -269,14 +269,29 @@ void LemkeSolver::run(const Problem& problem, Vector& x, Result& result) {
     result.message = "empty problem";
     return;
   }
+  if (n > maxRows) {
+    std::ostringstream os;
+    os << "lemke's dense tableau for " << n << " rows (up to " << 2 * n << " x " << 4 * n + 2
+       << " doubles) exceeds LemkeSolver::maxRows = " << maxRows << "; use dantzig or pgs";
+    result.status = Status::Unsupported;
+    result.message = os.str();
+    return;
+  }
   const DenseMatrix A = problem.toDense();
   const bool friction = problem.hasFindex();
   const bool standard = problem.classify() == ProblemClass::StandardLcp;
   const int outerLimit = friction ? std::max(1, opt.maxIterations) : 1;
   ToleranceRules rules;
   rules.pivotTolerance = opt.pivotTolerance;
-  const double t0 = nowSeconds();
-  auto stop = [&] { return outOfTime(t0); };
+  // A pivot costs O(m^2) with m >= n: the clock is read once per ~4096 / n^2 pivots (at most ~2%
+  // of the pivoting's cost).
+  const int clockEvery = std::max(1, 4096 / std::max(1, n * n));
+  int sinceClock = 0;
+  auto stop = [&] {
+    if (opt.timeBudget <= 0 || ++sinceClock < clockEvery) return false;
+    sinceClock = 0;
+    return outOfTime();
+  };
 
   Vector current = x;  // seeds the friction bounds
   for (int outer = 1; outer <= outerLimit; ++outer) {
@@ -301,13 +316,19 @@ void LemkeSolver::run(const Problem& problem, Vector& x, Result& result) {
         result.message = detail::rayMessage(s.outcome, s.rayLabel, lcp) + where;
         return;
       case LemkeEnd::PivotLimit:
-        os << "pivot limit " << maxPivots << " reached" << where << " (Options::maxPivots)";
+        os << "gave up: pivot limit " << maxPivots << " reached" << where
+           << " (Options::maxPivots; 0 means 50 m + 100 for m = " << m
+           << "): " << (outer > 1 ? "the last friction iteration's answer" : "the start")
+           << " is returned";
         result.status = Status::MaxIterations;
         result.message = os.str();
         return;
       case LemkeEnd::Stopped:
+        os << "gave up when the time budget (" << opt.timeBudget << " s) ran out after "
+           << s.outcome.pivots << " pivots" << where << ": "
+           << (outer > 1 ? "the last friction iteration's answer" : "the start") << " is returned";
         result.status = Status::TimeLimit;
-        result.message = "time budget spent" + where;
+        result.message = os.str();
         return;
     }
 

@@ -65,10 +65,12 @@ void PgsSolver::run(const Problem& problem, Vector& x, Result& result) {
     return;
   }
   const double omega = opt.relaxation;
-  detail::SweepMonitor monitor(opt, result);
+  detail::SweepMonitor monitor(opt, result, n);
   for (int sweep = 1; sweep <= opt.maxIterations; ++sweep) {
     detail::pgsSweep(problem, invDiag, omega, x);
-    if (monitor.wantsCheck(sweep) && monitor.stop(sweep, accuracy(problem, x))) return;
+    if (monitor.wantsCheck(sweep) ? monitor.stop(sweep, accuracy(problem, x))
+                                  : monitor.outOfTime(sweep))
+      return;
   }
 }
 

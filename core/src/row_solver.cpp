@@ -12,29 +12,8 @@
 
 namespace mlcp {
 
-bool acceptable(const Result& r, double acceptResidual) {
-  switch (r.status) {
-    case Status::Failed:
-    case Status::NumericalIssue:
-    case Status::InvalidInput:
-    case Status::Unsupported: return false;
-    default: break;
-  }
-  return std::isfinite(r.residual) && r.residual <= acceptResidual;
-}
-
 ProblemClass classify(const RowSystem& rows) {
   return classifyBounds(rows.lo, rows.hi, rows.findex);
-}
-
-const char* chooseSolver(ProblemClass c, int rows, double tolerance) {
-  switch (c) {
-    case ProblemClass::Empty: return "none";
-    case ProblemClass::Linear: return "ldlt";
-    default: break;
-  }
-  if (rows > kAutoPivotingRows && tolerance >= kAutoPgsTolerance) return "pgs";
-  return "dantzig";
 }
 
 // --- choice counts --------------------------------------------------------------------------
@@ -75,7 +54,7 @@ std::string ChoiceCounts::toString() const {
 // --- the row solver -------------------------------------------------------------------------
 
 // What is kept per island: its assembled-problem solvers by name, when it was last solved, and
-// how many more `auto` solves run pgs first after a rejected pivoting answer.
+// how many more `auto` solves run pgs first after a pivoting answer broke down.
 struct RowSolver::Slot {
   std::vector<std::pair<std::string, std::unique_ptr<Solver>>> solvers;
   std::uint64_t lastUse = 0;
@@ -117,7 +96,38 @@ RowSolver::RowSolver(const RowSolverSettings& settings) : settings_(settings) {
     refuse("fallback", settings_.fallback, "; auto only as the primary");
   if (!(settings_.acceptResidual >= 0))
     throw std::invalid_argument("mlcp::RowSolver: acceptResidual must be >= 0");
+  setTimeBudget(settings_.timeBudget);
+  if (!(settings_.minShare > 0 && settings_.minShare <= 1))
+    throw std::invalid_argument("mlcp::RowSolver: minShare must be in (0, 1]");
 }
+
+void RowSolver::setTimeBudget(double seconds) {
+  if (!(seconds >= 0) || !std::isfinite(seconds))
+    throw std::invalid_argument("mlcp::RowSolver: timeBudget must be finite and >= 0 seconds");
+  settings_.timeBudget = seconds;
+}
+
+double RowSolver::islandBudget(double now) {
+  const double budget = settings_.timeBudget;
+  if (!(budget > 0)) return 0;
+  if (!stepOpen_ || stepPending_) {
+    stepStart_ = now;
+    stepPending_ = false;
+  }
+  return std::max(budget - (now - stepStart_), settings_.minShare * budget);
+}
+
+namespace {
+// o bounded by `share` seconds from `start` as well (the tighter of the two budgets).
+Options withBudget(const Options& o, double share, double start) {
+  Options b = o;
+  if (share > 0 && (!(o.timeBudget > 0) || share < o.timeBudget)) {
+    b.timeBudget = share;
+    b.budgetStart = start;
+  }
+  return b;
+}
+}  // namespace
 
 RowSolver::~RowSolver() = default;
 
@@ -176,7 +186,9 @@ Result RowSolver::run(const RowSystem& rows, const std::string& name, const Opti
   if (equals(name, "pgs")) {
     rowPgs_.options() = o;
     x = start;
-    return rowPgs_.solve(rows, x);
+    Result r = rowPgs_.solve(rows, x);
+    if (r.status == Status::TimeLimit) keepStartIfBetter(rows, start, x, r, o.tolerance);
+    return r;
   }
   // Every assembled-problem solver follows the storage (ldlt: dense or sparse LDL^T).
   const bool sparse = rows.size() > settings_.denseMaxRows;
@@ -201,6 +213,13 @@ Result RowSolver::run(const RowSystem& rows, const std::string& name, const Opti
   return solver->solveWithGuess(assembled_, start, x);
 }
 
+void RowSolver::keepStartIfBetter(const RowSystem& rows, const Vector& start, Vector& x, Result& r,
+                                  double tolerance) {
+  const Accuracy a = accuracy(start, rows.slack(start), rows.lo, rows.hi, rows.findex,
+                              rows.b.lpNorm<Eigen::Infinity>());
+  if (takeStartIfBetter(r, a, tolerance)) x = start;
+}
+
 void RowSolver::assemble(const RowSystem& rows, bool sparse) {
   rows.assemble(sparse, assembled_, assembleScratch_);
   haveAssembled_ = true;
@@ -211,6 +230,49 @@ void RowSolver::capture(const RowSystem& rows) {
   const std::string path = capturePrefix_ + "island" + std::to_string(captured_.size()) + ".json";
   io::writeProblemJson(assembled_, path);
   captured_.push_back(path);
+}
+
+// Stage 4's fallback (policy.hpp's rule): r is the primary's unacceptable answer, x its x.
+Result RowSolver::fallBack(const RowSystem& rows, const Vector& start, Vector& x, Slot& island,
+                           IslandSolve& out, Result r, double share, double t0) {
+  // Built on every rejection (a fixed-sweep pgs near the limit: every step), so without an
+  // ostringstream, whose locale set-up cost more than a small island's sweep.
+  const std::string why = out.requested + " rejected (" + toString(r.status) + ", residual " +
+                          shortNumber(r.residual) + (r.message.empty() ? "" : ": ") + r.message +
+                          ")";
+  if (!settings_.fallback.empty()) {
+    out.fellBack = true;
+    Options o = settings_.fallbackOptions;
+    if (share > 0) {
+      const double now = nowSeconds();
+      o = withBudget(o, std::max(share - (now - t0), settings_.minShare * settings_.timeBudget),
+                     now);
+    }
+    Result f = run(rows, settings_.fallback, o, start, xFallback_, island, out);
+    if (better(f, r)) {
+      f.iterations += r.iterations;
+      f.message = why + "; " + settings_.fallback + ": " + f.message;
+      r = std::move(f);
+      x.swap(xFallback_);
+      out.choice = settings_.fallback;
+    } else {
+      r.message = why + "; " + settings_.fallback + " no better (" + toString(f.status) +
+                  ", residual " + shortNumber(f.residual) + ")";
+    }
+  } else {
+    r.message = why + "; no fallback";
+  }
+  if (!std::isfinite(r.residual)) {
+    // No solver found a finite answer: the start is the engine's "no change".
+    const int n = rows.size();
+    x = start.allFinite() ? start : Vector::Zero(n);
+    r.message += "; start kept";
+    applyAccuracy(
+        r,
+        accuracy(x, rows.slack(x), rows.lo, rows.hi, rows.findex, rows.b.lpNorm<Eigen::Infinity>()),
+        settings_.options.tolerance);
+  }
+  return r;
 }
 
 IslandSolve RowSolver::solve(const RowSystem& rows, const Vector& start, Vector& x,
@@ -251,57 +313,30 @@ IslandSolve RowSolver::solveScreened(const RowSystem& rows, const Vector& start,
   }
   if (!capturePrefix_.empty()) capture(rows);
 
+  const double share = islandBudget(t0);
   const bool autoChoice = equals(settings_.solver, "auto");
-  out.requested = autoChoice ? chooseSolver(out.problemClass, n, settings_.options.tolerance)
-                             : settings_.solver;
+  const Policy& policy = settings_.policy;
   Slot& island = slot(key);
-  if (autoChoice && island.pgsFirst > 0 && equals(out.requested, "dantzig")) {
-    --island.pgsFirst;
-    out.requested = "pgs";
+  if (autoChoice) {
+    const bool spent = share > 0 && share <= settings_.minShare * settings_.timeBudget;
+    const Choice c = policy.choose(out.problemClass, n, settings_.options.tolerance, true, spent);
+    out.requested = c.solver;
+    if (island.pgsFirst > 0 && !equals(out.requested, "ldlt") && !equals(out.requested, "pgs")) {
+      --island.pgsFirst;
+      out.requested = "pgs";
+    }
+  } else {
+    out.requested = settings_.solver;
   }
-  Result r = run(rows, out.requested, settings_.options, start, x, island, out);
+  Result r =
+      run(rows, out.requested, withBudget(settings_.options, share, t0), start, x, island, out);
   if (r.status == Status::InvalidInput || r.status == Status::Unsupported) x = start;
   out.choice = out.requested;
   if (!acceptable(r, settings_.acceptResidual)) {
-    // A near miss (a finite answer within kAutoNearMiss x the limit, e.g. friction passes ran
-    // out) keeps dantzig for the next solve; a breakdown or a far miss sends the island to pgs.
-    const bool nearMiss = r.status != Status::Failed && r.status != Status::NumericalIssue &&
-                          r.residual <= kAutoNearMiss * settings_.acceptResidual;
-    if (autoChoice && !nearMiss && equals(out.requested, "dantzig"))
-      island.pgsFirst = kAutoPgsAfterRejection;
-    // Built on every rejection (a fixed-sweep pgs near the limit: every step), so without an
-    // ostringstream, whose locale set-up cost more than a small island's sweep.
-    const std::string why = out.requested + " rejected (" + toString(r.status) + ", residual " +
-                            shortNumber(r.residual) + (r.message.empty() ? "" : ": ") + r.message +
-                            ")";
-    if (!settings_.fallback.empty()) {
-      out.fellBack = true;
-      Result f =
-          run(rows, settings_.fallback, settings_.fallbackOptions, start, xFallback_, island, out);
-      const bool usable = f.status != Status::InvalidInput && f.status != Status::Unsupported &&
-                          std::isfinite(f.residual);
-      if (usable && !(std::isfinite(r.residual) && r.residual <= f.residual)) {
-        f.iterations += r.iterations;
-        f.message = why + "; " + settings_.fallback + ": " + f.message;
-        r = std::move(f);
-        x.swap(xFallback_);
-        out.choice = settings_.fallback;
-      } else {
-        r.message = why + "; " + settings_.fallback + " no better (" + toString(f.status) +
-                    ", residual " + std::to_string(f.residual) + ")";
-      }
-    } else {
-      r.message = why + "; no fallback";
-    }
-    if (!std::isfinite(r.residual)) {
-      // Nothing usable: the start is the engine's "no change".
-      x = start.allFinite() ? start : Vector::Zero(n);
-      r.message += "; start kept";
-      applyAccuracy(r,
-                    accuracy(x, rows.slack(x), rows.lo, rows.hi, rows.findex,
-                             rows.b.lpNorm<Eigen::Infinity>()),
-                    settings_.options.tolerance);
-    }
+    if (autoChoice && !equals(out.requested, "pgs") && !equals(out.requested, "ldlt") &&
+        policy.demotes(r, settings_.acceptResidual))
+      island.pgsFirst = policy.pgsAfterBreakdown;
+    r = fallBack(rows, start, x, island, out, std::move(r), share, t0);
   }
   out.accepted = acceptable(r, settings_.acceptResidual);
   r.solver = out.choice;

@@ -380,7 +380,7 @@ Result RowPgs::iterate(Vector& x, double bNorm, double t0) {
     last = packedAccuracy(x, bNorm);
     lastValid = true;
   };
-  detail::SweepMonitor monitor(opt, result);
+  detail::SweepMonitor monitor(opt, result, n);
   if (n == 0) {
     result.status = Status::Converged;
     result.message = "empty problem";
@@ -388,7 +388,10 @@ Result RowPgs::iterate(Vector& x, double bNorm, double t0) {
   for (int sweep = 1; n > 0 && sweep <= opt.maxIterations; ++sweep) {
     sweepOnce(x.data());
     lastValid = false;
-    if (!monitor.wantsCheck(sweep)) continue;
+    if (!monitor.wantsCheck(sweep)) {
+      if (monitor.outOfTime(sweep)) break;
+      continue;
+    }
     check();
     if (monitor.stop(sweep, last)) break;
   }

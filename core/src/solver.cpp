@@ -1,7 +1,9 @@
 #include "mlcp/solver.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <limits>
 #include <sstream>
 
 #include "mlcp/residual.hpp"
@@ -26,8 +28,13 @@ double nowSeconds() {
   return std::chrono::duration<double>(Clock::now().time_since_epoch()).count();
 }
 
-bool Solver::outOfTime(double startSeconds) const {
-  return options_.timeBudget > 0 && nowSeconds() - startSeconds > options_.timeBudget;
+double budgetDeadline(const Options& o) {
+  if (!(o.timeBudget > 0)) return std::numeric_limits<double>::infinity();
+  return (o.budgetStart > 0 ? o.budgetStart : nowSeconds()) + o.timeBudget;
+}
+
+bool Solver::outOfTime() const {
+  return options_.timeBudget > 0 && nowSeconds() > options_.budgetStart + options_.timeBudget;
 }
 
 void applyAccuracy(Result& r, const Accuracy& a, double tolerance) {
@@ -58,7 +65,7 @@ Result Solver::solve(const Problem& problem, Vector& x) {
     start_ = x;
   else
     start_.setZero(problem.b.size());
-  return runChecked(problem, x);
+  return runChecked(problem, x, useGuess ? &x : nullptr);
 }
 
 Result Solver::solveWithGuess(const Problem& problem, const Vector& guess, Vector& x) {
@@ -79,10 +86,34 @@ Result Solver::solveWithGuess(const Problem& problem, const Vector& guess, Vecto
     return r;
   }
   start_ = guess;
-  return runChecked(problem, x);
+  return runChecked(problem, x, &guess);
 }
 
-Result Solver::runChecked(const Problem& problem, Vector& x) {
+void Solver::keepStartIfBetter(const Problem& problem, const Vector* start, Result& r) {
+  Vector slack = problem.b;
+  Accuracy a;
+  if (start) {
+    slack.noalias() +=
+        problem.isSparse() ? Vector(problem.sparseA() * *start) : Vector(problem.denseA() * *start);
+    a = accuracy(problem, *start, slack);
+  } else {
+    a = accuracy(problem, Vector::Zero(problem.size()), slack);
+  }
+  if (!takeStartIfBetter(r, a, options_.tolerance)) return;
+  if (start)
+    start_ = *start;
+  else
+    start_.setZero(problem.size());
+}
+
+bool takeStartIfBetter(Result& r, const Accuracy& start, double tolerance) {
+  if (!(start.residual < r.residual) && std::isfinite(r.residual)) return false;
+  applyAccuracy(r, start, tolerance);
+  r.message += "; the start's residual is lower: start returned";
+  return true;
+}
+
+Result Solver::runChecked(const Problem& problem, Vector& x, const Vector* start) {
   const double t0 = timed_ ? nowSeconds() : 0.0;
   auto elapsed = [&] { return timed_ ? nowSeconds() - t0 : 0.0; };
   Result r;
@@ -94,6 +125,15 @@ Result Solver::runChecked(const Problem& problem, Vector& x) {
   }
   r.status = Status::Failed;
   r.solver = name();
+  // Every stage of the method counts the budget from the same start.
+  struct BudgetStart {
+    Options& o;
+    bool set;
+    ~BudgetStart() {
+      if (set) o.budgetStart = 0;
+    }
+  } budget{options_, options_.timeBudget > 0 && !(options_.budgetStart > 0)};
+  if (budget.set) options_.budgetStart = t0 > 0 ? t0 : nowSeconds();
   run(problem, start_, r);
   if (r.status == Status::InvalidInput || r.status == Status::Unsupported) {
     r.seconds = elapsed();
@@ -110,6 +150,7 @@ Result Solver::runChecked(const Problem& problem, Vector& x) {
   slack_ += problem.b;
   applyAccuracy(r, checkedAccuracy(problem, start_, slack_, options_.tolerance),
                 options_.tolerance);
+  if (r.status == Status::TimeLimit) keepStartIfBetter(problem, start, r);
   x.swap(start_);
   r.seconds = elapsed();
   return r;

@@ -45,6 +45,7 @@ Settings fixedSweepPgs(int sweeps) {
   s.options = mlcp::Options();  // core's: tolerance 1e-10 (not reached), checked every sweep
   s.options.maxIterations = sweeps;
   s.acceptResidual = INFINITY;
+  s.timeBudget = 0;  // paths compared bit for bit: no wall-clock cut
   return s;
 }
 
@@ -52,6 +53,7 @@ Settings stockLike(const std::string& solver) {
   Settings s;
   s.solver = solver;
   s.cfm = mlcp::bullet::CfmModel::StockMlcp;
+  s.timeBudget = 0;  // compared with stock step by step: no wall-clock cut
   return s;
 }
 

@@ -9,6 +9,8 @@ check solve-help 0 'lemke|pgs' -- "$mlcp" solve --help
 check spd 0 'converged' -- "$mlcp" solve "$data/spd.json" --solver pgs --tol 1e-9
 check boxed 0 'converged' -- "$mlcp" solve "$data/boxed.json" --solver pgs --tol 1e-9
 check findex 0 'converged' -- "$mlcp" solve "$data/findex.json" --solver pgs --tol 1e-9
+check time-budget 0 'converged' -- "$mlcp" solve "$data/spd.json" --solver auto --time-budget 0.5
+check time-budget-bad 2 'not in range' -- "$mlcp" solve "$data/spd.json" --solver pgs --time-budget -1
 check siconos 0 'converged' -- "$mlcp" solve "$siconos/lcp/lcp_mmc.dat" --solver pgs --tol 1e-9
 check seed-pgs-refuses 1 'positive diagonal' -- "$mlcp" solve "$data/seed_lemke.json" --solver pgs
 check too-few-iterations 1 'max-iterations' -- "$mlcp" solve "$siconos/lcp/lcp_mmc.dat" --solver pgs --max-iter 3

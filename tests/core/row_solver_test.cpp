@@ -88,15 +88,6 @@ TEST(RowSolver, ClassifiesRowsByTheirBounds) {
   EXPECT_EQ(classify(limited), ProblemClass::Boxed);
 }
 
-TEST(RowSolver, ChoosesByClassSizeAndTolerance) {
-  EXPECT_STREQ(chooseSolver(ProblemClass::Empty, 0, 1e-6), "none");
-  EXPECT_STREQ(chooseSolver(ProblemClass::Linear, 5000, 1e-6), "ldlt");
-  EXPECT_STREQ(chooseSolver(ProblemClass::Findex, 12, 1e-6), "dantzig");
-  EXPECT_STREQ(chooseSolver(ProblemClass::StandardLcp, kAutoPivotingRows, 1e-3), "dantzig");
-  EXPECT_STREQ(chooseSolver(ProblemClass::Findex, kAutoPivotingRows + 1, kAutoPgsTolerance), "pgs");
-  EXPECT_STREQ(chooseSolver(ProblemClass::Findex, kAutoPivotingRows + 1, 1e-6), "dantzig");
-}
-
 TEST(RowSolver, AutoSolvesEachClassWithItsChoiceAndReportsIt) {
   RowSolverSettings settings;  // auto
   settings.options.tolerance = 1e-10;
@@ -209,7 +200,7 @@ TEST(RowSolver, AnAnswerAboveTheLimitFallsBackWhateverTheSolver) {
   const IslandSolve s = solver.solve(rows, Vector::Zero(rows.size()), x);
   EXPECT_TRUE(s.fellBack);
   EXPECT_EQ(s.choice, "dantzig");
-  EXPECT_LE(rowResidual(rows, x), 1e-9);
+  EXPECT_LE(rowResidual(rows, x), 1e-9) << s.result.residual << " " << s.result.message;
 
   settings.acceptResidual = kInf;  // any finite answer: no fallback
   RowSolver lenient(settings);

@@ -178,5 +178,31 @@ TEST(OdeEdge, CInterface) {
   mlcp_ode_stepper_destroy(stepper);
 }
 
+TEST(OdeEdge, CTimeBudgetSetterChecksItsValueAndReachesTheRowSolver) {
+  EXPECT_EQ(mlcp_ode_set_time_budget(nullptr, 0.01), 0);
+  EXPECT_NE(std::string(mlcp_ode_last_error()).find("NULL"), std::string::npos);
+  mlcp_ode_stepper* stepper = mlcp_ode_stepper_create("auto");
+  ASSERT_NE(stepper, nullptr);
+  EXPECT_EQ(mlcp_ode_set_time_budget(stepper, -1), 0);
+  EXPECT_NE(std::string(mlcp_ode_last_error()).find("timeBudget must be finite and >= 0"),
+            std::string::npos)
+      << mlcp_ode_last_error();
+  EXPECT_EQ(mlcp_ode_set_time_budget(stepper, std::nan("")), 0);
+  EXPECT_EQ(mlcp_ode_set_time_budget(stepper, 0.25), 1);
+  EXPECT_EQ(mlcp_ode_set_time_budget(stepper, 0), 1);  // none
+  auto s = boxStack(2);
+  s->step([&](dWorldID w, dReal h) { ASSERT_EQ(mlcp_ode_stepper_step(stepper, w, h), 1); }, 0.01);
+  EXPECT_LE(mlcp_ode_stepper_last_residual(stepper), 1e-9);
+  mlcp_ode_stepper_destroy(stepper);
+  Stepper ours("auto");
+  ours.setTimeBudget(0.25);
+  EXPECT_EQ(ours.rowSolver()->settings().timeBudget, 0.25);
+  // The "ode-..." solvers have no row solver; the value is still checked.
+  Stepper stock("ode-step");
+  EXPECT_THROW(stock.setTimeBudget(-1), std::invalid_argument);
+  stock.setTimeBudget(0.01);
+  EXPECT_EQ(stock.options().timeBudget, 0.01);
+}
+
 }  // namespace
 }  // namespace mlcp::ode::test

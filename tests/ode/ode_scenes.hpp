@@ -27,6 +27,7 @@ inline StepperOptions fixedSweepPgs(int sweeps, bool keepProblems = false) {
   o.engineIterations = false;
   o.fallback = "";
   o.keepProblems = keepProblems;
+  o.timeBudget = 0;  // fixed work per step, comparable bit for bit: no wall-clock cut
   return o;
 }
 

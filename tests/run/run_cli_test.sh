@@ -39,6 +39,10 @@ for engine in bullet ode; do
     failed=$((failed + 1))
     echo "FAIL engine-iterations-$engine:"; head -4 "$tmp/$engine-fixed.csv" | sed 's/^/    /'
   fi
+  check "time-budget-$engine" 0 'stack_10 in '"$engine"' with auto: 5 steps' -- \
+    "$mlcp" run "$scenes/stack_10.json" --engine "$engine" --solver auto --steps 5 --time-budget 0.2
+  check "time-budget-bad-$engine" 2 'time-budget' -- \
+    "$mlcp" run "$scenes/stack_10.json" --engine "$engine" --steps 1 --time-budget -0.5
 done
 check stock-bullet 0 'with bullet-si: 3 steps' -- \
   "$mlcp" run "$scenes/resting_box.json" --engine bullet --solver bullet-si --steps 3 --iterations 10

@@ -32,6 +32,7 @@ struct SolverSettings {
   double tolerance = 1e-10;
   int maxIterations = 1000;
   double relaxation = 1.0;
+  double timeBudget = 0;  // seconds, 0 for none (Options::timeBudget)
 };
 void addSolverSettings(CLI::App& cmd, SolverSettings& s);
 

@@ -151,6 +151,7 @@ int runDiff(const DiffArgs& args) {
       for (int k = 0; k < 2; ++k) {
         scene::RunSettings run = scene::RunSettings::fromScene(s);
         run.solver = args.solvers[k];
+        run.timeBudget = 0;  // a diff compares solvers, not how busy the machine was
         if (!args.iterations.empty())
           run.iterations = args.iterations[std::min<std::size_t>(k, args.iterations.size() - 1)];
         auto world = makeWorld(args.engine, s, run);

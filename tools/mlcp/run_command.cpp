@@ -29,6 +29,7 @@ struct RunArgs {
   bool engineIterations = false;
   std::string fallback = "pgs";
   double fallbackResidual = -1;
+  double timeBudget = -1;  // -1: the adapters' default
   std::string csv;
   std::string trajectory;
   int capture = -1;  // -1: no capture
@@ -51,6 +52,7 @@ int runScene(const RunArgs& args) {
   run.engineIterations = args.engineIterations;
   run.fallback = args.fallback == "none" ? "" : args.fallback;
   if (args.fallbackResidual >= 0) run.fallbackResidual = args.fallbackResidual;
+  if (args.timeBudget >= 0) run.timeBudget = args.timeBudget;
   const int steps = args.steps >= 0 ? args.steps : s.settings.steps;
 
   std::unique_ptr<scene::World> world;
@@ -168,6 +170,11 @@ Runner addRunCommand(CLI::App& app) {
                   "core solver run when an answer is rejected, or none (default pgs)");
   cmd->add_option("--fallback-residual", args->fallbackResidual,
                   "scaled residual above which an answer is rejected (default 1e-3)")
+      ->check(nonNegativeNumber());
+  cmd->add_option("--time-budget", args->timeBudget,
+                  "wall-clock budget of one step's solves in seconds, 0 for none (core solvers "
+                  "only; default 0.05): islands solved after it ran out get a minimal share and "
+                  "answers stopped by it report time-limit")
       ->check(nonNegativeNumber());
   cmd->add_option("--csv", args->csv, "CSV file to write (one row per step)");
   cmd->add_option("--trajectory", args->trajectory,

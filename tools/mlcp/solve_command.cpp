@@ -45,12 +45,18 @@ void addSolverSettings(CLI::App& cmd, SolverSettings& s) {
       ->capture_default_str();
   cmd.add_option("--relaxation", s.relaxation, "SOR factor of gs/pgs, in (0, 2)")
       ->capture_default_str();
+  cmd.add_option("--time-budget", s.timeBudget,
+                 "wall-clock budget of a solve in seconds, 0 for none: when it runs out the "
+                 "best answer so far is returned with status time-limit")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
 }
 
 void applySettings(const SolverSettings& s, Options& options) {
   options.tolerance = s.tolerance;
   options.maxIterations = s.maxIterations;
   options.relaxation = s.relaxation;
+  options.timeBudget = s.timeBudget;
 }
 
 namespace {

@@ -95,6 +95,7 @@ void ConstraintSolver::openStep(int numBodies) {
   current_ = StepStats();
   records_.clear();
   builder_.newStep();
+  if (rows_) rows_->beginStep();  // the time budget is per step
   stepOpen_ = true;
   stepBodies_ = numBodies;
 }
@@ -202,6 +203,10 @@ bool ConstraintSolver::solveIslandFast(Island& island, bool split) {
   const double t0 = nowSeconds();
   pgs_.options() = rows_->options();
   pgs_.options().warmStart = true;  // as RowSolver runs it: from the start given
+  if (const double share = rows_->islandBudget(t0); share > 0) {  // the step's budget
+    pgs_.options().timeBudget = share;
+    pgs_.options().budgetStart = t0;
+  }
   const int n = static_cast<int>(island.rows.size());
   Result r = builder_.solvePgs(pgs_, island, split, x_);
   if (!pgs_.velocityChanges() || !acceptable(r, settings_.acceptResidual)) return false;

@@ -214,6 +214,13 @@ int mlcp_ode_stepper_reset_warm_start(mlcp_ode_stepper* s) {
   });
 }
 
+int mlcp_ode_set_time_budget(mlcp_ode_stepper* s, double seconds) {
+  return guarded("mlcp_ode_set_time_budget", MLCP_ODE_ERROR, [&] {
+    stepperOf(s).setTimeBudget(seconds);
+    return MLCP_ODE_OK;
+  });
+}
+
 int mlcp_ode_stepper_step(mlcp_ode_stepper* s, dWorldID world, dReal stepsize) {
   return guarded("mlcp_ode_stepper_step", MLCP_ODE_ERROR, [&] {
     Stepper& stepper = stepperOf(s);

@@ -111,6 +111,7 @@ class OdeWorld : public scene::World {
     options.warmStart = run.warmStart;
     options.fallback = run.fallback;  // the stepper never falls back from "ode-..."
     options.acceptResidual = run.fallbackResidual;
+    options.timeBudget = run.timeBudget;
     stepper_ = std::make_unique<Stepper>(stepperName, options);
     iterations_ = run.iterations;
     built_ = buildWorld(s, run);

@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <cmath>
 #include <iterator>
 #include <stdexcept>
 #include <utility>
@@ -121,10 +122,11 @@ Stepper::Stepper(const Settings& options) : impl_(std::make_unique<Impl>()) {
   // fall back.
   impl_->primary = makeMethod(options.solver, rs);
   if (!options.reference.empty()) {
-    // The reference only measures: no fallback, every answer kept.
+    // The reference only measures: no fallback, every answer kept, no budget.
     RowSolverSettings ref = rs;
     ref.fallback = "";
     ref.acceptResidual = kInf;
+    ref.timeBudget = 0;
     impl_->reference = makeMethod(options.reference, ref);
     if (impl_->reference.forwards())
       throw std::invalid_argument("mlcp::ode::Stepper: reference '" + options.reference +
@@ -144,6 +146,14 @@ const std::vector<IslandProblem>& Stepper::lastProblems() const { return impl_->
 void Stepper::resetWarmStart() { impl_->warm.clear(); }
 RowSolver* Stepper::rowSolver() { return impl_->primary.solver.get(); }
 
+void Stepper::setTimeBudget(double seconds) {
+  if (RowSolver* rows = rowSolver())
+    rows->setTimeBudget(seconds);  // checks the value
+  else if (!(seconds >= 0) || !std::isfinite(seconds))
+    throw std::invalid_argument("mlcp::ode::Stepper: timeBudget must be finite and >= 0 seconds");
+  impl_->options.timeBudget = seconds;
+}
+
 bool Stepper::step(dWorldID world, dReal h) {
   if (!world) throw std::invalid_argument("mlcp::ode::Stepper::step: null world");
   if (!(h > 0)) throw std::invalid_argument("mlcp::ode::Stepper::step: step size must be > 0");
@@ -157,6 +167,7 @@ bool Stepper::step(dWorldID world, dReal h) {
   }
   impl_->beginStep(world);
   ActiveScope scope(world, impl_.get());
+  if (RowSolver* rows = rowSolver()) rows->beginStep();  // the time budget is per step
   // dWorldStep's two calls, with our estimator and island stepper.
   dxWorldProcessIslandsInfo islands;
   bool ok = dxReallocateWorldProcessContext(world, islands, h, &Impl::estimateMemory) &&

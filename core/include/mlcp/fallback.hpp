@@ -1,26 +1,26 @@
-// mlcp/fallback.hpp: a verified fallback chain (registry "a>b>c") and the `auto` solver.
+// mlcp/fallback.hpp: a verified fallback chain (registry "a>b>c") and the registry's `auto`.
 //
-// FallbackSolver runs its solvers in order. Each answer is checked by the Solver base class
-// (residual recomputed, NaN/Inf caught); the first that converges is returned. Otherwise the
-// next solver starts again from the caller's start point. Result::fallbacks counts the rejected
-// attempts and Result::solver names the solver whose answer is returned; when none converges,
-// the answer with the smallest residual is returned with its own status and a message listing
-// every attempt. Options set on the chain are passed to every member.
+// FallbackSolver runs its solvers in order under the fallback rule of policy.hpp: each answer
+// is checked by the Solver base class (residual recomputed, NaN/Inf caught); the first
+// acceptable one (here: converged, residual <= Options::tolerance) is returned, otherwise the
+// next solver starts again from the caller's start point, and when none is acceptable the best
+// answer any of them found (lowest finite residual) is returned with its own status and a
+// message listing every attempt. Result::fallbacks counts the answers passed over and
+// Result::solver names the solver whose answer is returned. Options set on the chain are passed
+// to every member; a time budget is the chain's, shared by its members (each does at least one
+// bounded chunk of work before it reads the clock, so a late member still improves on the
+// start).
 //
-// AutoSolver models no more than the problem needs: it classifies the problem and runs
-// a chain chosen for that class and size (rules in fallback.cpp, reported in Result::message):
-//   empty                 -> nothing to do
-//   linear (all equality) -> ldlt > pgs
-//   zero/negative A_ii    -> lemke > dantzig   (projected Gauss-Seidel cannot divide by it)
-//   n <= pivotingLimit    -> dantzig > lemke > pgs
-//   larger                -> pgs > dantzig
-// Solvers missing from the registry are skipped.
+// AutoSolver classifies the problem, asks Policy (policy.hpp) for a solver and its fallback and
+// runs that two-member chain. The choice and its reason open Result::message. Solvers missing
+// from the registry are skipped.
 #pragma once
 
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "mlcp/policy.hpp"
 #include "mlcp/solver.hpp"
 
 namespace mlcp {
@@ -42,8 +42,8 @@ class FallbackSolver : public Solver {
 class AutoSolver : public Solver {
  public:
   const char* name() const override { return "auto"; }
-  // Largest problem handed to a pivoting method first. Default 600 rows.
-  int pivotingLimit = 600;
+  // The rules; change them between solves (e.g. policy.largeIslandSolver = "newton").
+  Policy policy;
 
  protected:
   void run(const Problem& problem, Vector& x, Result& result) override;

@@ -30,6 +30,9 @@
 // on a 33-row joint chain. Dense wins up to 60-100 rows on a thin band, further on a wider one
 // and always on a full matrix, so RowSolver's 64-row limit sits at the crossover
 // (docs/benchmarks.md, docs/decisions.md).
+//
+// Options::timeBudget does not stop it: the answer is one factorization and two triangular
+// solves, with no iterate before they end (their cost is fixed by the pattern, not by the data).
 #pragma once
 
 #include <memory>

@@ -25,10 +25,14 @@
 // feasible, and ray termination then proves infeasibility. For other matrices (bimatrix games,
 // general indefinite M) it may end on a ray although a solution exists. Murty's examples take
 // 2^n - 1 pivots; the pivot limit is Options::maxPivots, 0 meaning 50 m + 100 for an LCP of
-// size m (Status::MaxIterations when reached).
+// size m (Status::MaxIterations when reached), and Options::timeBudget stops it between pivots
+// (Status::TimeLimit); either way the message says so and the start (or, with friction, the
+// last outer iteration's answer) is returned, never a half-pivoted tableau.
 //
 // Cost. Dense tableau of m x (2m + 2) doubles (A is converted with Problem::toDense()); each
-// pivot costs O(m^2), a solve typically O(m) pivots. Meant for small or medium dense problems.
+// pivot costs O(m^2), a solve typically O(m) pivots. Meant for small or medium dense problems:
+// problems above LemkeSolver::maxRows rows are refused (Status::Unsupported, x untouched)
+// rather than allocating a tableau of gigabytes.
 //
 // Accuracy. The tableau is pivoted for complementarity, not for stability, so its final values
 // carry round-off. The solver therefore re-solves the final active set in the original
@@ -77,6 +81,9 @@ namespace mlcp {
 class LemkeSolver : public Solver {
  public:
   const char* name() const override { return "lemke"; }
+  // Largest problem accepted, in rows: 2000 rows make a tableau of up to 4000 x 8002 doubles
+  // (256 MB). Default 2000.
+  int maxRows = 2000;
 
  protected:
   void run(const Problem& problem, Vector& x, Result& result) override;

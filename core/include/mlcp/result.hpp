@@ -42,8 +42,17 @@ struct Options {
   // Start from the x passed to solve() instead of from zero (methods that can use it). Default
   // false.
   bool warmStart = false;
-  // Wall-clock budget in seconds; 0 means none. Checked between iterations. Default 0.
+  // Wall-clock budget in seconds; 0 means none. Every solver checks it between its steps
+  // (sweeps, pivots, block steps) at a bounded cost: the clock is read about once per ~1000
+  // row updates or pivot-column operations, so a check costs a few percent of the work at most
+  // and the overshoot is about that much work. When it runs out the solver returns its best
+  // iterate, never worse than its start (Solver keeps the start otherwise), with
+  // Status::TimeLimit. Default 0.
   double timeBudget = 0.0;
+  // The nowSeconds() value the budget counts from; 0 means the solve's own start. A caller that
+  // has read the clock already (RowSolver: the island's start, so assembly counts against the
+  // budget) passes it and spares the solver a clock read. Default 0.
+  double budgetStart = 0.0;
   // Record the residual after every iteration in Result::history (costs one residual
   // evaluation, O(nnz A), per iteration). Default false.
   bool recordHistory = false;

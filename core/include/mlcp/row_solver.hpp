@@ -1,44 +1,76 @@
 // mlcp/row_solver.hpp: the one place that solves an engine island's rows (both adapters).
 //
 //     mlcp::RowSolver solver;                      // settings: solver "auto", fallback "pgs"
+//     solver.beginStep();                          // once per engine step (the time budget's)
 //     mlcp::IslandSolve s = solver.solve(rows, start, x, islandKey);
 //     s.choice;    // "ldlt", "dantzig", "pgs", "none", ...: the solver whose answer x is
-//     s.fellBack;  // the primary's answer was rejected and the fallback ran
+//     s.fellBack;  // the primary's answer was not acceptable and the fallback ran
+//     s.accepted;  // the returned answer is acceptable (policy.hpp, rule 1)
 //
-// Stages per island (the Bullet drop-in and the ODE stepper both run exactly this):
+// What it solves. An island's rows (rows.hpp): per row two 6-wide Jacobian blocks, the bodies'
+// inverse masses, b, cfm, lo, hi, findex; the MLCP is w = A x + b with A = J M^-1 J^T +
+// diag(cfm), lo <= x <= hi and the complementarity conditions of DESIGN's canonical form.
 //
+// Stages per island (the Bullet drop-in and the ODE stepper both run exactly these):
 //  0. screen the rows one by one (RowScreen, row_screen.hpp): a degenerate row (non-finite rhs
 //     or Jacobian, no effect on any body, A_ii = 0 without cfm, empty bounds) takes x = 0 and
 //     is left out, NaN bounds become +-inf; stages 1-4 run on the rows kept, so one such row
 //     never costs the rest of its island its answer. IslandSolve::screened counts them.
-//  1. classify the rows by their bounds alone (no matrix needed; ProblemClass, problem.hpp):
-//       no rows                       -> Empty:       nothing to solve ("none");
-//       every row -inf..inf            -> Linear:      bilateral joints only;
-//       every row 0..inf               -> StandardLcp: frictionless contacts;
-//       other bounds, no findex        -> Boxed:       joints with limits/motors, mixed;
-//       friction-coupled rows (findex) -> Findex:      contacts with friction.
-//  2. choose: the requested name, or with "auto" chooseSolver() below (the rules and the
-//     measurements behind them are written there).
-//  3. solve from the caller's start: "pgs" runs RowPgs on the rows themselves (O(nnz J) per
-//     sweep, no matrix); every other name gets A = J M^-1 J^T + diag(cfm) assembled once per
-//     island, dense up to denseMaxRows rows and sparse above. Solver objects live per island
-//     key and name, so the sparse analyses of ldlt and dantzig (ordering, elimination tree) are
-//     redone only when that island's pattern changes, and RowPgs' buffers are reused.
-//  4. verify, the same rule for every solver (acceptable() below): the answer is finite, its
-//     status is not Failed, NumericalIssue, InvalidInput or Unsupported, and its residual,
-//     recomputed from the problem by residual.hpp (never the solver's claim), is <=
-//     acceptResidual. A rejected answer sends the island to the fallback solver from the same
-//     start; the better of the two answers (lower residual; the primary's on a tie) is kept.
-//     When neither is usable (NaN/Inf, or nothing solved) the start itself is returned: the
-//     engine's "no change" (Bullet: the impulses already applied; ODE: last step's forces).
+//  1. classify the rows by their bounds and findex alone (ProblemClass, problem.hpp; no matrix):
+//     Empty (no rows, answer "none"), Linear (bilateral joints only), StandardLcp (frictionless
+//     contacts), Boxed (limits, motors), Findex (contacts with friction).
+//  2. choose: the requested name, or for "auto" Policy::choose (policy.hpp) from the class, the
+//     row count, Options::tolerance and whether the step's time budget is spent; plus one rule
+//     with memory per island: after a pivoting answer broke down (Policy::demotes) the island
+//     runs pgs first for its next Policy::pgsAfterBreakdown solves, then pivoting is tried again.
+//     Engine rows with cfm = 0 on redundant friction rows (Bullet's CfmModel::Engine) are the
+//     islands that defeat pivoting; the memory keeps them from paying a failed pivoting solve
+//     every step.
+//  3. solve from the caller's start: "pgs" runs RowPgs on the rows themselves (O(nnz J) per sweep,
+//     no matrix); every other name gets A assembled once per island, dense up to denseMaxRows
+//     rows and sparse above. Solver objects live per island key and name, so the sparse analyses
+//     of ldlt and dantzig (ordering, elimination tree) are redone only when that island's
+//     pattern changes, and RowPgs' buffers are reused.
+//  4. verify and fall back, by the one fallback rule of policy.hpp: an answer is acceptable when
+//     its status is not a breakdown and its residual, recomputed from the rows by residual.hpp,
+//     is finite and <= acceptResidual; an unacceptable one sends the island to the fallback
+//     from the same start, the better of the two answers (lower finite residual, the primary's
+//     on a tie) is returned, and only when neither is finite the start (the engine's "no
+//     change": Bullet's applied impulses, ODE's last forces).
 //
-// acceptResidual, default 1e-3 (kDefaultAcceptResidual): the scaled natural-map residual is
-// ||x - clamp(x - w, lo', hi')||_inf / (1 + ||b||_inf); at 1e-3 the worst row's impulse error is
-// 0.1% of the island's largest velocity error term. Warm-started pgs with the scenes' 50 sweeps
-// ends at 1e-9..3e-2 on the scenes (measured with `mlcp run`): a tighter default (the Bullet
-// adapter had 1e-6) re-solved most pyramid and stack steps with the fallback's 1000 sweeps, a
-// looser one accepted pgs answers whose stacks visibly sink. +inf accepts any finite answer
+// The time budget. timeBudget is the wall-clock time of one engine step's solves (beginStep()
+// opens a step; without it each solve is a step of its own). An island gets what is left of the
+// step's budget when it starts, at least minShare * timeBudget; that share bounds its primary
+// (Options::timeBudget, counted from the island's start so assembly counts) and what is left of
+// it, again at least the minimal share, bounds the fallback. Once the step's budget is spent,
+// large contact islands go to pgs (Policy), which improves on any start within any share; small
+// ones keep dantzig, which ends in microseconds. A solver stopped by the budget returns its best
+// iterate, never worse than its start (solver.hpp), with Status::TimeLimit and its recomputed
+// residual. The budget therefore bounds a step by about timeBudget + (islands after the budget
+// ran out) * minShare * timeBudget, plus what cannot be interrupted: assembly and one
+// factorization (ldlt's, a dantzig block step's).
+//
+// Invariants: x always has rows.size() finite entries on return; IslandSolve::result.residual is
+// the residual of that x; the settings' names are checked at construction.
+//
+// Cost over the chosen solver's: classification O(n), one clock read, the residual check O(nnz
+// J) (it doubles as the acceptance test), assembly O(nnz A) for matrix-based solvers; an
+// unacceptable answer adds the fallback's solve.
+//
+// acceptResidual, default kDefaultAcceptResidual (1e-3): the scaled natural-map residual
+// ||x - clamp(x - w, lo', hi')||_inf / (1 + ||b||_inf) bounds the worst row's impulse error by
+// 0.1% of the island's largest velocity-error term. Tighter limits re-solve most steps of
+// warm-started fixed-sweep pgs with the fallback; looser ones accept pgs answers under which
+// stacks visibly sink (docs/benchmarks.md, "Acceptance limit"). +inf accepts any finite answer
 // (SI-like fixed-sweep pgs).
+//
+// timeBudget, default kDefaultTimeBudget (0.05 s): three frames of a 60 Hz program. A drop-in
+// whose island cannot be solved exactly in time (dantzig on ODE's 210-box pyramid: ~4 s a step
+// unbounded) then runs at ~20 steps a second with the best answer found instead of hanging for
+// seconds or minutes, while the exact answers of the scenes up to 55 boxes (ODE: ~11 ms a step)
+// and every joint island (microseconds) stay untouched; a tighter default cut pyramid_55's
+// dantzig solves on a loaded machine (docs/benchmarks.md, "Time budget"). 0 disables it, for
+// reproducible runs: an answer cut by a budget depends on the machine's speed and load.
 #pragma once
 
 #include <cstdint>
@@ -48,6 +80,7 @@
 #include <utility>
 #include <vector>
 
+#include "mlcp/policy.hpp"
 #include "mlcp/problem.hpp"
 #include "mlcp/result.hpp"
 #include "mlcp/row_screen.hpp"
@@ -58,6 +91,10 @@ namespace mlcp {
 
 // The acceptance limit both adapters use by default (see above). Dimensionless.
 inline constexpr double kDefaultAcceptResidual = 1e-3;
+// The per-step time budget both adapters use by default (see above), in seconds.
+inline constexpr double kDefaultTimeBudget = 0.05;
+// The smallest share of timeBudget an island's solve gets (see above). Dimensionless.
+inline constexpr double kDefaultMinShare = 0.05;
 // Largest island assembled dense for matrix-based solvers, in rows. Default 64.
 inline constexpr int kDefaultDenseMaxRows = 64;
 // The scaled natural-map residual an island's solve aims at by default, dimensionless: 1e-6 is
@@ -90,9 +127,11 @@ inline Options fallbackIslandOptions() {
 // The island solver's settings, the one shape both adapters' settings derive from
 // (mlcp::bullet::Settings, mlcp::ode::Settings).
 struct RowSolverSettings {
-  // A registry name (mlcp::solverNames(), "a>b" chains included), "auto" (chooseSolver per
+  // A registry name (mlcp::solverNames(), "a>b" chains included), "auto" (policy below, per
   // island) or "pgs" (RowPgs on the rows). Default "auto".
   std::string solver = "auto";
+  // The rules of "auto" (policy.hpp). Default: Policy's defaults.
+  Policy policy;
   // Options of the primary (tolerance, iteration and pivot limits, ...). warmStart is ignored:
   // every solve starts from the caller's start. Default islandOptions(): tolerance 1e-6
   // (kDefaultIslandTolerance), core defaults otherwise.
@@ -107,6 +146,12 @@ struct RowSolverSettings {
   // Largest accepted scaled natural-map residual (dimensionless); +inf accepts any finite
   // answer. Default kDefaultAcceptResidual (1e-3).
   double acceptResidual = kDefaultAcceptResidual;
+  // Wall-clock budget of one engine step's solves, in seconds (see above); 0 for none. Options'
+  // own timeBudget, when set, still bounds each solve. Default kDefaultTimeBudget (0.05 s).
+  double timeBudget = kDefaultTimeBudget;
+  // The smallest share of timeBudget an island's solve (and its fallback) gets, in (0, 1].
+  // Default kDefaultMinShare (0.05: 2.5 ms of a 50 ms budget, ~50 pgs sweeps of 1000 rows).
+  double minShare = kDefaultMinShare;
   // Islands with at most this many rows give matrix-based solvers a dense A, larger ones a
   // sparse A (rows); ldlt then factors dense or sparse LDL^T accordingly. Default
   // kDefaultDenseMaxRows (64).
@@ -132,65 +177,8 @@ inline void useEngineIterations(Options& options, int iterations) {
   options.maxIterations = options.checkEvery = iterations < 1 ? 1 : iterations;
 }
 
-// The verification every answer passes (see stage 4 above): finite residual <= acceptResidual
-// and a status other than Failed, NumericalIssue, InvalidInput, Unsupported.
-bool acceptable(const Result& r, double acceptResidual);
-
 // ProblemClass of the rows from their bounds and findex alone (Problem::classify's rules).
 ProblemClass classify(const RowSystem& rows);
-
-// `auto`'s choice for an island of this class and size at this requested tolerance (scaled
-// residual):
-//   Empty                       -> "none"
-//   Linear                      -> "ldlt"     one LDL^T solve: exact (dense up to denseMaxRows
-//                                             rows, sparse above with its analysis reused)
-//   StandardLcp, Boxed, Findex  -> "dantzig"  exact pivoting answer (residual ~1e-12)
-//     except rows > kAutoPivotingRows at tolerance >= kAutoPgsTolerance -> "pgs"
-// and RowSolver adds one rule with memory: an island whose dantzig answer broke down (failed,
-// numerical issue, NaN) or missed the acceptance limit by more than kAutoNearMiss times runs pgs
-// first for its next kAutoPgsAfterRejection solves (then dantzig is tried again); a near miss
-// (friction passes ran out at 2e-3 against 1e-3, say) goes to the fallback for that solve only.
-// Measured with `mlcp run SCENE --engine E --solver S --steps 100` (scene defaults: 50
-// iterations, tolerance 1e-6, fallback pgs, acceptResidual 1e-3), mean solver ms per step and
-// worst residual:
-//   pendulum_chain (20 hinges, Linear)  ODE  ldlt 0.016 ms 5e-14 | dantzig 0.017 | pgs 1.35 ms 1e-1
-//                                       Bullet ldlt 0.017 ms 5e-14 | dantzig 0.059 | pgs 0.66 ms
-//   mass_ratio_stack (Findex)           ODE  dantzig 0.14 ms 1e-12 | pgs 4.5 ms 0.45
-//   pyramid_15 (Findex, ~280 rows)      ODE  dantzig 4.6 ms 5e-15 | pgs 20 ms 1e-3
-//                                       Bullet (friction rows with their contact's CFM,
-//                                       bullet::CfmModel::Regularized) dantzig 3.1 ms 8e-7 |
-//                                       pgs 0.74 ms 9e-3 (100 sweeps)
-//   hinge_motor_limits (Boxed)          both dantzig 0.003-0.04 ms 1e-15 | pgs 0.004-0.008 1e-6
-// Tiny joint islands against ODE's own solver over the same span (`mlcp run --solver ode-world`:
-// the same assembly into a kept problem, dxSolveLCP, the same residual check), solver time per
-// step, medians of 300 steps (shared machine: ranges of repeated runs), and instructions per
-// solve (callgrind, the adapter's whole island solve):
-//   pendulum_chain (33 rows, ldlt)     auto 5.0-5.2 us, 55k | ode-world 5.8-6.2 us, 77k
-//     (ldlt's dense envelope LDL^T (ldlt.hpp) ~25k, assembly 15k, validation and check ~8k;
-//     before it: sparse LDL^T, 9.7 us and 99.8k)
-//   hinge_motor_limits (6 rows, dantzig) auto 0.61 us, 5.8k | ode-world 0.68 us, 6.7k
-//     (means of 300 steps, report; dantzig's tiny-island path, dantzig_small.hpp, ~1.7k;
-//     assembly 1.4k; validation and the residual check ~1k; ODE's dxSolveLCP alone 2.8k.
-//     Before that path: 1.22 us, 10.4k.) The first step is cold and takes the same path from
-//     the cold guess (~19 us against ode-world's 13-17 us, mostly code fetched from memory).
-// Bullet, the same scenes against bullet-mlcp-dantzig (report means): pendulum 8.9 vs 20 us,
-// hinge 1.4 vs 2.3 us (Bullet hands the hinge's rows over with a zero start: the cold guess).
-// The memory rule dates from Bullet's zero-CFM friction rows (bullet::CfmModel::Engine), on which
-// dantzig failed 29 of 30 steps of pyramid_15 (70 ms, residual 0.12): with the rule auto went
-// from 47 ms to 8.6 ms there. With the default Regularized model dantzig's answers are accepted
-// and the rule does not fire on the report's scenes (it did, on one near miss of Bullet's
-// pyramid_15, sending 30 solves to pgs: worst residual 2e-3 instead of dantzig's, hence the
-// near-miss exception); it stays as the guard for islands that defeat pivoting. Numbers of the main
-// job's report: README, "Each island gets what it needs".
-const char* chooseSolver(ProblemClass c, int rows, double tolerance);
-// Largest contact island handed to dantzig whatever the tolerance (rows). See chooseSolver.
-inline constexpr int kAutoPivotingRows = 600;
-// Loosest requested tolerance at which large contact islands go to pgs. See chooseSolver.
-inline constexpr double kAutoPgsTolerance = 1e-4;
-// Solves of an island that run pgs first after its dantzig answer was rejected. Default 30.
-inline constexpr int kAutoPgsAfterRejection = 30;
-// A rejected dantzig answer within this factor of acceptResidual is a near miss (no memory).
-inline constexpr double kAutoNearMiss = 10;
 
 // What one island's solve gives back.
 struct IslandSolve {
@@ -225,7 +213,7 @@ class ChoiceCounts {
 class RowSolver {
  public:
   // Throws std::invalid_argument naming the known solvers for an unknown solver or fallback
-  // name, and for a negative or NaN acceptResidual.
+  // name, and for a negative or NaN acceptResidual, timeBudget or minShare outside (0, 1].
   explicit RowSolver(const RowSolverSettings& settings = RowSolverSettings());
   ~RowSolver();
   RowSolver(const RowSolver&) = delete;
@@ -235,6 +223,20 @@ class RowSolver {
   // The primary's and fallback's options may be changed between solves (names may not).
   Options& options() { return settings_.options; }
   Options& fallbackOptions() { return settings_.fallbackOptions; }
+  // Changes the per-step budget between solves (seconds, 0 for none); throws
+  // std::invalid_argument for a negative or non-finite value.
+  void setTimeBudget(double seconds);
+
+  // Opens an engine step: the budget's clock starts at the next solve() and runs over every
+  // solve until the next beginStep(). Without it every solve is a step of its own.
+  void beginStep() {
+    stepOpen_ = true;
+    stepPending_ = true;
+  }
+  // The share of the step's budget an island starting at `now` (nowSeconds()) gets, in seconds
+  // (see above); 0 without a budget. For callers that solve an island themselves (Bullet's
+  // packed pgs path) under the same budget.
+  double islandBudget(double now);
 
   // Solves the island's rows from `start` (size rows.size(), used as given: pass zeros for a
   // cold start) into x. islandKey identifies the island across steps (any stable number, e.g.
@@ -264,7 +266,12 @@ class RowSolver {
   Solver* assembledSolver(Slot& island, const std::string& name);
   Result run(const RowSystem& rows, const std::string& name, const Options& options,
              const Vector& start, Vector& x, Slot& island, IslandSolve& report);
+  Result fallBack(const RowSystem& rows, const Vector& start, Vector& x, Slot& island,
+                  IslandSolve& out, Result r, double share, double t0);
   void assemble(const RowSystem& rows, bool sparse);
+  // A time-limited answer x is replaced by the start when the start's residual is lower.
+  static void keepStartIfBetter(const RowSystem& rows, const Vector& start, Vector& x, Result& r,
+                                double tolerance);
   void capture(const RowSystem& rows);
 
   RowSolverSettings settings_;
@@ -280,6 +287,9 @@ class RowSolver {
   std::uint64_t lastKey_ = 0;  // the key of lastSlot_
   Slot* lastSlot_ = nullptr;   // the island solved last (slots_ owns it)
   std::uint64_t calls_ = 0;
+  bool stepOpen_ = false;     // beginStep() was called: solves share a step's budget
+  bool stepPending_ = false;  // the next solve starts the step's clock
+  double stepStart_ = 0;
   std::string capturePrefix_;
   std::vector<std::string> captured_;
 };

@@ -9,7 +9,9 @@
 // The base class does what every solver shares, so no algorithm can skip it: it validates the
 // problem (InvalidInput leaves x untouched), times the solve, and recomputes the accuracy of
 // the returned x with residual.hpp. A solver that reports Converged with a residual above the
-// tolerance is downgraded to Failed; a non-finite x becomes NumericalIssue.
+// tolerance is downgraded to Failed; a non-finite x becomes NumericalIssue. A solve stopped by
+// Options::timeBudget (TimeLimit) returns its best iterate or, when that is worse than the start
+// (a pivoting method's half-pivoted x), the start itself: a budget never makes x worse.
 #pragma once
 
 #include <memory>
@@ -61,12 +63,17 @@ class Solver {
   // check are done by the caller.
   virtual void run(const Problem& problem, Vector& x, Result& result) = 0;
 
-  // For iterative methods: true when the time budget started at `start` is spent.
-  bool outOfTime(double startSeconds) const;
+  // True when Options::timeBudget is spent (reads the clock; false without a budget). During
+  // run() options().budgetStart is set whenever there is a budget, so every stage of a method
+  // counts from the same start.
+  bool outOfTime() const;
 
  private:
-  // Runs the algorithm on start_ (holding the start point) and swaps it into x.
-  Result runChecked(const Problem& problem, Vector& x);
+  // Runs the algorithm on start_ (holding the start point, *start or zeros when null) and swaps
+  // it into x.
+  Result runChecked(const Problem& problem, Vector& x, const Vector* start);
+  // TimeLimit: the start replaces the iterate when its residual is lower.
+  void keepStartIfBetter(const Problem& problem, const Vector* start, Result& r);
   Options options_;
   bool timed_ = true;
   // The iterate and w = A x + b of the accuracy check, kept so repeated solves of one size do
@@ -80,7 +87,16 @@ struct Accuracy;
 // Converged; a Converged claim above the tolerance becomes Failed.
 void applyAccuracy(Result& r, const Accuracy& a, double tolerance);
 
+// A TimeLimit answer is never worse than its start: when the start's accuracy is better (a lower
+// residual, or r's is not finite) r takes it (with a note in the message) and true is returned;
+// the caller then returns the start as x.
+bool takeStartIfBetter(Result& r, const Accuracy& start, double tolerance);
+
 // Seconds on a monotonic clock (for timing and time budgets).
 double nowSeconds();
+
+// The nowSeconds() value at which o.timeBudget runs out: budgetStart + timeBudget (the clock is
+// read when budgetStart is 0), +inf without a budget.
+double budgetDeadline(const Options& o);
 
 }  // namespace mlcp

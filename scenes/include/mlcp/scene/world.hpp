@@ -67,6 +67,9 @@ struct RunSettings {
   // adapters' default for a drop-in; the loaders give the engine the same count). Default
   // false: a scene run sweeps toward `tolerance` within `iterations`.
   bool engineIterations = false;
+  // Wall-clock budget of one step's solves in seconds, 0 for none (core solvers only;
+  // RowSolverSettings::timeBudget). Default the adapters' kDefaultTimeBudget (0.05 s).
+  double timeBudget = kDefaultTimeBudget;
 
   static RunSettings fromScene(const Scene& scene);
 };

@@ -87,6 +87,11 @@ int mlcp_ode_stepper_set_contact_match_distance(mlcp_ode_stepper* stepper, doubl
 /* Forget the warm-start cache (e.g. after teleporting bodies). */
 int mlcp_ode_stepper_reset_warm_start(mlcp_ode_stepper* stepper);
 
+/* Wall-clock budget of one step's island solves in seconds, 0 for none (default 0.05; see
+ * mlcp/row_solver.hpp): when it runs out a solve returns its best answer so far, never worse
+ * than its start. MLCP_ODE_ERROR for a negative or non-finite value (unchanged then). */
+int mlcp_ode_set_time_budget(mlcp_ode_stepper* stepper, double seconds);
+
 /* Like dWorldStep: MLCP_ODE_OK, or MLCP_ODE_ERROR when ODE could not allocate working memory,
  * the arguments are invalid (NULL world, stepsize <= 0) or the step failed (the message says
  * why; the world may then be part-way through the step). */

@@ -173,6 +173,9 @@ class Stepper {
   mlcp::Options& solverOptions();
   // The fallback's options (Settings::fallbackOptions), adjustable between steps.
   mlcp::Options& fallbackOptions();
+  // StepperOptions::timeBudget, adjustable between steps (seconds, finite, >= 0; throws
+  // std::invalid_argument otherwise). The "ode-..." solvers ignore it.
+  void setTimeBudget(double seconds);
   // Statistics of the last step (cleared at the start of each step).
   const StepStats& lastStep() const;
   // The islands with rows of the last step, in step order, when Settings::keepProblems
