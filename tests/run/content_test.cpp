@@ -95,7 +95,16 @@ constexpr const char* kPgsLimit =
 constexpr const char* kSixDof =
     "degenerate rows from 6-dof springs with infinite limits: with the +-1e30 limit dantzig "
     "reports converged (residual 1e-33) on an answer that holds nothing, and the boxes fall";
+constexpr const char* kFallbackCap =
+    "bounded fallback: the island's answer misses the 1e-3 acceptance and the pgs fallback, "
+    "bounded at 100 sweeps so that a drop-in never pays 1000 by surprise, does not reach it "
+    "either (an exact large-island method would)";
 const KnownFailure kKnownFailures[] = {
+    {"ragdoll_pile", "bullet", "dantzig", kFallbackCap, false},
+    {"ragdoll_pile", "bullet", "auto", kFallbackCap, false},
+    {"vehicle", "ode", "pgs", kFallbackCap, false},
+    {"vehicle", "ode", "ldlt", kFallbackCap, false},
+    {"hull_stack", "ode", "pgs", kFallbackCap, false},
     {"ragdoll_pile", "bullet", "pgs", kPgsLimit, false},
     {"ragdoll_pile", "ode", "pgs", kPgsLimit, false},
     {"plank_bridge", "bullet", "pgs", kBridge, false},

@@ -95,7 +95,9 @@
 // Threads. solveGroup, prepareSolve and allSolved hold a mutex: one solver called from several
 // threads at once (a btDiscreteDynamicsWorldMt under a threaded task scheduler, when one
 // instance fills both of its slots) solves one group at a time, correctly. For groups solved in
-// parallel give each thread its own instance: SolverPool.
+// parallel give each thread its own instance: SolverPool. The warm-start memory (last answers
+// per manifold point) is the instance's: two worlds stepped at once through one instance start
+// from each other's answers, so give each world its own solver.
 #pragma once
 
 #include <BulletDynamics/ConstraintSolver/btSequentialImpulseConstraintSolver.h>
