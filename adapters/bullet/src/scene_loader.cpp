@@ -115,7 +115,7 @@ class BulletWorld : public scene::World {
       settings.warmStart = run.warmStart;
       settings.fallback = run.fallback;
       settings.acceptResidual = run.fallbackResidual;
-      settings.engineIterations = run.engineIterations;   // m_numIterations is run.iterations
+      settings.engineIterations = run.engineIterations;  // m_numIterations is run.iterations
       settings.timeBudget = run.timeBudget;
       solver = scenes::makeBulletSolver(name, settings);  // throws for unknown names
       ours_ = static_cast<ConstraintSolver*>(solver.get());
