@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <exception>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -110,6 +111,10 @@ struct mlcp::ode::Stepper::Impl {
   // the island workspace takes in turn.
   std::vector<IslandProblem> problems, spareProblems;
   std::mutex mutex;  // islands may run on ODE's worker threads
+  // The first exception an island's solve threw this step: kept by stepIsland and rethrown by
+  // Stepper::step once ODE's island processing has returned, so that it never unwinds through
+  // ODE's frames (they would leak their job records and leave its threading state half-done).
+  std::exception_ptr pendingError;
 
   // dstepper_fn_t and dmemestimate_fn_t: they find the Impl of the world being stepped.
   static void stepIsland(const dxStepperProcessingCallContext* context);

@@ -174,6 +174,7 @@ bool Stepper::step(dWorldID world, dReal h) {
             dxProcessIslands(world, islands, h, &Impl::stepIsland, &Impl::estimateMaxCallCount);
   impl_->warm.endStep();
   impl_->stats.seconds = nowSeconds() - t0;
+  if (impl_->pendingError) std::rethrow_exception(std::exchange(impl_->pendingError, nullptr));
   return ok;
 }
 
@@ -192,7 +193,13 @@ void Stepper::Impl::beginStep(dxWorld* world) {
 }
 
 void Stepper::Impl::stepIsland(const dxStepperProcessingCallContext* context) {
-  activeStepper(context->m_world)->runIsland(context);
+  Impl* impl = activeStepper(context->m_world);
+  try {
+    impl->runIsland(context);
+  } catch (...) {
+    std::lock_guard<std::mutex> lock(impl->mutex);
+    if (!impl->pendingError) impl->pendingError = std::current_exception();
+  }
 }
 
 void Stepper::Impl::keepProblem(IslandWork& w, int island) {
