@@ -65,12 +65,12 @@
 // (SI-like fixed-sweep pgs).
 //
 // timeBudget, default kDefaultTimeBudget (0.05 s): three frames of a 60 Hz program. A drop-in
-// whose island cannot be solved exactly in time (dantzig on ODE's 210-box pyramid: ~4 s a step
-// unbounded) then runs at ~20 steps a second with the best answer found instead of hanging for
-// seconds or minutes, while the exact answers of the scenes up to 55 boxes (ODE: ~11 ms a step)
-// and every joint island (microseconds) stay untouched; a tighter default cut pyramid_55's
-// dantzig solves on a loaded machine (docs/benchmarks.md, "Time budget"). 0 disables it, for
-// reproducible runs: an answer cut by a budget depends on the machine's speed and load.
+// whose island cannot be solved exactly in time (dantzig on a 210-box pyramid takes seconds a
+// step unbounded) then runs at ~20 steps a second with the best answer found instead of hanging,
+// while the exact answers of the scenes up to 55 boxes and every joint island stay untouched; a
+// tighter default cut pyramid_55's dantzig solves on a loaded machine (docs/benchmarks.md, "Time
+// budget"). 0 disables it, for reproducible runs: an answer cut by a budget depends on the
+// machine's speed and load.
 #pragma once
 
 #include <cstdint>
@@ -107,7 +107,7 @@ inline constexpr double kDefaultIslandTolerance = 1e-6;
 // Sweep limit of a pgs/gs fallback when the engine's iteration count is not used
 // (RowSolverSettings::engineIterations false): 100 sweeps, 10x Bullet's and 5x ODE QuickStep's
 // default cost, is what a rejected answer may cost at most by default (core's 1000 would cost
-// 100x SI per rejected island).
+// a hundred times the engine's solver per rejected island).
 inline constexpr int kDefaultFallbackSweeps = 100;
 
 // Options with the islands' default tolerance (kDefaultIslandTolerance), core defaults otherwise.
@@ -165,7 +165,7 @@ struct RowSolverSettings {
   // maxIterations sweeps toward the tolerance: Bullet's btContactSolverInfo::m_numIterations
   // (10 by default), ODE's dWorldGetQuickStepNumIterations (20) with dWorldGetQuickStepW (1.3)
   // as the relaxation. A drop-in pgs then costs what the engine's own solver costs (core's
-  // 1000 sweeps toward 1e-10 cost 7-108x SI per step on Bullet's demos); a fallback of the
+  // 1000 sweeps toward 1e-10 cost orders of magnitude more, docs/benchmarks.md); a fallback of the
   // primary's own name is not run (the same sweeps from the same start give the same answer).
   // Set false (and options.maxIterations) for more accuracy. Default true.
   bool engineIterations = true;
