@@ -6,6 +6,7 @@ namespace mlcp {
 
 void ScreenCounts::add(const ScreenCounts& o) {
   clampedBound += o.clampedBound;
+  rhsBeyondReach += o.rhsBeyondReach;
   nonFiniteRhs += o.nonFiniteRhs;
   nonFiniteRow += o.nonFiniteRow;
   noJacobian += o.noJacobian;
@@ -16,10 +17,10 @@ void ScreenCounts::add(const ScreenCounts& o) {
 
 std::string ScreenCounts::toString() const {
   const std::pair<const char*, int> entries[] = {
-      {"clamped-bound", clampedBound},  {"non-finite-rhs", nonFiniteRhs},
-      {"non-finite-row", nonFiniteRow}, {"no-jacobian", noJacobian},
-      {"zero-diagonal", zeroDiagonal},  {"empty-bounds", emptyBounds},
-      {"inert-normal", inertNormal}};
+      {"clamped-bound", clampedBound},  {"rhs-beyond-reach", rhsBeyondReach},
+      {"non-finite-rhs", nonFiniteRhs}, {"non-finite-row", nonFiniteRow},
+      {"no-jacobian", noJacobian},      {"zero-diagonal", zeroDiagonal},
+      {"empty-bounds", emptyBounds},    {"inert-normal", inertNormal}};
   std::string s;
   for (const auto& [name, count] : entries)
     if (count > 0) s += (s.empty() ? "" : " ") + std::string(name) + ":" + std::to_string(count);
@@ -28,7 +29,15 @@ std::string ScreenCounts::toString() const {
 
 namespace {
 
-enum class Verdict { Keep, NonFiniteRhs, NonFiniteRow, NoJacobian, ZeroDiagonal, EmptyBounds };
+enum class Verdict {
+  Keep,
+  BeyondReach,
+  NonFiniteRhs,
+  NonFiniteRow,
+  NoJacobian,
+  ZeroDiagonal,
+  EmptyBounds
+};
 
 // One side's share of A_ii (J M^-1 J^T) and of ref (see row_screen.hpp).
 void side(const BodyInverseMass& body, const Vector6& j, double& aii, double& ref) {
@@ -38,7 +47,18 @@ void side(const BodyInverseMass& body, const Vector6& j, double& aii, double& re
       body.invMass * lin.squaredNorm() + body.invInertia.cwiseAbs().maxCoeff() * ang.squaredNorm();
 }
 
-Verdict judge(const RowSystem& s, int i) {
+// The answer of a row whose b_i is beyond reach (row_screen.hpp): the bound b_i's sign names, or
+// 0 for a friction row (its bounds move with its normal's x).
+Verdict beyondReach(const RowSystem& s, int i, bool fx, double& fixedAt) {
+  const double c = s.b[i] > 0 ? s.lo[i] : s.hi[i];
+  if (fx && s.findex[i] >= 0) return Verdict::BeyondReach;
+  if (!std::isfinite(c)) return Verdict::NonFiniteRhs;
+  fixedAt = c;
+  return Verdict::BeyondReach;
+}
+
+// fixedAt: the row's answer when the verdict is BeyondReach (left 0 otherwise).
+Verdict judge(const RowSystem& s, int i, bool fx, double& fixedAt) {
   const ConstraintRow& r = s.rows[i];
   const int nb = static_cast<int>(s.bodies.size());
   // Rows naming bodies out of range are validation's to report.
@@ -47,9 +67,10 @@ Verdict judge(const RowSystem& s, int i) {
   if ((a && !r.jA.allFinite()) || (b && !r.jB.allFinite()) || !std::isfinite(s.cfm[i]) ||
       s.cfm[i] < 0)
     return Verdict::NonFiniteRow;
-  if (!std::isfinite(s.b[i])) return Verdict::NonFiniteRhs;
+  if (std::isnan(s.b[i])) return Verdict::NonFiniteRhs;
   const double lo = s.lo[i], hi = s.hi[i];
   if (lo == kInf || hi == -kInf || lo > hi) return Verdict::EmptyBounds;
+  if (std::abs(s.b[i]) >= kBeyondReach) return beyondReach(s, i, fx, fixedAt);
   if ((!a || r.jA.isZero(0)) && (!b || r.jB.isZero(0))) return Verdict::NoJacobian;
   double aii = 0, ref = 0;
   if (a) side(s.bodies[r.bodyA], r.jA, aii, ref);
@@ -60,6 +81,7 @@ Verdict judge(const RowSystem& s, int i) {
 
 void count(ScreenCounts& c, Verdict v) {
   switch (v) {
+    case Verdict::BeyondReach: ++c.rhsBeyondReach; break;
     case Verdict::NonFiniteRhs: ++c.nonFiniteRhs; break;
     case Verdict::NonFiniteRow: ++c.nonFiniteRow; break;
     case Verdict::NoJacobian: ++c.noJacobian; break;
@@ -78,18 +100,20 @@ bool RowScreen::screen(const RowSystem& s) {
   if (s.b.size() != n || s.lo.size() != n || s.hi.size() != n || s.cfm.size() != n) return false;
   const bool fx = static_cast<int>(s.findex.size()) == n;
   inert_.assign(n, 0);
+  fixed_.assign(n, 0.0);
   bool any = false;
   for (int i = 0; i < n; ++i) {
-    const Verdict v = judge(s, i);
+    const Verdict v = judge(s, i, fx, fixed_[i]);
     count(counts_, v);
     inert_[i] = v != Verdict::Keep;
     any |= inert_[i] != 0;
     counts_.clampedBound += v == Verdict::Keep && (std::isnan(s.lo[i]) || std::isnan(s.hi[i]));
   }
-  // Friction rows of an inert normal row (one level: findex has no chains).
+  // Friction rows of an inert normal row (one level: findex has no chains); a normal fixed at a
+  // non-zero bound gives its friction rows fixed bounds below.
   for (int i = 0; fx && i < n; ++i) {
     const int f = s.findex[i];
-    if (!inert_[i] && f >= 0 && f < n && inert_[f]) {
+    if (!inert_[i] && f >= 0 && f < n && inert_[f] && fixed_[f] == 0) {
       inert_[i] = 1;
       ++counts_.inertNormal;
     }
@@ -121,9 +145,36 @@ bool RowScreen::screen(const RowSystem& s) {
     if (fx) {
       const int f = s.findex[i];
       kept_.findex[k] = f >= 0 && f < n ? place[f] : f;
+      if (f >= 0 && f < n && inert_[f]) {  // its normal is fixed at fixed_[f] != 0
+        kept_.lo[k] *= std::abs(fixed_[f]);
+        kept_.hi[k] *= std::abs(fixed_[f]);
+      }
     }
   }
+  for (int i = 0; i < n; ++i)
+    if (fixed_[i] != 0) fix(s, i);
   return true;
+}
+
+// Row i fixed at c = fixed_[i]: each kept row's b_j += J_j M^-1 J_i^T c on the bodies they share.
+void RowScreen::fix(const RowSystem& s, int i) {
+  const ConstraintRow& r = s.rows[i];
+  auto push = [&](int body, const Vector6& j) {
+    Vector6 dv = Vector6::Zero();
+    if (body < 0) return dv;
+    const BodyInverseMass& m = s.bodies[body];
+    dv << m.invMass * j.head<3>(), m.invInertia * j.tail<3>();
+    return Vector6(dv * fixed_[i]);
+  };
+  const Vector6 dvA = push(r.bodyA, r.jA), dvB = push(r.bodyB, r.jB);
+  auto on = [&](int body, const Vector6& j) {
+    return (body >= 0 && body == r.bodyA ? j.dot(dvA) : 0.0) +
+           (body >= 0 && body == r.bodyB ? j.dot(dvB) : 0.0);
+  };
+  for (int k = 0; k < kept_.size(); ++k) {
+    const ConstraintRow& q = kept_.rows[k];
+    kept_.b[k] += on(q.bodyA, q.jA) + on(q.bodyB, q.jB);
+  }
 }
 
 void RowScreen::gather(const Vector& full, Vector& kept) const {
@@ -132,7 +183,7 @@ void RowScreen::gather(const Vector& full, Vector& kept) const {
 }
 
 void RowScreen::scatter(const Vector& kept, Vector& full) const {
-  full.setZero(n_);
+  full = Eigen::Map<const Vector>(fixed_.data(), n_);
   for (int k = 0; k < kept.size(); ++k) full[index_[k]] = kept[k];
 }
 

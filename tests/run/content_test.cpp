@@ -100,9 +100,6 @@ constexpr const char* kBridge =
 constexpr const char* kPgsLimit =
     "pgs convergence: 50 sweeps and the pgs fallback's 1000 do not reach the 1e-3 acceptance on "
     "this scene (a method limit; the slow-exact-solvers-on-large-islands work replaces pgs here)";
-constexpr const char* kSixDof =
-    "degenerate rows from 6-dof springs with infinite limits: with the +-1e30 limit dantzig "
-    "reports converged (residual 1e-33) on an answer that holds nothing, and the boxes fall";
 constexpr const char* kFallbackCap =
     "bounded fallback: the island's answer misses the 1e-3 acceptance and the pgs fallback, "
     "bounded at 100 sweeps so that a drop-in never pays 1000 by surprise, does not reach it "
@@ -125,8 +122,6 @@ const KnownFailure kKnownFailures[] = {
     {"hull_stack", "bullet", "pgs", kPgsLimit, false},
     {"stack_1000", "bullet", "pgs", kPgsLimit, false},
     {"stack_1000", "ode", "pgs", kPgsLimit, false},
-    {"six_dof_spring.hold", "bullet", "dantzig", kSixDof, false},
-    {"six_dof_spring.hold", "bullet", "auto", kSixDof, false},
 };
 
 const KnownFailure* knownFailure(const std::string& scene, const std::string& engine,

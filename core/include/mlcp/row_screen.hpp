@@ -10,7 +10,10 @@
 //
 //   reason          row                                   handling
 //   clampedBound    lo or hi NaN                          kept, NaN lo -> -inf, NaN hi -> +inf
-//   nonFiniteRhs    b_i NaN or +-inf                      inert
+//   rhsBeyondReach  |b_i| >= kBeyondReach (or +-inf),     fixed at that bound (x_i = lo_i for
+//                   pushing toward a finite bound         b_i > 0, hi_i for b_i < 0)
+//   nonFiniteRhs    b_i NaN, or beyond reach toward an    inert
+//                   infinite bound
 //   nonFiniteRow    J or cfm_i NaN/Inf, or cfm_i < 0      inert
 //   noJacobian      J_i = 0 on every body it names        inert (it moves nothing)
 //   zeroDiagonal    A_ii = J_i M^-1 J_i^T <= 1e-12 * ref  inert (M^-1 J_i^T = 0: it moves
@@ -19,13 +22,30 @@
 //   inertNormal     friction row whose normal row is      inert (its bounds mu |x_normal| are
 //                   inert                                 0 wide)
 //
+// A row whose b_i is beyond reach is an engine idiom, not an error: Bullet's 6-dof limit "at
+// infinity" (btGeneric6DofSpring2Constraint with +-1e30 or SIMD_INFINITY limits gives its limit
+// rows rhs = fps erp (x - 1e30), or -inf where that overflows) and a motor or spring that pushes
+// "at full force" (target velocity +-SIMD_INFINITY, the impulse bounded by lo_i, hi_i). b_i is
+// the velocity (Bullet; velocity / h in ODE) the row would undo; the impulses of the rest of
+// the island change w_i = A_i x + b_i by far less than 1e10 m/s, so w_i keeps b_i's sign and
+// complementarity puts x_i on the bound that sign names: lo_i for b_i > 0, hi_i for b_i < 0.
+// That is the answer Bullet's sequential impulse gives the row (its impulse clamps there) and
+// the exact one. Left in, such a row breaks every solver the same way: 1 + ||b||_inf, the
+// residual's scale, becomes 1e31, any x passes the acceptance, and a pivoting solver reports
+// "converged" on the start (the boxes of scenes/six_dof_spring.json fell). A fixed row leaves
+// the solve: x_i = c moves the other rows' b_j by A_ji c = J_j M^-1 J_i^T c (nothing when c = 0,
+// Bullet's one-sided limit rows), and a friction row whose normal is fixed at c gets the fixed
+// bounds mu |c|. A friction row beyond reach is inert (its bounds move with its normal).
+//
 // ref = sum over the row's bodies of invMass |J_lin|^2 + max|invInertia_kl| |J_ang|^2, the
 // size A_ii would have if J were not in M^-1's null space: the test is relative, so a 1 mm or a
-// 1 km scene screens the same rows. An inert row takes x_i = 0 and is left out of the solve:
-// the solver gets the other rows, compacted in their order, findex renumbered.
+// 1 km scene screens the same rows. An inert row takes x_i = 0 and a fixed row x_i = c; both
+// are left out of the solve: the solver gets the other rows, compacted in their order, findex
+// renumbered.
 //
 // Cost: one pass over the rows (A_ii's two 3x3 products a side, ~50 flops a row) when nothing
-// is wrong, which is the usual case; the compacted copy is built only when a row is inert.
+// is wrong, which is the usual case; the compacted copy is built only when a row is screened,
+// and each row fixed at a non-zero bound costs one more pass over the kept rows.
 #pragma once
 
 #include <string>
@@ -38,6 +58,7 @@ namespace mlcp {
 // Rows screened, by reason (see above). inert() counts the rows left out of the solve.
 struct ScreenCounts {
   int clampedBound = 0;
+  int rhsBeyondReach = 0;  // fixed at a bound, left out of the solve (counted by inert())
   int nonFiniteRhs = 0;
   int nonFiniteRow = 0;
   int noJacobian = 0;
@@ -46,7 +67,8 @@ struct ScreenCounts {
   int inertNormal = 0;
 
   int inert() const {
-    return nonFiniteRhs + nonFiniteRow + noJacobian + zeroDiagonal + emptyBounds + inertNormal;
+    return rhsBeyondReach + nonFiniteRhs + nonFiniteRow + noJacobian + zeroDiagonal + emptyBounds +
+           inertNormal;
   }
   int total() const { return clampedBound + inert(); }
   void add(const ScreenCounts& other);
@@ -57,6 +79,8 @@ struct ScreenCounts {
 
 // A_ii <= kZeroDiagonal * ref (see above) with cfm_i = 0 is a zero diagonal. Dimensionless.
 inline constexpr double kZeroDiagonal = 1e-12;
+// |b_i| >= kBeyondReach is beyond reach (see above). In b's unit: m/s (Bullet), m/s^2 (ODE).
+inline constexpr double kBeyondReach = 1e10;
 
 class RowScreen {
  public:
@@ -72,12 +96,16 @@ class RowScreen {
   const std::vector<int>& keptIndex() const { return index_; }
   // full (size of the screened rows) -> the kept rows' entries.
   void gather(const Vector& full, Vector& kept) const;
-  // The kept rows' answer -> full (size of the screened rows), inert rows 0.
+  // The kept rows' answer -> full (size of the screened rows), inert rows 0, fixed rows their
+  // bound.
   void scatter(const Vector& kept, Vector& full) const;
 
  private:
+  void fix(const RowSystem& s, int i);
+
   ScreenCounts counts_;
   std::vector<unsigned char> inert_;
+  std::vector<double> fixed_;  // per screened row: its answer when left out (0 unless fixed)
   std::vector<int> index_;
   RowSystem kept_;
   int n_ = 0;
