@@ -946,14 +946,17 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
     ws.pivots = 0;
     result.iterations = totalPivots;
     writeBack();
-    if (o == Outcome::Failed && ws.shift == 0) {
+    // The default pivot limit (50 n + 100) is reached by cycling on a singular A as well.
+    const bool cycled = o == Outcome::PivotLimit && opt.maxPivots <= 0;
+    if ((o == Outcome::Failed || cycled) && ws.shift == 0) {
       // Pivoting breaks down on a singular A (redundant joints, coplanar contacts): once more
-      // from the caller's start on A + delta I; the residual is still measured on A.
+      // on A + delta I, cold (the guess led into the breakdown; from Bullet's cached impulses
+      // the regularised friction passes needed more than 50); the residual is measured on A.
       const std::string first = ws.message;
       const int spent = totalPivots;
       const double delta = kRegularization * ws.scale;
       ws.shift = delta;
-      x = ws.guess;
+      x = Vector::Zero(n);
       runPivoting(problem, x, result, fromBlock);
       ws.shift = 0;
       result.iterations += spent;

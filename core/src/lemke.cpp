@@ -250,6 +250,11 @@ LcpSolution solveLcp(const StandardForm& f, const ToleranceRules& rules, int max
   return sol;
 }
 
+// The retry of a ray adds kRegularization * max(1, max |A_ii|) to A's diagonal: Bullet's bridge
+// of planks joined by two ball joints each (a singular A, its rows' drift ~1e-8 of b) ends in a
+// spurious ray on A and solves in a few pivots on A + 1e-12 max |A_ii| I, leaving ~5e-11 on A.
+constexpr double kRegularization = 1e-12;
+
 bool boundsMoved(const Problem& p, const Vector& before, const Vector& after, double tol) {
   for (int i = 0; i < p.size(); ++i) {
     const double a = p.effectiveHi(i, before), b = p.effectiveHi(i, after);
@@ -261,7 +266,6 @@ bool boundsMoved(const Problem& p, const Vector& before, const Vector& after, do
 }  // namespace
 
 void LemkeSolver::run(const Problem& problem, Vector& x, Result& result) {
-  const Options& opt = options();
   const int n = problem.size();
   result.iterations = 0;
   if (n == 0) {
@@ -277,7 +281,35 @@ void LemkeSolver::run(const Problem& problem, Vector& x, Result& result) {
     result.message = os.str();
     return;
   }
-  const DenseMatrix A = problem.toDense();
+  DenseMatrix A = problem.toDense();
+  const Vector start = x;
+  pivot(problem, A, x, result);
+  if (result.status != Status::Failed) return;
+  // A ray on a singular A (redundant joints): once more from the start on A + delta I, the
+  // answer measured on A; the better of the two stands.
+  const double delta = kRegularization * std::max(1.0, A.diagonal().cwiseAbs().maxCoeff());
+  A.diagonal().array() += delta;
+  Vector again = start;
+  Result second = result;
+  second.iterations = 0;
+  pivot(problem, A, again, second);
+  const int pivots = result.iterations + second.iterations;
+  std::ostringstream os;
+  if (second.status == Status::Converged || residual(problem, again) < residual(problem, x)) {
+    os << "regularised: A + " << delta << " I after a ray (" << result.message << "); "
+       << second.message;
+    result = std::move(second);
+    x = std::move(again);
+  } else {
+    os << result.message;  // an infeasible problem: the ray stands
+  }
+  result.iterations = pivots;
+  result.message = os.str();
+}
+
+void LemkeSolver::pivot(const Problem& problem, const DenseMatrix& A, Vector& x, Result& result) {
+  const Options& opt = options();
+  const int n = problem.size();
   const bool friction = problem.hasFindex();
   const bool standard = problem.classify() == ProblemClass::StandardLcp;
   const int outerLimit = friction ? std::max(1, opt.maxIterations) : 1;

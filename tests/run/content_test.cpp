@@ -94,9 +94,21 @@ struct KnownFailure {
   const char* bug;
   bool crashes;
 };
-constexpr const char* kBridge =
-    "singular redundant bridges: pairs of ball joints on one axis give a singular A that the "
-    "solvers leave above the 1e-3 acceptance";
+// The bridge's A is singular (pairs of ball joints on one axis, cfm 0 in Bullet); dantzig and
+// lemke solve it through their regularised retries, these stay.
+constexpr const char* kBridgePgs =
+    "pgs convergence on the singular bridge: the 12-plank chain under two 10 kg crates needs ~1000 "
+    "sweeps from zero to reach the 1e-3 acceptance (a captured Bullet step: 0.11 after 50 sweeps, "
+    "0.044 after 100, 4.5e-4 after 1000), beyond 50 sweeps and the 100-sweep fallback (a method "
+    "limit)";
+constexpr const char* kBridgeLdlt =
+    "ldlt refuses bounded rows: once the crates land (step 16) the islands have contacts, and the "
+    "100-sweep pgs fallback misses the 1e-3 acceptance on the singular bridge (see kBridgePgs)";
+constexpr const char* kBridgeAuto =
+    "auto on the singular bridge in Bullet: on one step its dantzig's exact-friction passes, "
+    "after the regularised retry, still move after the scene's 50 (the same island settles "
+    "after 199 cheap passes), and the policy's demotion to pgs after that breakdown leaves the "
+    "next islands to pgs, which misses the 1e-3 acceptance here (see kBridgePgs)";
 constexpr const char* kPgsLimit =
     "pgs convergence: 50 sweeps and the pgs fallback's 1000 do not reach the 1e-3 acceptance on "
     "this scene (a method limit; the slow-exact-solvers-on-large-islands work replaces pgs here)";
@@ -112,13 +124,11 @@ const KnownFailure kKnownFailures[] = {
     {"hull_stack", "ode", "pgs", kFallbackCap, false},
     {"ragdoll_pile", "bullet", "pgs", kPgsLimit, false},
     {"ragdoll_pile", "ode", "pgs", kPgsLimit, false},
-    {"plank_bridge", "bullet", "pgs", kBridge, false},
-    {"plank_bridge", "bullet", "dantzig", kBridge, false},
-    {"plank_bridge", "bullet", "lemke", kBridge, false},
-    {"plank_bridge", "bullet", "ldlt", kBridge, false},
-    {"plank_bridge", "bullet", "auto", kBridge, false},
-    {"plank_bridge", "ode", "pgs", kBridge, false},
-    {"plank_bridge", "ode", "ldlt", kBridge, false},
+    {"plank_bridge", "bullet", "pgs", kBridgePgs, false},
+    {"plank_bridge", "bullet", "ldlt", kBridgeLdlt, false},
+    {"plank_bridge", "bullet", "auto", kBridgeAuto, false},
+    {"plank_bridge", "ode", "pgs", kBridgePgs, false},
+    {"plank_bridge", "ode", "ldlt", kBridgeLdlt, false},
     {"hull_stack", "bullet", "pgs", kPgsLimit, false},
     {"stack_1000", "bullet", "pgs", kPgsLimit, false},
     {"stack_1000", "ode", "pgs", kPgsLimit, false},

@@ -31,8 +31,10 @@
 // cfm > 0) every Schur complement is positive and the method finds the unique solution. For
 // symmetric positive semidefinite A (rank-deficient contacts, cfm = 0) a consistent problem
 // usually solves (a zero-pivot row whose w is already 0 is left where it is, and the message
-// counts such redundant rows). A pivoting that breaks down (Failed) is run once more from the
-// caller's start on A + delta I, delta = 1e-10 max |A_ii|: engines' redundant joints disagree by
+// counts such redundant rows). A pivoting that breaks down (Failed, or the default pivot limit
+// reached: cycling) is run once more from zero on A + delta I, delta = 1e-10 max |A_ii| (from
+// the guess that led into the breakdown the friction passes took up to 4x longer on Bullet's
+// plank bridge): engines' redundant joints disagree by
 // their drift (Bullet's bridge of planks joined by two ball joints each: ~1e-8 of b), which no
 // zero pivot absorbs; the regularised answer leaves a residual on A at that level, and the
 // message says "regularised". Otherwise, and for general non-symmetric matrices, the method may

@@ -59,6 +59,13 @@
 // for PSD A; for a P-matrix A with finite boxes the doubled matrix is no longer a P-matrix and
 // ray termination, though not expected, is reported as it is.
 //
+// Singular A. In exact arithmetic a feasible LCP with PSD M never ends on a ray; in floating
+// point a singular A (engines' redundant joints: a pair of ball joints on one axis) does, its
+// zero pivots rounded to either sign. A solve that ends on a ray runs once more from the same
+// start on A + delta I, delta = 1e-12 max(1, max |A_ii|), and the answer with the lower residual
+// on A itself stands (the message says "regularised"). A consistent singular problem keeps a
+// residual of order delta ||x|| on A; an infeasible one ends on a ray again.
+//
 // Friction (findex) rows: an outer fixed point on the bounds. Iteration k solves the boxed
 // problem with bounds lo_i |x_j|, hi_i |x_j| taken from the previous answer (from the start
 // point, zero unless a guess is given, at k = 1), then re-solves its active set with the true
@@ -87,6 +94,10 @@ class LemkeSolver : public Solver {
 
  protected:
   void run(const Problem& problem, Vector& x, Result& result) override;
+
+ private:
+  // The pivoting (with the friction passes) on A, the problem's matrix or a regularised one.
+  void pivot(const Problem& problem, const DenseMatrix& A, Vector& x, Result& result);
 };
 
 // Runs Lemke on a standard LCP (lo = 0, hi = +inf, no findex) and prints every tableau to out:
