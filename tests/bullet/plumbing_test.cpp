@@ -554,6 +554,30 @@ TEST(BulletPlumbing, DefaultPgsRunsBulletsIterationCount) {
   }
 }
 
+// Regression: a packed pgs answer that missed the acceptance (as Bullet's 10 sweeps often do)
+// went on to RowSolver, which had no fallback to run (engineIterations clears a pgs fallback of
+// pgs) and ran the same sweeps from the same start again: every such island cost twice its
+// sweeps plus a RowSystem. Now it stays packed, is solved once and is counted as rejected.
+TEST(BulletPlumbing, RejectedPgsAnswerWithoutFallbackIsNotSolvedTwice) {
+  sc::World w;
+  Settings s;
+  s.solver = "pgs";
+  s.acceptResidual = 1e-12;  // no answer of 2 sweeps passes
+  w.setSolver(std::make_unique<ConstraintSolver>(s));
+  auto* mine = static_cast<ConstraintSolver*>(w.solver());
+  sc::stack(w, 3);
+  w.info().m_numIterations = 2;
+  for (int i = 0; i < 5; ++i) {
+    w.step();
+    const mlcp::bullet::StepStats& st = mine->lastStep();
+    ASSERT_GT(st.islands, 0);
+    EXPECT_EQ(st.packedIslands, st.islands) << "step " << i;
+    EXPECT_EQ(st.failures, st.islands) << "step " << i;
+    EXPECT_EQ(st.fallbacks, 0);
+    EXPECT_NE(st.message.find("no fallback"), std::string::npos) << st.message;
+  }
+}
+
 }  // namespace
 
 // An injected NaN and a failing primary: every island falls back, the statistics say so, and

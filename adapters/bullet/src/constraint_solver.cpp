@@ -209,11 +209,21 @@ bool ConstraintSolver::solveIslandFast(Island& island, bool split) {
   }
   const int n = static_cast<int>(island.rows.size());
   Result r = builder_.solvePgs(pgs_, island, split, x_);
-  if (!pgs_.velocityChanges() || !acceptable(r, settings_.acceptResidual)) return false;
+  if (!pgs_.velocityChanges()) return false;  // not finite: the screened rows' path
+  // A rejected answer goes on to RowSolver only for its fallback: without one (engineIterations
+  // clears a pgs fallback of pgs) it would run the same sweeps from the same start again.
+  const bool accepted = acceptable(r, settings_.acceptResidual);
+  if (!accepted && !rows_->settings().fallback.empty()) return false;
   r.solver = "pgs";
   r.seconds = nowSeconds() - t0;
   record(r, n, "pgs");
   current_.packedIslands += 1;
+  if (!accepted) {
+    current_.failures += 1;
+    if (current_.message.empty())
+      current_.message = "pgs rejected (" + std::string(toString(r.status)) + ", residual " +
+                         std::to_string(r.residual) + "); no fallback";
+  }
   if (island.perRowWriteBack) {
     applyPerRow(island, x_, split);
     if (!split) builder_.remember(island, x_);

@@ -66,8 +66,10 @@
 // components are 0 or 1 and f's are equal (any rotation); an island with another body
 // (Island::perRowWriteBack) is written back row by row as the
 // RowSolver path does (tested with factors (0.3, 1, 0.5) and linear factors (1, 0.5, 1)).
-// Its answer passes the same acceptable() rule; a rejected one (or keepIslands, or a caller
-// holding rowSolver()) goes through RowSolver on a RowSystem copy like every other solver. The
+// Its answer passes the same acceptable() rule; a rejected one goes through RowSolver on a
+// RowSystem copy like every other solver when RowSolver has a fallback to run (without one it
+// would repeat the same sweeps from the same start: the packed answer stays, counted in
+// failures), and so does every island with keepIslands or a caller holding rowSolver(). The
 // iterates are the same as RowSolver's pgs bit for bit (one packing code); the write-back differs
 // by round-off (the bodies' velocities, 1e-9 apart after ~17 steps of a settling pyramid). The
 // cached-impulse start (the default) reads the manifold points in build() and keeps answers in
@@ -239,7 +241,8 @@ class ConstraintSolver : public btSequentialImpulseConstraintSolver {
  private:
   void solveIsland(Island& island, std::uint64_t key, bool split);
   // "pgs" packed straight from Bullet's rows and written back per body; false when the answer
-  // was not accepted (the island then goes through rows_ like every other solver).
+  // is not finite, or was not accepted and rows_ has a fallback (the island then goes through
+  // rows_ like every other solver).
   bool solveIslandFast(Island& island, bool split);
   // Store impulses row by row through Bullet's own body update (internalApplyImpulse or
   // internalApplyPushImpulse with x - applied), and set the applied impulses to x.
