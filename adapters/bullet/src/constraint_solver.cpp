@@ -209,7 +209,8 @@ bool ConstraintSolver::solveIslandFast(Island& island, bool split) {
   }
   const int n = static_cast<int>(island.rows.size());
   Result r = builder_.solvePgs(pgs_, island, split, x_);
-  if (!pgs_.velocityChanges()) return false;  // not finite: the screened rows' path
+  // Not finite, or a row RowSolver's screening fixes: the screened rows' path.
+  if (!pgs_.velocityChanges() || island.beyondReach) return false;
   // A rejected answer goes on to RowSolver only for its fallback: without one (engineIterations
   // clears a pgs fallback of pgs) it would run the same sweeps from the same start again.
   const bool accepted = acceptable(r, settings_.acceptResidual);

@@ -8,6 +8,7 @@
 
 #include "mlcp/bullet/constraint_solver.hpp"
 #include "mlcp/detail/row_pack.hpp"
+#include "mlcp/row_screen.hpp"
 
 namespace mlcp::bullet {
 
@@ -205,6 +206,7 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     isl.hasSplit = false;
     isl.filled = false;
     isl.perRowWriteBack = false;
+    isl.beyondReach = false;
   };
   // One component with every row on a dynamic body (a pile, a pyramid): the rows are island 0 in
   // their own order, its bodies were numbered in the pass above (first use, as the general
@@ -224,6 +226,7 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     isl.hasSplit = false;
     isl.filled = false;
     isl.perRowWriteBack = false;
+    isl.beyondReach = false;
     for (const int d : firstUse) mass(isl, d);
   } else {
     for (const int d : firstUse) bodyLocal_[d] = -1;
@@ -402,6 +405,7 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
   const double rhsPenetration = c.m_rhsPenetration;
   const double splitB = scaled && rhsPenetration != 0 ? -rhsPenetration / jd : 0.0;
   out.b = split ? splitB : scaled ? -c.m_rhs / jd : 0.0;
+  if (std::abs(out.b) >= kBeyondReach) isl.beyondReach = true;
   if (cfm_ == CfmModel::StockMlcp)
     out.cfm = stockCfm_;
   else
