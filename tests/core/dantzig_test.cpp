@@ -1201,20 +1201,25 @@ TEST(Dantzig, DantzigIncrementalFinishSkipsRowsMovedByEarlierDrives) {
   }
 }
 
-// Regression: an island of scenes/plank_bridge.json in Bullet (108 rows: 13 pairs of ball joints
-// on one axis each, so A is singular with cfm 0, and the crates' contacts with friction). The
-// pivoting cycles on its zero pivots until the pivot limit (5500) and ended MaxIterations at
-// residual 0.44; the limit is now taken as a breakdown and the solve retried on A + delta I.
-TEST(Dantzig, PivotLimitOnASingularAIsRetriedRegularised) {
-  const Problem p = io::readProblemJson(std::string(MLCP_SOURCE_DIR) +
-                                        "/tests/data/plank_bridge_bullet_step26.json");
-  DantzigSolver s;
-  s.options().tolerance = 1e-6;
-  Vector x;
-  const Result r = s.solve(p, x);
-  EXPECT_TRUE(r.converged()) << toString(r.status) << " " << r.message;
-  EXPECT_NE(r.message.find("regularised"), std::string::npos) << r.message;
-  EXPECT_LE(accuracy(p, x).residual, 1e-6);
+// Regression: islands of scenes/plank_bridge.json in Bullet (13 pairs of ball joints on one axis
+// each, so A is singular with cfm 0, and the crates' contacts with friction). On step 26 (108
+// rows) dantzig's pivoting cycled on its zero pivots to the pivot limit (5500) and ended
+// MaxIterations at residual 0.44; on step 21 (90 rows) lemke ended on a spurious ray at residual
+// 0.21. Both now retry on A + delta I and answer with a residual on A at delta's level.
+TEST(Dantzig, SingularBridgeIslandsAreRetriedRegularised) {
+  for (const auto& [name, file] : {std::pair("dantzig", "plank_bridge_bullet_step26.json"),
+                                   std::pair("lemke", "plank_bridge_bullet_step21.json")}) {
+    SCOPED_TRACE(name);
+    const Problem p = io::readProblemJson(std::string(MLCP_SOURCE_DIR) + "/tests/data/" + file);
+    std::unique_ptr<Solver> s = makeSolver(name);
+    ASSERT_TRUE(s);
+    s->options().tolerance = 1e-6;
+    Vector x;
+    const Result r = s->solve(p, x);
+    EXPECT_TRUE(r.converged()) << toString(r.status) << " " << r.message;
+    EXPECT_NE(r.message.find("regularised"), std::string::npos) << r.message;
+    EXPECT_LE(accuracy(p, x).residual, 1e-6);
+  }
 }
 
 // Redundant joints: a ball joint given twice (the second copy's rows scaled, as Bullet's two

@@ -182,21 +182,6 @@ TEST(Lemke, InfeasibleEndsOnARay) {
   EXPECT_GT(residual(p, x), 1e-3);
 }
 
-// Regression: an island of scenes/plank_bridge.json in Bullet (90 rows: pairs of ball joints on
-// one axis, so A is singular with cfm 0, and contacts with friction) ended on a spurious ray at
-// residual 0.21; retried on A + delta I it solves, with a residual on A at delta's level.
-TEST(Lemke, RayOnASingularAIsRetriedRegularised) {
-  const Problem p = io::readProblemJson(std::string(MLCP_SOURCE_DIR) +
-                                        "/tests/data/plank_bridge_bullet_step21.json");
-  LemkeSolver s;
-  s.options().tolerance = 1e-6;
-  Vector x;
-  const Result r = s.solve(p, x);
-  EXPECT_TRUE(r.converged()) << toString(r.status) << " " << r.message;
-  EXPECT_NE(r.message.find("regularised"), std::string::npos) << r.message;
-  EXPECT_LE(accuracy(p, x).residual, 1e-6);
-}
-
 TEST(Lemke, InfeasiblePsdProblemIsNeverConverged) {
   // w1 = -z2 - z3 - 1e-4 < 0 for every z >= 0 (Pang's example, perturbed).
   DenseMatrix M(3, 3);

@@ -15,6 +15,21 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+// Appends a row along `lin` on body 0 (arm (0, 0.5, 0)) with the given rhs and bounds.
+void addRow(RowSystem& s, const Eigen::Vector3d& lin, double b, double lo, double hi, int findex) {
+  ConstraintRow r;
+  r.bodyA = 0;
+  r.jA << lin, Eigen::Vector3d(0, 0.5, 0).cross(lin);
+  s.rows.push_back(r);
+  const int n = s.size();
+  for (Vector* v : {&s.b, &s.lo, &s.hi, &s.cfm}) v->conservativeResize(n);
+  s.b[n - 1] = b;
+  s.lo[n - 1] = lo;
+  s.hi[n - 1] = hi;
+  s.cfm[n - 1] = 0;
+  s.findex.push_back(findex);
+}
+
 // One unit body (mass 1, inertia 1) held to the world: a ball joint's three rows 0-2, a contact
 // row 3 along y with its friction row 4 along x, and nothing else.
 RowSystem island() {
@@ -23,23 +38,9 @@ RowSystem island() {
   body.invMass = 1;
   body.invInertia = Eigen::Matrix3d::Identity();
   s.bodies = {body};
-  const Eigen::Vector3d arm(0, 0.5, 0);
-  auto add = [&](const Eigen::Vector3d& lin, double b, double lo, double hi, int findex) {
-    ConstraintRow r;
-    r.bodyA = 0;
-    r.jA << lin, arm.cross(lin);
-    s.rows.push_back(r);
-    const int n = s.size();
-    for (Vector* v : {&s.b, &s.lo, &s.hi, &s.cfm}) v->conservativeResize(n);
-    s.b[n - 1] = b;
-    s.lo[n - 1] = lo;
-    s.hi[n - 1] = hi;
-    s.cfm[n - 1] = 0;
-    s.findex.push_back(findex);
-  };
-  for (int k = 0; k < 3; ++k) add(Eigen::Vector3d::Unit(k), 0.1 * (k + 1), -kInf, kInf, -1);
-  add(Eigen::Vector3d::UnitY(), -1, 0, kInf, -1);
-  add(Eigen::Vector3d::UnitX(), 0.2, -0.5, 0.5, 3);
+  for (int k = 0; k < 3; ++k) addRow(s, Eigen::Vector3d::Unit(k), 0.1 * (k + 1), -kInf, kInf, -1);
+  addRow(s, Eigen::Vector3d::UnitY(), -1, 0, kInf, -1);
+  addRow(s, Eigen::Vector3d::UnitX(), 0.2, -0.5, 0.5, 3);
   return s;
 }
 
@@ -139,21 +140,6 @@ TEST(RowScreen, FrictionOfAnInertNormalIsInert) {
   EXPECT_EQ(screen.counts().inertNormal, 1);
   EXPECT_EQ(screen.kept().size(), 3);
   EXPECT_EQ(screen.counts().toString(), "non-finite-rhs:1 inert-normal:1");
-}
-
-// Appends a row along `lin` on the body of island() with the given rhs and bounds.
-void addRow(RowSystem& s, const Eigen::Vector3d& lin, double b, double lo, double hi, int findex) {
-  ConstraintRow r;
-  r.bodyA = 0;
-  r.jA << lin, Eigen::Vector3d(0, 0.5, 0).cross(lin);
-  s.rows.push_back(r);
-  const int n = s.size();
-  for (Vector* v : {&s.b, &s.lo, &s.hi, &s.cfm}) v->conservativeResize(n);
-  s.b[n - 1] = b;
-  s.lo[n - 1] = lo;
-  s.hi[n - 1] = hi;
-  s.cfm[n - 1] = 0;
-  s.findex.push_back(findex);
 }
 
 // The kept rows see what the full rows see: w of the full system at scatter(x) equals the kept
