@@ -32,7 +32,7 @@
 // That is the answer Bullet's sequential impulse gives the row (its impulse clamps there) and
 // the exact one. Left in, such a row breaks every solver the same way: 1 + ||b||_inf, the
 // residual's scale, becomes 1e31, any x passes the acceptance, and a pivoting solver reports
-// "converged" on the start (the boxes of scenes/six_dof_spring.json fell). A fixed row leaves
+// "converged" on its start, which holds nothing (scenes/six_dof_spring.json). A fixed row leaves
 // the solve: x_i = c moves the other rows' b_j by A_ji c = J_j M^-1 J_i^T c (nothing when c = 0,
 // Bullet's one-sided limit rows), and a friction row whose normal is fixed at c gets the fixed
 // bounds mu |c|. A friction row beyond reach is inert (its bounds move with its normal).
