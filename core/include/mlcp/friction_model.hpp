@@ -14,8 +14,10 @@
 //         method for it (auto's choice); dantzig takes it but, made for P-matrices, often stalls
 //         and says so; newton refuses a non-symmetric A; pgs, gs and ldlt cannot take it at all
 //         and are refused when the settings are made. Lemke needs a little cfm on the rows (the
-//         engines' cfm / dt, 6e-4 at a world cfm of 1e-5): at 1e-10..1e-8 its ratio tests on
-//         near-singular pivots end in false ray terminations.
+//         engines' cfm / dt, 6e-4 at a world cfm of 1e-5, as the scenes set): at 1e-10..1e-8
+//         (ODE's double-precision default world CFM is 1e-10) the four coplanar contacts of a
+//         face make near-singular pivots, and a few percent of its solves end in a false ray
+//         termination or a wrong basis; those answers are rejected and the box answers instead.
 //
 // RowSolver (row_solver.hpp) applies the setting per island: with "cone", an island with
 // friction rows is solved as the cone's LCP (stage 3, RowSolver::solveCone) and mapped back to
