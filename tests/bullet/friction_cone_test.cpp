@@ -20,9 +20,7 @@ namespace sc = mlcp::bullet::scenes;
 using mlcp::FrictionModel;
 using mlcp::bullet::ConstraintSolver;
 using mlcp::bullet::Settings;
-using mlcp::test::frictionRadius;
-using mlcp::test::frictionSupport;
-using mlcp::test::kConePi;
+using namespace mlcp::test;  // cone_closed_form.hpp
 
 constexpr double kG = 9.81, kMu = 0.5;
 // A flat slab (1 x 0.2 x 1 m) that does not rotate (angular factor 0): a particle. Bullet's
@@ -34,11 +32,8 @@ constexpr double kHalfHeight = 0.1;
 // k = 0: the box.
 Settings settingsFor(int k) {
   Settings s;
-  s.solver = k == 0 ? "dantzig" : "auto";
-  s.friction = k == 0 ? FrictionModel::Box : FrictionModel::Cone;
-  if (k > 0) s.frictionDirections = k;
+  mlcp::test::useModel(s, k);
   s.cfm = mlcp::bullet::CfmModel::StockMlcp;  // globalCfm / dt on friction rows too
-  s.timeBudget = 0;
   return s;
 }
 
@@ -84,23 +79,9 @@ void expectModelRan(const Box& b, int k) {
   }
 }
 
-struct Case {
-  int k;  // 0: box
-  double psi;
-};
-
-std::string name(const Case& c) {
-  return (c.k == 0 ? std::string("box") : "cone k=" + std::to_string(c.k)) +
-         " psi=" + std::to_string(c.psi);
-}
-
-// Along a direction of the polygon, halfway between two, and the box on a diagonal.
-const Case kCases[] = {
-    {4, 0}, {4, kConePi / 4}, {8, kConePi / 8}, {8, kConePi / 4}, {0, kConePi / 4}};
-
 TEST(BulletFrictionCone, AnInclineSticksBelowAndSlidesAboveTheModelsCriticalSlope) {
-  for (const Case& c : kCases) {
-    SCOPED_TRACE(name(c));
+  for (const FrictionCase& c : kFrictionCases) {
+    SCOPED_TRACE(caseName(c));
     const double critical = kMu * frictionRadius(c.k, c.psi);
     for (double factor : {0.95, 1.05}) {
       const double alpha = std::atan(factor * critical);
@@ -121,8 +102,8 @@ TEST(BulletFrictionCone, AnInclineSticksBelowAndSlidesAboveTheModelsCriticalSlop
 }
 
 TEST(BulletFrictionCone, AnInclineSlidesWithTheModelsAcceleration) {
-  for (const Case& c : kCases) {
-    SCOPED_TRACE(name(c));
+  for (const FrictionCase& c : kFrictionCases) {
+    SCOPED_TRACE(caseName(c));
     const double alpha = std::atan(1.6 * kMu * frictionRadius(c.k, c.psi));
     Box b = boxOnGround(c.k, alpha, c.psi);
     const btVector3 down(std::cos(c.psi), 0, std::sin(c.psi));
@@ -141,8 +122,8 @@ TEST(BulletFrictionCone, AnInclineSlidesWithTheModelsAcceleration) {
 }
 
 TEST(BulletFrictionCone, ABoxPushedAlongTheGroundSlowsWithTheModelsFriction) {
-  for (const Case& c : kCases) {
-    SCOPED_TRACE(name(c));
+  for (const FrictionCase& c : kFrictionCases) {
+    SCOPED_TRACE(caseName(c));
     const double speed = 3;
     Box b = boxOnGround(c.k, 0, 0, speed * btVector3(std::cos(c.psi), 0, std::sin(c.psi)));
     b.world->step(5);  // the contact forms and carries the box's weight

@@ -19,6 +19,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+
+#include "mlcp/row_solver.hpp"
 
 namespace mlcp::test {
 
@@ -43,6 +46,29 @@ inline double frictionSupport(int k, double psi) {
   const double width = 2 * kConePi / k;
   const double a = angleWithin(psi, width);
   return std::cos(std::min(a, width - a));
+}
+
+// The engine tests' cases: along a direction of the polygon, halfway between two, on a diagonal,
+// and the box (k = 0) on a diagonal, where it gives sqrt(2) mu.
+struct FrictionCase {
+  int k;  // 0: the box
+  double psi;
+};
+inline constexpr FrictionCase kFrictionCases[] = {
+    {4, 0}, {4, kConePi / 4}, {8, kConePi / 8}, {8, kConePi / 4}, {0, kConePi / 4}};
+
+// An adapter's settings (bullet::Settings, ode::Settings) for a case's model, untimed: the box
+// with dantzig, the cone with k directions and auto (lemke).
+inline void useModel(RowSolverSettings& s, int k) {
+  s.solver = k == 0 ? "dantzig" : "auto";
+  s.friction = k == 0 ? FrictionModel::Box : FrictionModel::Cone;
+  if (k > 0) s.frictionDirections = k;
+  s.timeBudget = 0;
+}
+
+inline std::string caseName(const FrictionCase& c) {
+  return (c.k == 0 ? std::string("box") : "cone k=" + std::to_string(c.k)) +
+         " psi=" + std::to_string(c.psi);
 }
 
 }  // namespace mlcp::test

@@ -43,4 +43,21 @@ inline RowSystem cubeOnGround(const std::vector<Eigen::Vector3d>& points, const 
   return s;
 }
 
+// rows with a third friction row on the first contact's normal (row 0), as Bullet's rolling
+// friction adds: bounds -0.1..0.1 times the normal impulse, the first tangent's Jacobian.
+inline RowSystem withRollingFriction(RowSystem rows) {
+  const int n = rows.size();
+  rows.rows.push_back(rows.rows[1]);
+  rows.b.conservativeResize(n + 1);
+  rows.lo.conservativeResize(n + 1);
+  rows.hi.conservativeResize(n + 1);
+  rows.cfm.conservativeResize(n + 1);
+  rows.b[n] = 0;
+  rows.lo[n] = -0.1;
+  rows.hi[n] = 0.1;
+  rows.cfm[n] = rows.cfm[1];
+  rows.findex.push_back(0);
+  return rows;
+}
+
 }  // namespace mlcp::test

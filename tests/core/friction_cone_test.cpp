@@ -148,17 +148,7 @@ TEST(FrictionCone, ContactsTheConeCannotExpressAreRefusedWithAReason) {
   anisotropic.lo[2] = -0.2;
   anisotropic.hi[2] = 0.2;
   EXPECT_NE(cone.build(anisotropic, 4).find("anisotropic"), std::string::npos);
-  RowSystem rolling = rows;  // a third friction row on the same normal (rolling friction)
-  rolling.rows.push_back(rows.rows[1]);
-  rolling.b.conservativeResize(4);
-  rolling.lo.conservativeResize(4);
-  rolling.hi.conservativeResize(4);
-  rolling.cfm.conservativeResize(4);
-  rolling.b[3] = 0;
-  rolling.lo[3] = -0.1;
-  rolling.hi[3] = 0.1;
-  rolling.cfm[3] = 0;
-  rolling.findex.push_back(0);
+  const RowSystem rolling = test::withRollingFriction(rows);
   EXPECT_NE(cone.build(rolling, 4).find("rolling friction"), std::string::npos);
   RowSystem lifted = rows;
   lifted.lo[0] = -1;

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "common/cone_closed_form.hpp"
 #include "common/cube_on_ground.hpp"
 #include "mlcp/friction_cone.hpp"
 #include "mlcp/io.hpp"
@@ -75,13 +76,10 @@ Eigen::Vector2d slide(const RowSystem& rows, const Vector& x, const Vector6& bef
 
 TEST(RowSolverCone, ABoxPushedAlongTheGroundLosesTheConesFrictionInEveryDirection) {
   const double mu = 0.5, speed = 2;
-  struct Case {
-    int k;
-    double psi, muEffective;
-  };
-  for (const Case& c : {Case{4, 0, mu}, Case{4, kPi / 4, mu * std::cos(kPi / 4)},
-                        Case{8, kPi / 4, mu}, Case{8, kPi / 8, mu * std::cos(kPi / 8)}}) {
-    SCOPED_TRACE("k = " + std::to_string(c.k) + ", psi = " + std::to_string(c.psi));
+  for (const test::FrictionCase& c : test::kFrictionCases) {
+    if (c.k == 0) continue;  // the box: below
+    SCOPED_TRACE(test::caseName(c));
+    const double muEffective = mu * test::frictionSupport(c.k, c.psi);
     const Vector6 v = pushed(speed, c.psi);
     const RowSystem rows = cubeOnGround(kCorners, v, mu, kCfm);
     RowSolver solver(coneSettings(c.k));
@@ -92,7 +90,7 @@ TEST(RowSolverCone, ABoxPushedAlongTheGroundLosesTheConesFrictionInEveryDirectio
     EXPECT_FALSE(s.fellBack) << s.result.message;
     EXPECT_LE(s.result.residual, 1e-9);
     const Eigen::Vector2d h = slide(rows, x, v);
-    EXPECT_NEAR(h.norm(), speed - c.muEffective * kG * kDt, 1e-5);
+    EXPECT_NEAR(h.norm(), speed - muEffective * kG * kDt, 1e-5);
     EXPECT_NEAR(std::atan2(h.y(), h.x()), c.psi, 1e-5);
     EXPECT_LE(coneViolation(rows, x, c.k), 1e-7);
   }
@@ -233,17 +231,8 @@ TEST(RowSolverCone, APrimaryThatCannotTakeTheLcpFallsBackToTheBox) {
 
 // Contacts the cone cannot express (here rolling friction: a third friction row) keep the box.
 TEST(RowSolverCone, AnIslandTheConeCannotExpressKeepsTheBoxAndSaysWhy) {
-  RowSystem rows = cubeOnGround({{0, 0, -0.5}}, pushed(1, 0), 0.5, kCfm);
-  rows.rows.push_back(rows.rows[1]);
-  rows.b.conservativeResize(4);
-  rows.lo.conservativeResize(4);
-  rows.hi.conservativeResize(4);
-  rows.cfm.conservativeResize(4);
-  rows.b[3] = 0;
-  rows.lo[3] = -0.1;
-  rows.hi[3] = 0.1;
-  rows.cfm[3] = kCfm;
-  rows.findex.push_back(0);
+  const RowSystem rows =
+      test::withRollingFriction(cubeOnGround({{0, 0, -0.5}}, pushed(1, 0), 0.5, kCfm));
   RowSolver solver(coneSettings(4, "dantzig"));
   Vector x;
   const IslandSolve s = solver.solve(rows, Vector::Zero(rows.size()), x);

@@ -16,9 +16,7 @@
 namespace mlcp::ode::test {
 namespace {
 
-using mlcp::test::frictionRadius;
-using mlcp::test::frictionSupport;
-using mlcp::test::kConePi;
+using namespace mlcp::test;  // cone_closed_form.hpp
 
 constexpr double kG = 9.81, kMu = 0.5;
 constexpr dReal kH = 0.01;
@@ -26,10 +24,7 @@ constexpr dReal kH = 0.01;
 // k = 0: the box.
 Settings settingsFor(int k) {
   Settings s;
-  s.solver = k == 0 ? "dantzig" : "auto";
-  s.friction = k == 0 ? FrictionModel::Box : FrictionModel::Cone;
-  if (k > 0) s.frictionDirections = k;
-  s.timeBudget = 0;
+  mlcp::test::useModel(s, k);
   return s;
 }
 
@@ -89,22 +84,9 @@ void expectModelRan(const SlabRun& r, int k) {
   }
 }
 
-struct Case {
-  int k;  // 0: box
-  double psi;
-};
-
-std::string name(const Case& c) {
-  return (c.k == 0 ? std::string("box") : "cone k=" + std::to_string(c.k)) +
-         " psi=" + std::to_string(c.psi);
-}
-
-const Case kCases[] = {
-    {4, 0}, {4, kConePi / 4}, {8, kConePi / 8}, {8, kConePi / 4}, {0, kConePi / 4}};
-
 TEST(OdeFrictionCone, AnInclineSticksBelowAndSlidesAboveTheModelsCriticalSlope) {
-  for (const Case& c : kCases) {
-    SCOPED_TRACE(name(c));
+  for (const FrictionCase& c : kFrictionCases) {
+    SCOPED_TRACE(caseName(c));
     const double critical = kMu * frictionRadius(c.k, c.psi);
     for (double factor : {0.95, 1.05}) {
       const double alpha = std::atan(factor * critical);
@@ -125,8 +107,8 @@ TEST(OdeFrictionCone, AnInclineSticksBelowAndSlidesAboveTheModelsCriticalSlope) 
 }
 
 TEST(OdeFrictionCone, AnInclineSlidesWithTheModelsAcceleration) {
-  for (const Case& c : kCases) {
-    SCOPED_TRACE(name(c));
+  for (const FrictionCase& c : kFrictionCases) {
+    SCOPED_TRACE(caseName(c));
     const double alpha = std::atan(1.6 * kMu * frictionRadius(c.k, c.psi));
     SlabRun r = slabOnGround(c.k, alpha, c.psi);
     r.step(10);
@@ -147,8 +129,8 @@ TEST(OdeFrictionCone, AnInclineSlidesWithTheModelsAcceleration) {
 }
 
 TEST(OdeFrictionCone, ABoxPushedAlongTheGroundSlowsWithTheModelsFriction) {
-  for (const Case& c : kCases) {
-    SCOPED_TRACE(name(c));
+  for (const FrictionCase& c : kFrictionCases) {
+    SCOPED_TRACE(caseName(c));
     const double speed = 3;
     SlabRun r = slabOnGround(c.k, 0, 0, speed * std::cos(c.psi), speed * std::sin(c.psi));
     r.step(5);
