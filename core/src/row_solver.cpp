@@ -373,10 +373,10 @@ IslandSolve RowSolver::solveScreened(const RowSystem& rows, const Vector& start,
   const bool autoChoice = equals(settings_.solver, "auto");
   const Policy& policy = settings_.policy;
   Slot& island = slot(key);
-  // An island that runs pgs first after a breakdown (below) keeps the box meanwhile.
+  // The cone is tried on every solve: the demotion to pgs below is the box's rule (the cone is
+  // a model the caller asked for, and pgs cannot take its LCP).
   const bool cone = settings_.friction == FrictionModel::Cone &&
-                    out.problemClass == ProblemClass::Findex &&
-                    !(autoChoice && island.pgsFirst > 0) && buildCone(rows, start, out);
+                    out.problemClass == ProblemClass::Findex && buildCone(rows, start, out);
   if (!capturePrefix_.empty()) cone ? capture(cone_.problem()) : capture(rows);
 
   Result r;
@@ -398,7 +398,7 @@ IslandSolve RowSolver::solveScreened(const RowSystem& rows, const Vector& start,
   if (r.status == Status::InvalidInput || r.status == Status::Unsupported) x = start;
   out.choice = out.requested;
   if (!acceptable(r, settings_.acceptResidual)) {
-    if (autoChoice && !equals(out.requested, "pgs") && !equals(out.requested, "ldlt") &&
+    if (autoChoice && !cone && !equals(out.requested, "pgs") && !equals(out.requested, "ldlt") &&
         policy.demotes(r, settings_.acceptResidual))
       island.pgsFirst = policy.pgsAfterBreakdown;
     r = fallBack(rows, start, x, island, out, std::move(r), share, t0);

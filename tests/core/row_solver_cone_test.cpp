@@ -229,6 +229,25 @@ TEST(RowSolverCone, APrimaryThatCannotTakeTheLcpFallsBackToTheBox) {
   EXPECT_TRUE(x.allFinite());
 }
 
+// A rejected cone answer (lemke's false ray termination at cfm 1e-8, see friction_model.hpp)
+// falls back to the box for that solve only: the box's pgs-first memory after a breakdown does
+// not take the cone from the island for its next solves.
+TEST(RowSolverCone, ARejectedConeAnswerDoesNotCostTheIslandTheConeLater) {
+  const Vector6 v = pushed(2, kPi / 8);
+  const RowSystem hard = cubeOnGround(kCorners, v, 0.5, 1e-8);
+  const RowSystem easy = cubeOnGround(kCorners, v, 0.5, kCfm);
+  RowSolver solver(coneSettings(8));
+  Vector x;
+  IslandSolve s = solver.solve(hard, Vector::Zero(hard.size()), x, 7);
+  ASSERT_TRUE(s.fellBack) << "lemke solved the hard case: " << s.result.message;
+  EXPECT_EQ(s.friction, FrictionModel::Box);
+  for (int i = 0; i < 3; ++i) {
+    s = solver.solve(easy, Vector::Zero(easy.size()), x, 7);
+    EXPECT_EQ(s.friction, FrictionModel::Cone) << i << ": " << s.result.message;
+    EXPECT_EQ(s.choice, "lemke") << i;
+  }
+}
+
 // Contacts the cone cannot express (here rolling friction: a third friction row) keep the box.
 TEST(RowSolverCone, AnIslandTheConeCannotExpressKeepsTheBoxAndSaysWhy) {
   const RowSystem rows =

@@ -35,7 +35,9 @@
 //     friction rows is solved instead as the polyhedral cone's standard LCP (RowSolver::solveCone:
 //     FrictionCone built from the rows, the start mapped into it, the requested solver or for
 //     "auto" the policy's choice for an LCP with zero diagonal entries, lemke; its residual
-//     recomputed on that LCP), and the answer mapped back to the rows' impulses.
+//     recomputed on that LCP), and the answer mapped back to the rows' impulses. The pgs-first
+//     memory of stage 2 is the box's: the cone runs on every solve (pgs cannot take its LCP,
+//     and one rejected lemke answer would otherwise cost the island the cone for 30 steps).
 //  4. verify and fall back, by the one fallback rule of policy.hpp: an answer is acceptable when
 //     its status is not a breakdown and its residual, recomputed from the rows by residual.hpp,
 //     is finite and <= acceptResidual; an unacceptable one sends the island to the fallback
