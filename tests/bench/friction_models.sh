@@ -7,11 +7,13 @@
 # LCP's); box_answers: steps whose answer came from box friction (a rejected cone answer's box
 # fallback, or the box model itself). slide_diagonal only: where the slab stops against the
 # closed form of isotropic Coulomb friction (0.794, 0.459), heading 30 degrees, 0.917 m.
-# Usage: tests/bench/friction_models.sh MLCP_BINARY OUT.csv [SCENES...]
+# steps: the steps done within the wall-clock limit of each run (LIMIT_SECONDS, default 120).
+# Usage: tests/bench/friction_models.sh MLCP_BINARY OUT.csv [LIMIT_SECONDS] [SCENES...]
 set -uo pipefail
 mlcp=$1
 out=$2
-shift 2
+limit=${3:-120}
+shift 3 2>/dev/null || shift $#
 repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 scenes=("$@")
 [ ${#scenes[@]} -gt 0 ] || scenes=(slide_diagonal stack_10 pyramid_15)
@@ -25,13 +27,16 @@ for scene in "${scenes[@]}"; do
       # k = 16 on the slab only: lemke's dense tableau makes it seconds a step on a pyramid.
       [ "$scene" != slide_diagonal ] && [ "$2" = 16 ] && continue
       steps=$([ "$scene" = slide_diagonal ] && echo 60 || echo 100)
-      "$mlcp" run "$repo/scenes/$scene.json" --engine "$engine" --friction "$1" \
+      timeout "$limit" "$mlcp" run "$repo/scenes/$scene.json" --engine "$engine" --friction "$1" \
         --friction-directions "$2" --steps "$steps" --time-budget 0 \
         --csv "$work/run.csv" --trajectory "$work/traj.csv" > /dev/null 2>&1
       python3 - "$scene" "$engine" "$1" "$2" "$work/run.csv" "$work/traj.csv" >> "$out" <<'EOF'
 import csv, math, sys
 scene, engine, model, k, run, traj = sys.argv[1:]
 rows = list(csv.DictReader(open(run)))
+if not rows:
+    print(",".join([scene, engine, model, k, "0"] + [""] * 9))
+    sys.exit()
 ms = [float(r["solver_ms"]) for r in rows]
 res = max(float(r["residual"]) for r in rows)
 # A step answered by the box: the model is the box, or some island's answer came from pgs (the
