@@ -145,6 +145,28 @@ TEST(OdeFrictionCone, ABoxPushedAlongTheGroundSlowsWithTheModelsFriction) {
   }
 }
 
+// mu = dInfinity (no slip) reaches the core as free tangent rows (island.cpp): with the cone
+// selected they stay free rows, and the slab holds a 60 degree slope; mu = 0 slides freely.
+TEST(OdeFrictionCone, InfiniteMuHoldsAndZeroMuSlidesWithTheConeSelected) {
+  const double alpha = kConePi / 3;
+  for (const double mu : {static_cast<double>(dInfinity), 0.0}) {
+    SlabRun r = slabOnGround(8, alpha, 0.3);
+    r.scene->surface.mu = mu;
+    r.step(10);
+    const dReal* p = dBodyGetPosition(r.body());
+    const double x0 = p[0], y0 = p[1];
+    r.step(50);
+    const double moved = std::hypot(p[0] - x0, p[1] - y0);
+    EXPECT_EQ(r.rejected, 0) << mu;
+    if (mu > 0) {
+      EXPECT_LT(moved, 1e-3);
+    } else {  // frictionless: a = g sin(alpha); semi-implicit Euler moves a h^2 n (n + 1) / 2
+      const double a = kG * std::sin(alpha);
+      EXPECT_NEAR(moved, a * kH * kH * (60 * 61 - 10 * 11) / 2, 1e-3 * moved);
+    }
+  }
+}
+
 TEST(OdeFrictionCone, BadSettingsAreClearErrors) {
   Settings s = settingsFor(4);
   for (const char* name : {"pgs", "ode-step", "ode-lcp"}) {
