@@ -20,6 +20,7 @@ std::pair<double, double> direction(double theta) {
 
 std::string FrictionCone::build(const RowSystem& rows, int directions, bool sparse) {
   if (directions < 3) return "the friction cone needs at least 3 directions per contact";
+  directions_ = directions;
   if (std::string why = rows.validate(); !why.empty()) return why;
   boxSize_ = rows.size();
   if (std::string why = groupContacts(rows); !why.empty()) {
@@ -35,6 +36,8 @@ std::string FrictionCone::build(const RowSystem& rows, int directions, bool spar
 // (or a single tangent) on the normal's bodies.
 std::string FrictionCone::groupContacts(const RowSystem& rows) {
   contacts_.clear();
+  dropped_.clear();
+  frictionless_ = 0;
   std::map<int, std::vector<int>> tangents;  // normal row -> its friction rows, in row order
   for (int i = 0; i < rows.size(); ++i)
     if (!rows.findex.empty() && rows.findex[i] >= 0) tangents[rows.findex[i]].push_back(i);
@@ -52,9 +55,16 @@ std::string FrictionCone::groupContacts(const RowSystem& rows) {
     for (int t : ts) {
       if (std::abs(rows.hi[t] - c.mu) > 1e-12 * (1 + c.mu))
         return where + "anisotropic friction (its tangents have different mu)";
+      if (rows.lo[t] != -rows.hi[t])
+        return where + "friction bounds not of the form -mu..mu (row " + std::to_string(t) + ")";
       if (rows.rows[t].bodyA != rows.rows[normal].bodyA ||
           rows.rows[t].bodyB != rows.rows[normal].bodyB)
         return where + "a friction row acts on other bodies than its normal";
+    }
+    if (c.mu == 0) {  // no friction (see the header)
+      ++frictionless_;
+      dropped_.insert(dropped_.end(), ts.begin(), ts.end());
+      continue;
     }
     contacts_.push_back(c);
   }
@@ -71,6 +81,7 @@ void FrictionCone::buildDirections(const RowSystem& rows, int directions) {
     tangent[c.t1] = true;
     if (c.t2 >= 0) tangent[c.t2] = true;
   }
+  for (int t : dropped_) tangent[t] = true;
   kept_.clear();
   for (int i = 0; i < rows.size(); ++i)
     if (!tangent[i]) {

@@ -99,6 +99,10 @@ RowSolver::RowSolver(const RowSolverSettings& settings) : settings_(settings) {
   setTimeBudget(settings_.timeBudget);
   if (!(settings_.minShare > 0 && settings_.minShare <= 1))
     throw std::invalid_argument("mlcp::RowSolver: minShare must be in (0, 1]");
+  if (const std::string why =
+          frictionSettingsError(settings_.friction, settings_.frictionDirections, settings_.solver);
+      !why.empty())
+    throw std::invalid_argument("mlcp::RowSolver: " + why);
 }
 
 void RowSolver::setTimeBudget(double seconds) {
@@ -158,10 +162,12 @@ RowSolver::Slot& RowSolver::slot(std::uint64_t key) {
   return *it->second;
 }
 
-Solver* RowSolver::assembledSolver(Slot& island, const std::string& name) {
+Solver* RowSolver::assembledSolver(Slot& island, const std::string& name, const char* tag) {
   for (auto& [n, solver] : island.solvers)
-    if (n == name) return solver.get();
-  island.solvers.emplace_back(name, makeSolver(name));
+    if (n.size() == name.size() + std::strlen(tag) && n.compare(0, std::strlen(tag), tag) == 0 &&
+        n.compare(std::strlen(tag), std::string::npos, name) == 0)
+      return solver.get();
+  island.solvers.emplace_back(tag + name, makeSolver(name));
   // solve() times the whole island (assembly, solve, check) with fewer clock reads.
   island.solvers.back().second->setTimed(false);
   return island.solvers.back().second.get();
@@ -227,9 +233,59 @@ void RowSolver::assemble(const RowSystem& rows, bool sparse) {
 
 void RowSolver::capture(const RowSystem& rows) {
   if (!haveAssembled_) assemble(rows, rows.size() > settings_.denseMaxRows);
+  capture(assembled_);
+}
+
+void RowSolver::capture(const Problem& problem) {
   const std::string path = capturePrefix_ + "island" + std::to_string(captured_.size()) + ".json";
-  io::writeProblemJson(assembled_, path);
+  io::writeProblemJson(problem, path);
   captured_.push_back(path);
+}
+
+bool RowSolver::buildCone(const RowSystem& rows, const Vector& start, IslandSolve& out) {
+  if (start.size() != rows.size()) return false;  // the box's solve reports the start
+  const double t0 = settings_.timeAssembly ? nowSeconds() : 0;
+  // About the cone's size (a contact's 3 rows become k + 2 unknowns), for the storage only.
+  const int size = rows.size() * (settings_.frictionDirections + 2) / 3;
+  coneNote_ = cone_.build(rows, settings_.frictionDirections, size > settings_.denseMaxRows);
+  if (settings_.timeAssembly) out.assembleSeconds += nowSeconds() - t0;
+  if (!coneNote_.empty()) coneNote_ = "cone not built (" + coneNote_ + "): box friction; ";
+  return coneNote_.empty();
+}
+
+// The cone's LCP from the box start, by the requested solver or auto's choice for an LCP with
+// zero diagonal entries; its residual recomputed on that LCP (residual.hpp), never taken from
+// the solver; the answer as the rows' impulses.
+Result RowSolver::solveCone(const Vector& start, Vector& x, Slot& island, IslandSolve& out,
+                            double share, double t0) {
+  const Problem& p = cone_.problem();
+  if (equals(settings_.solver, "auto")) {
+    const bool spent = share > 0 && share <= settings_.minShare * settings_.timeBudget;
+    out.requested =
+        settings_.policy
+            .choose(ProblemClass::StandardLcp, p.size(), settings_.options.tolerance, false, spent)
+            .solver;
+  } else {
+    out.requested = settings_.solver;
+  }
+  Solver* solver = assembledSolver(island, out.requested, "cone:");
+  Options o = withBudget(settings_.options, share, t0);
+  o.warmStart = true;
+  solver->setOptions(o);
+  coneStart_ = cone_.toCone(start);
+  coneX_.resize(0);  // a refused problem leaves it untouched: then the start stands
+  Result r = solver->solveWithGuess(p, coneStart_, coneX_);
+  if (coneX_.size() == p.size()) {
+    applyAccuracy(r, accuracy(p, coneX_), o.tolerance);
+    x = cone_.toBox(coneX_);
+  } else {
+    x = start;
+  }
+  out.friction = FrictionModel::Cone;
+  r.message = "cone k=" + std::to_string(cone_.directions()) + ", " +
+              std::to_string(cone_.contacts()) + " contacts, " + std::to_string(p.size()) +
+              " unknowns: " + r.message;
+  return r;
 }
 
 // Stage 4's fallback (policy.hpp's rule): r is the primary's unacceptable answer, x its x.
@@ -255,6 +311,7 @@ Result RowSolver::fallBack(const RowSystem& rows, const Vector& start, Vector& x
       r = std::move(f);
       x.swap(xFallback_);
       out.choice = settings_.fallback;
+      out.friction = FrictionModel::Box;
     } else {
       r.message = why + "; " + settings_.fallback + " no better (" + toString(f.status) +
                   ", residual " + shortNumber(f.residual) + ")";
@@ -298,6 +355,7 @@ IslandSolve RowSolver::solveScreened(const RowSystem& rows, const Vector& start,
   solveStart_ = t0;
   ++calls_;
   haveAssembled_ = false;
+  coneNote_.clear();
   IslandSolve out;
   const int n = rows.size();
   out.problemClass = classify(rows);
@@ -311,13 +369,20 @@ IslandSolve RowSolver::solveScreened(const RowSystem& rows, const Vector& start,
     out.result.message = "no constraint rows";
     return out;
   }
-  if (!capturePrefix_.empty()) capture(rows);
-
   const double share = islandBudget(t0);
   const bool autoChoice = equals(settings_.solver, "auto");
   const Policy& policy = settings_.policy;
   Slot& island = slot(key);
-  if (autoChoice) {
+  // The cone is tried on every solve: the demotion to pgs below is the box's rule (the cone is
+  // a model the caller asked for, and pgs cannot take its LCP).
+  const bool cone = settings_.friction == FrictionModel::Cone &&
+                    out.problemClass == ProblemClass::Findex && buildCone(rows, start, out);
+  if (!capturePrefix_.empty()) cone ? capture(cone_.problem()) : capture(rows);
+
+  Result r;
+  if (cone) {
+    r = solveCone(start, x, island, out, share, t0);
+  } else if (autoChoice) {
     const bool spent = share > 0 && share <= settings_.minShare * settings_.timeBudget;
     const Choice c = policy.choose(out.problemClass, n, settings_.options.tolerance, true, spent);
     out.requested = c.solver;
@@ -328,17 +393,18 @@ IslandSolve RowSolver::solveScreened(const RowSystem& rows, const Vector& start,
   } else {
     out.requested = settings_.solver;
   }
-  Result r =
-      run(rows, out.requested, withBudget(settings_.options, share, t0), start, x, island, out);
+  if (!cone)
+    r = run(rows, out.requested, withBudget(settings_.options, share, t0), start, x, island, out);
   if (r.status == Status::InvalidInput || r.status == Status::Unsupported) x = start;
   out.choice = out.requested;
   if (!acceptable(r, settings_.acceptResidual)) {
-    if (autoChoice && !equals(out.requested, "pgs") && !equals(out.requested, "ldlt") &&
+    if (autoChoice && !cone && !equals(out.requested, "pgs") && !equals(out.requested, "ldlt") &&
         policy.demotes(r, settings_.acceptResidual))
       island.pgsFirst = policy.pgsAfterBreakdown;
     r = fallBack(rows, start, x, island, out, std::move(r), share, t0);
   }
   out.accepted = acceptable(r, settings_.acceptResidual);
+  if (!coneNote_.empty()) r.message = coneNote_ + r.message;
   r.solver = out.choice;
   r.fallbacks = out.fellBack ? 1 : 0;
   r.seconds = nowSeconds() - t0;

@@ -455,11 +455,16 @@ void parseSettings(const Node& n, Settings& s) {
 }
 
 void parseSolver(const Node& n, SolverDefaults& s) {
-  n.allowOnly({"name", "iterations", "tolerance", "warm_start"});
+  n.allowOnly({"name", "iterations", "tolerance", "warm_start", "friction", "friction_directions"});
   if (n.has("name")) s.name = n.child("name").string();
   if (n.has("iterations")) s.iterations = int(n.child("iterations").integer(1, 100000000));
   s.tolerance = numberOr(n, "tolerance", s.tolerance, &Node::positive);
   if (n.has("warm_start")) s.warmStart = n.child("warm_start").boolean();
+  if (n.has("friction") && !parseFrictionModel(n.child("friction").string(), s.friction))
+    n.child("friction").fail("must be \"box\" or \"cone\"");
+  if (n.has("friction_directions"))
+    s.frictionDirections =
+        int(n.child("friction_directions").integer(kMinConeDirections, kMaxConeDirections));
 }
 
 int jointBody(const Node& n, const Scene& scene) {

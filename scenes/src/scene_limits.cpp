@@ -135,6 +135,8 @@ void checkSettings(const Scene& scene) {
   const Where solver(scene, "solver");
   solver.range("iterations", scene.solver.iterations, 1, double(kMaxIterations), "");
   solver.range("tolerance", scene.solver.tolerance, kMinTolerance, kMaxTolerance, "");
+  solver.range("friction_directions", scene.solver.frictionDirections, kMinConeDirections,
+               kMaxConeDirections, "");
   Where(scene, "scene").magnitude("gravity", scene.gravity, kMaxGravity, "m/s^2");
 }
 

@@ -47,6 +47,8 @@ RunSettings RunSettings::fromScene(const Scene& scene) {
   s.iterations = scene.solver.iterations;
   s.tolerance = scene.solver.tolerance;
   s.warmStart = scene.solver.warmStart;
+  s.friction = scene.solver.friction;
+  s.frictionDirections = scene.solver.frictionDirections;
   return s;
 }
 

@@ -8,47 +8,16 @@
 
 #include <cmath>
 
+#include "common/cube_on_ground.hpp"
 #include "mlcp/lemke.hpp"
 
 namespace mlcp {
 namespace {
 
+using test::cubeOnGround;
+
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kG = 9.81, kDt = 1.0 / 60;
-
-// A unit cube of mass 1 on the ground (the world), contact frame n = z, t1 = x, t2 = y, one
-// contact at each given point (relative to the centre of mass), three rows each: normal, t1, t2
-// with findex to the normal. b = J v for the velocity v the cube would have without contact.
-RowSystem cubeOnGround(const std::vector<Eigen::Vector3d>& points, const Vector6& velocity,
-                       double mu, double cfm = 0) {
-  RowSystem s;
-  BodyInverseMass body;
-  body.invMass = 1;
-  body.invInertia = Eigen::Matrix3d::Identity() * 6.0;  // I = m s^2 / 6 for s = 1
-  s.bodies.push_back(body);
-  const Eigen::Vector3d axes[3] = {Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX(),
-                                   Eigen::Vector3d::UnitY()};
-  const int n = 3 * static_cast<int>(points.size());
-  s.b.resize(n);
-  s.lo.resize(n);
-  s.hi.resize(n);
-  s.cfm = Vector::Constant(n, cfm);
-  s.findex.assign(n, -1);
-  for (std::size_t c = 0; c < points.size(); ++c) {
-    for (int k = 0; k < 3; ++k) {
-      const int i = static_cast<int>(3 * c) + k;
-      ConstraintRow row;
-      row.bodyA = 0;
-      row.jA << axes[k], points[c].cross(axes[k]);
-      s.rows.push_back(row);
-      s.b[i] = row.jA.dot(velocity);
-      s.lo[i] = k == 0 ? 0 : -mu;
-      s.hi[i] = k == 0 ? kInf : mu;
-      if (k > 0) s.findex[i] = static_cast<int>(3 * c);
-    }
-  }
-  return s;
-}
 
 // Solves the cone LCP with lemke, checks it as a standard LCP by hand and returns the box-form
 // impulses.
@@ -179,21 +148,29 @@ TEST(FrictionCone, ContactsTheConeCannotExpressAreRefusedWithAReason) {
   anisotropic.lo[2] = -0.2;
   anisotropic.hi[2] = 0.2;
   EXPECT_NE(cone.build(anisotropic, 4).find("anisotropic"), std::string::npos);
-  RowSystem rolling = rows;  // a third friction row on the same normal (rolling friction)
-  rolling.rows.push_back(rows.rows[1]);
-  rolling.b.conservativeResize(4);
-  rolling.lo.conservativeResize(4);
-  rolling.hi.conservativeResize(4);
-  rolling.cfm.conservativeResize(4);
-  rolling.b[3] = 0;
-  rolling.lo[3] = -0.1;
-  rolling.hi[3] = 0.1;
-  rolling.cfm[3] = 0;
-  rolling.findex.push_back(0);
+  const RowSystem rolling = test::withRollingFriction(rows);
   EXPECT_NE(cone.build(rolling, 4).find("rolling friction"), std::string::npos);
   RowSystem lifted = rows;
   lifted.lo[0] = -1;
   EXPECT_NE(cone.build(lifted, 4).find("lower bound"), std::string::npos);
+}
+
+// mu = 0: the polygon is a point; the contact keeps its normal as a plain LCP row and no
+// directions, and its tangents answer 0.
+TEST(FrictionCone, AFrictionlessContactKeepsOnlyItsNormal) {
+  Vector6 v = Vector6::Zero();
+  v << 1, 0.5, -0.2, 0, 0, 0;
+  RowSystem rows = cubeOnGround({{0, 0, -0.5}, {0.5, 0, -0.5}}, v, 0.4);
+  rows.lo[1] = rows.lo[2] = rows.hi[1] = rows.hi[2] = 0;  // the first contact has mu = 0
+  FrictionCone cone;
+  ASSERT_EQ(cone.build(rows, 8), "");
+  EXPECT_EQ(cone.contacts(), 1);
+  EXPECT_EQ(cone.frictionless(), 1);
+  EXPECT_EQ(cone.problem().size(), 2 + 8 + 1);
+  Vector z = Vector::Constant(cone.problem().size(), 1.0);
+  const Vector x = cone.toBox(z);
+  EXPECT_EQ(x[1], 0);
+  EXPECT_EQ(x[2], 0);
 }
 
 }  // namespace

@@ -52,12 +52,19 @@ static void settersAcceptValidValues(void) {
   CHECK(mlcp_ode_stepper_set_warm_start(s, 0) == MLCP_ODE_OK);
   CHECK(mlcp_ode_stepper_set_contact_match_distance(s, 0.01) == MLCP_ODE_OK);
   CHECK(mlcp_ode_stepper_reset_warm_start(s) == MLCP_ODE_OK);
+  CHECK(mlcp_ode_stepper_set_friction_model(s, MLCP_ODE_FRICTION_MODEL_CONE, 8) == MLCP_ODE_OK);
+  CHECK(mlcp_ode_stepper_set_friction_model(s, MLCP_ODE_FRICTION_MODEL_BOX, 4) == MLCP_ODE_OK);
   mlcp_ode_stepper_destroy(s);
 }
 
 static void settersRejectBadValues(void) {
   mlcp_ode_stepper* s = mlcp_ode_stepper_create("pgs");
   CHECK(s != NULL);
+  CHECK_ERROR(mlcp_ode_stepper_set_friction_model(s, MLCP_ODE_FRICTION_MODEL_CONE, 4),
+              "mlcp_ode_stepper_set_friction_model");
+  CHECK(strstr(mlcp_ode_last_error(), "pgs") != NULL);
+  CHECK_ERROR(mlcp_ode_stepper_set_friction_model(s, MLCP_ODE_FRICTION_MODEL_BOX, 2),
+              "mlcp_ode_stepper_set_friction_model");
   CHECK_ERROR(mlcp_ode_stepper_set_solver_tolerance(s, MLCP_ODE_PRIMARY, 0),
               "mlcp_ode_stepper_set_solver_tolerance");
   CHECK_ERROR(mlcp_ode_stepper_set_solver_tolerance(s, MLCP_ODE_PRIMARY, NAN),

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "mlcp/scene/convex_hull.hpp"
+#include "mlcp/scene/world.hpp"
 
 namespace {
 
@@ -228,6 +229,7 @@ const Expected kScenes[] = {
     {"stack_1000", 1001, 1000, 0},
     {"boxes_3000", 3001, 3000, 0},
     {"hull_stack", 9, 8, 0},
+    {"slide_diagonal", 2, 1, 0},  // the friction models' anisotropy
 };
 
 TEST(SceneFiles, EveryFileIsListedAndLoadsWithItsCounts) {
@@ -976,6 +978,31 @@ TEST(SceneErrors, NewShapesAndJoints) {
   expectError(joints(R"({"type": "gear", "bodies": ["b", "c"], "axis": [0, 0, 1],
       "limits": {"lower": 0, "upper": 1}, "ratio": 1})"),
               {"joints[0]: unknown field \"limits\""});
+}
+
+TEST(SceneParse, FrictionModelOfTheRunSettings) {
+  const std::string box =
+      R"({"name": "b", "shape": {"type": "box", "size": [1, 1, 1]}, "mass": 1})";
+  Scene s = parseScene(withBodies(box));
+  EXPECT_EQ(s.solver.friction, mlcp::FrictionModel::Box);
+  EXPECT_EQ(s.solver.frictionDirections, 4);
+  s = parseScene(withBodies(box, R"("solver": {"friction": "cone", "friction_directions": 8},)"));
+  EXPECT_EQ(s.solver.friction, mlcp::FrictionModel::Cone);
+  EXPECT_EQ(s.solver.frictionDirections, 8);
+  const RunSettings run = RunSettings::fromScene(s);
+  EXPECT_EQ(run.friction, mlcp::FrictionModel::Cone);
+  EXPECT_EQ(run.frictionDirections, 8);
+}
+
+TEST(SceneErrors, FrictionModelAndDirections) {
+  const std::string box =
+      R"({"name": "b", "shape": {"type": "box", "size": [1, 1, 1]}, "mass": 1})";
+  expectError(withBodies(box, R"("solver": {"friction": "pyramid"},)"),
+              {"solver.friction", "must be \"box\" or \"cone\""});
+  expectError(withBodies(box, R"("solver": {"friction_directions": 2},)"),
+              {"solver.friction_directions"});
+  expectError(withBodies(box, R"("solver": {"friction_directions": 65},)"),
+              {"solver.friction_directions"});
 }
 
 }  // namespace

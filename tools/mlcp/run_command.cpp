@@ -30,6 +30,8 @@ struct RunArgs {
   std::string fallback = "pgs";
   double fallbackResidual = -1;
   double timeBudget = -1;  // -1: the adapters' default
+  std::string friction;    // "" : the scene's
+  int frictionDirections = -1;
   std::string csv;
   std::string trajectory;
   int capture = -1;  // -1: no capture
@@ -53,6 +55,8 @@ int runScene(const RunArgs& args) {
   run.fallback = args.fallback == "none" ? "" : args.fallback;
   if (args.fallbackResidual >= 0) run.fallbackResidual = args.fallbackResidual;
   if (args.timeBudget >= 0) run.timeBudget = args.timeBudget;
+  if (!args.friction.empty()) parseFrictionModel(args.friction, run.friction);  // checked by CLI11
+  if (args.frictionDirections >= 0) run.frictionDirections = args.frictionDirections;
   const int steps = args.steps >= 0 ? args.steps : s.settings.steps;
 
   std::unique_ptr<scene::World> world;
@@ -176,6 +180,15 @@ Runner addRunCommand(CLI::App& app) {
                   "only; default 0.05): islands solved after it ran out get a minimal share and "
                   "answers stopped by it report time-limit")
       ->check(nonNegativeNumber());
+  cmd->add_option("--friction", args->friction,
+                  "friction model: box (the engines' own) or cone (the polyhedral cone's LCP; "
+                  "core solvers that take an LCP: auto, lemke, dantzig) (default: the scene's "
+                  "solver.friction, box)")
+      ->check(CLI::IsMember({"box", "cone"}));
+  cmd->add_option("--friction-directions", args->frictionDirections,
+                  "friction directions per contact of the cone, 3 to 64 (default: the scene's "
+                  "solver.friction_directions, 4)")
+      ->check(CLI::Range(kMinConeDirections, kMaxConeDirections));
   cmd->add_option("--csv", args->csv, "CSV file to write (one row per step)");
   cmd->add_option("--trajectory", args->trajectory,
                   "trajectory CSV to write, one row per step and dynamic body: " +

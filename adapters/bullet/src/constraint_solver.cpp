@@ -52,12 +52,21 @@ void accumulate(StepStats& into, const StepStats& from) {
   into.failures += from.failures;
   into.choices.add(from.choices);
   into.packedIslands += from.packedIslands;
+  into.coneIslands += from.coneIslands;
   into.screened.add(from.screened);
   worst(into, from);
 }
 
 ConstraintSolver::ConstraintSolver(const Settings& settings) : settings_(settings) {
   si_ = settings_.solver == "si";
+  if (si_ && settings_.friction == FrictionModel::Cone)
+    throw std::invalid_argument(
+        "mlcp::bullet::ConstraintSolver: friction 'cone' needs a core solver; si is Bullet's own "
+        "(box friction)");
+  if (const std::string why =
+          frictionSettingsError(settings_.friction, settings_.frictionDirections, settings_.solver);
+      !why.empty())
+    throw std::invalid_argument("mlcp::bullet::ConstraintSolver: " + why);
   RowSolverSettings rs = settings_;
   if (si_) rs.solver = "pgs";  // only the fallback name is checked
   // The same sweeps from the same start give the same answer: no second run.
@@ -293,6 +302,7 @@ void ConstraintSolver::solveIsland(Island& island, std::uint64_t key, bool split
   current_.fallbacks += solved.fellBack;
   current_.screened.add(solved.screened);
   current_.failures += !solved.accepted;
+  current_.coneIslands += solved.friction == FrictionModel::Cone;
   if (current_.message.empty() && (solved.fellBack || !solved.accepted))
     current_.message = result.message;
   record(result, n, solved.choice);

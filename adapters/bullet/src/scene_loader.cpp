@@ -95,6 +95,9 @@ class BulletWorld : public scene::World {
   BulletWorld(const scene::Scene& s, const scene::RunSettings& run) : scene::World(s) {
     std::unique_ptr<btConstraintSolver> solver;
     const std::string& name = run.solver;
+    if (run.friction == FrictionModel::Cone && name.rfind("bullet-", 0) == 0)
+      throw std::invalid_argument("friction 'cone' needs a core solver; '" + name +
+                                  "' is Bullet's own (box friction)");
     if (name == "bullet-si") {
       solver = std::make_unique<btSequentialImpulseConstraintSolver>();
       fixedSweeps_ = true;
@@ -117,6 +120,8 @@ class BulletWorld : public scene::World {
       settings.acceptResidual = run.fallbackResidual;
       settings.engineIterations = run.engineIterations;  // m_numIterations is run.iterations
       settings.timeBudget = run.timeBudget;
+      settings.friction = run.friction;
+      settings.frictionDirections = run.frictionDirections;
       solver = scenes::makeBulletSolver(name, settings);  // throws for unknown names
       ours_ = static_cast<ConstraintSolver*>(solver.get());
     }

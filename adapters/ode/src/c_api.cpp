@@ -207,6 +207,16 @@ int mlcp_ode_stepper_set_contact_match_distance(mlcp_ode_stepper* s, double dist
   });
 }
 
+int mlcp_ode_stepper_set_friction_model(mlcp_ode_stepper* s, int model, int directions) {
+  return rebuild("mlcp_ode_stepper_set_friction_model", s, [&](Settings& settings) {
+    require(model == MLCP_ODE_FRICTION_MODEL_BOX || model == MLCP_ODE_FRICTION_MODEL_CONE,
+            "model must be MLCP_ODE_FRICTION_MODEL_BOX or MLCP_ODE_FRICTION_MODEL_CONE");
+    settings.friction = model == MLCP_ODE_FRICTION_MODEL_CONE ? mlcp::FrictionModel::Cone
+                                                              : mlcp::FrictionModel::Box;
+    settings.frictionDirections = directions;
+  });
+}
+
 int mlcp_ode_stepper_reset_warm_start(mlcp_ode_stepper* s) {
   return guarded("mlcp_ode_stepper_reset_warm_start", MLCP_ODE_ERROR, [&] {
     stepperOf(s).resetWarmStart();

@@ -274,6 +274,9 @@ Result solveWithOdeLcp(IslandWork& w, int nub, dxWorldProcessMemArena* arena,
 Method makeMethod(const std::string& name, RowSolverSettings settings) {
   Method m;
   m.name = name;
+  if (settings.friction == FrictionModel::Cone && name.rfind("ode-", 0) == 0)
+    throw std::invalid_argument("mlcp::ode::Stepper: friction 'cone' needs a core solver; '" +
+                                name + "' is ODE's own (box friction)");
   if (name == "ode-step") {
     m.kind = Method::Kind::ForwardStep;
   } else if (name == "ode-quickstep") {
@@ -498,6 +501,7 @@ void mlcp::ode::Stepper::Impl::runIsland(const dxStepperProcessingCallContext* c
     st.fellBack = solved.fellBack;
     st.accepted = solved.accepted;
     st.screened = solved.screened;
+    st.friction = solved.friction;
 
     if (hasReference) {
       const double tr = nowSeconds();

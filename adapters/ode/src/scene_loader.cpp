@@ -95,6 +95,9 @@ class OdeWorld : public scene::World {
  public:
   OdeWorld(const scene::Scene& s, const scene::RunSettings& run) : scene::World(s) {
     std::string stepperName = run.solver;
+    if (run.friction == FrictionModel::Cone && run.solver.rfind("ode-", 0) == 0)
+      throw std::invalid_argument("friction 'cone' needs a core solver; '" + run.solver +
+                                  "' is ODE's own (box friction)");
     if (run.solver == "ode-world") {
       stepperName = "ode-lcp";
     } else if (run.solver == "ode-quick") {
@@ -112,6 +115,8 @@ class OdeWorld : public scene::World {
     options.fallback = run.fallback;  // the stepper never falls back from "ode-..."
     options.acceptResidual = run.fallbackResidual;
     options.timeBudget = run.timeBudget;
+    options.friction = run.friction;
+    options.frictionDirections = run.frictionDirections;
     stepper_ = std::make_unique<Stepper>(stepperName, options);
     iterations_ = run.iterations;
     built_ = buildWorld(s, run);

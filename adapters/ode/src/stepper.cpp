@@ -113,6 +113,10 @@ Stepper::Stepper(const Settings& options) : impl_(std::make_unique<Impl>()) {
   impl_->options = options;
   impl_->stepOptions = options.options;
   RowSolverSettings rs = options;
+  if (const std::string why =
+          frictionSettingsError(options.friction, options.frictionDirections, options.solver);
+      !why.empty())
+    throw std::invalid_argument("mlcp::ode::Stepper: " + why);
   if (!options.fallback.empty() && !RowSolver::known(options.fallback))
     throw std::invalid_argument("mlcp::ode::Stepper: fallback '" + options.fallback +
                                 "' is not a core solver (known: " + solverNames() + ")");

@@ -34,10 +34,16 @@
 // suits pivoting (lemke), not pgs. toBox() maps an answer back to the engine's rows: the
 // normal impulse, and t1 = sum_j beta_j cos(theta_j), t2 = sum_j beta_j sin(theta_j).
 //
+// The two ends of mu, where the cone degenerates: mu = 0 is no friction (the polygon is a
+// point), so the contact's tangent rows answer 0 and its normal stays as a plain LCP row, without
+// k + 1 unknowns that could only be 0 (counted by frictionless()). mu = +inf (no slip, ODE's
+// dInfinity) never reaches it with findex: rows with findex need a finite mu (problem.hpp), and
+// the ODE adapter hands such contacts over as free tangent rows, which are kept as they are.
+//
 // Contacts the cone cannot express are refused with a reason, and the caller keeps the box:
 // more than two friction rows on one normal (Bullet's rolling friction), two tangents with
-// different mu (anisotropic friction) or on different bodies than their normal, a normal row
-// whose lower bound is not 0.
+// different mu (anisotropic friction), bounds not of the form -mu..mu, tangents on other bodies
+// than their normal, a normal row whose lower bound is not 0.
 #pragma once
 
 #include <string>
@@ -62,7 +68,10 @@ class FrictionCone {
   // The standard-LCP (plus kept rows) problem: unknowns [kept rows; per contact its directions;
   // one lambda per contact].
   const Problem& problem() const { return problem_; }
+  // Contacts in cone form (mu > 0), and those with mu = 0 (see above).
   int contacts() const { return static_cast<int>(contacts_.size()); }
+  int frictionless() const { return frictionless_; }
+  int directions() const { return directions_; }
 
   // A box-form start (size of the rows) in cone form: kept rows copied, each contact's tangent
   // impulse split over the two directions around it (nonnegative), lambda 0.
@@ -84,6 +93,8 @@ class FrictionCone {
   void assembleWithLambdas(bool sparse);
 
   std::vector<Contact> contacts_;
+  std::vector<int> dropped_;  // tangent rows of mu = 0 contacts (answer 0)
+  int frictionless_ = 0, directions_ = kDefaultConeDirections;
   std::vector<int> kept_;       // cone index i < kept_.size() holds box row kept_[i]
   std::vector<double> angles_;  // per cone direction index, theta_j (others unused)
   int boxSize_ = 0;

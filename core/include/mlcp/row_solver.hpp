@@ -31,6 +31,13 @@
 //     rows and sparse above. Solver objects live per island key and name, so the sparse analyses
 //     of ldlt and dantzig (ordering, elimination tree) are redone only when that island's
 //     pattern changes, and RowPgs' buffers are reused.
+//     With friction "cone" (RowSolverSettings::friction, friction_model.hpp) an island with
+//     friction rows is solved instead as the polyhedral cone's standard LCP (RowSolver::solveCone:
+//     FrictionCone built from the rows, the start mapped into it, the requested solver or for
+//     "auto" the policy's choice for an LCP with zero diagonal entries, lemke; its residual
+//     recomputed on that LCP), and the answer mapped back to the rows' impulses. The pgs-first
+//     memory of stage 2 is the box's: the cone runs on every solve (pgs cannot take its LCP,
+//     and one rejected lemke answer would otherwise cost the island the cone for 30 steps).
 //  4. verify and fall back, by the one fallback rule of policy.hpp: an answer is acceptable when
 //     its status is not a breakdown and its residual, recomputed from the rows by residual.hpp,
 //     is finite and <= acceptResidual; an unacceptable one sends the island to the fallback
@@ -80,6 +87,8 @@
 #include <utility>
 #include <vector>
 
+#include "mlcp/friction_cone.hpp"
+#include "mlcp/friction_model.hpp"
 #include "mlcp/policy.hpp"
 #include "mlcp/problem.hpp"
 #include "mlcp/result.hpp"
@@ -169,6 +178,13 @@ struct RowSolverSettings {
   // primary's own name is not run (the same sweeps from the same start give the same answer).
   // Set false (and options.maxIterations) for more accuracy. Default true.
   bool engineIterations = true;
+  // Friction model of islands with friction rows (friction_model.hpp): Box, the engine's rows as
+  // they are, or Cone, the polyhedral cone's standard LCP (pivoting solvers only: pgs, gs and
+  // ldlt are refused as the primary; the fallback runs on the box rows). Default Box.
+  FrictionModel friction = FrictionModel::Box;
+  // Friction directions per contact of the cone, in [kMinConeDirections, kMaxConeDirections]
+  // ([3, 64]). Default kDefaultConeDirections (4: the engine's tangents +-t1, +-t2).
+  int frictionDirections = kDefaultConeDirections;
 };
 
 // Sets options' sweep limit to an engine's iteration count, checked once at the end.
@@ -192,6 +208,10 @@ struct IslandSolve {
   bool accepted = true;        // the returned answer passes acceptable()
   double assembleSeconds = 0;  // part of result.seconds spent classifying and assembling A
   ScreenCounts screened;       // rows screened in stage 0 (inert ones answered x = 0)
+  // The friction model of the returned answer: Cone when the cone's LCP answered (result then
+  // holds that LCP's residual), Box otherwise (no friction rows, the cone refused the island,
+  // or the fallback's box answer was returned).
+  FrictionModel friction = FrictionModel::Box;
 };
 
 // Counts of IslandSolve::choice over a step, e.g. "dantzig:3 ldlt:1 none:2".
@@ -213,7 +233,8 @@ class ChoiceCounts {
 class RowSolver {
  public:
   // Throws std::invalid_argument naming the known solvers for an unknown solver or fallback
-  // name, and for a negative or NaN acceptResidual, timeBudget or minShare outside (0, 1].
+  // name, for a negative or NaN acceptResidual, timeBudget or minShare outside (0, 1], and for
+  // frictionDirections outside [3, 64] or the cone with a primary that cannot take its LCP.
   explicit RowSolver(const RowSolverSettings& settings = RowSolverSettings());
   ~RowSolver();
   RowSolver(const RowSolver&) = delete;
@@ -263,16 +284,23 @@ class RowSolver {
   IslandSolve solveScreened(const RowSystem& rows, const Vector& start, Vector& x,
                             std::uint64_t islandKey);
   Slot& slot(std::uint64_t key);
-  Solver* assembledSolver(Slot& island, const std::string& name);
+  // The island's solver of this name, kept under tag + name (the cone's apart from the box's).
+  Solver* assembledSolver(Slot& island, const std::string& name, const char* tag = "");
   Result run(const RowSystem& rows, const std::string& name, const Options& options,
              const Vector& start, Vector& x, Slot& island, IslandSolve& report);
   Result fallBack(const RowSystem& rows, const Vector& start, Vector& x, Slot& island,
                   IslandSolve& out, Result r, double share, double t0);
   void assemble(const RowSystem& rows, bool sparse);
+  // Stage 3 with friction "cone": builds the cone's LCP (false: the rows do not fit, the reason
+  // goes to out's message and the box runs), then solves it.
+  bool buildCone(const RowSystem& rows, const Vector& start, IslandSolve& out);
+  Result solveCone(const Vector& start, Vector& x, Slot& island, IslandSolve& out, double share,
+                   double t0);
   // A time-limited answer x is replaced by the start when the start's residual is lower.
   static void keepStartIfBetter(const RowSystem& rows, const Vector& start, Vector& x, Result& r,
                                 double tolerance);
   void capture(const RowSystem& rows);
+  void capture(const Problem& problem);
 
   RowSolverSettings settings_;
   RowPgs rowPgs_;
@@ -290,6 +318,9 @@ class RowSolver {
   bool stepOpen_ = false;     // beginStep() was called: solves share a step's budget
   bool stepPending_ = false;  // the next solve starts the step's clock
   double stepStart_ = 0;
+  FrictionCone cone_;
+  Vector coneStart_, coneX_;
+  std::string coneNote_;  // why the last island kept the box ("" when the cone was built)
   std::string capturePrefix_;
   std::vector<std::string> captured_;
 };

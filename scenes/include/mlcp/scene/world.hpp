@@ -70,6 +70,11 @@ struct RunSettings {
   // Wall-clock budget of one step's solves in seconds, 0 for none (core solvers only;
   // RowSolverSettings::timeBudget). Default the adapters' kDefaultTimeBudget (0.05 s).
   double timeBudget = kDefaultTimeBudget;
+  // Friction model of contacts (mlcp/friction_model.hpp; core solvers only: a stock solver with
+  // Cone is refused). Default Box.
+  FrictionModel friction = FrictionModel::Box;
+  // Friction directions per contact of the cone, in [3, 64]. Default kDefaultConeDirections (4).
+  int frictionDirections = kDefaultConeDirections;
 
   static RunSettings fromScene(const Scene& scene);
 };

@@ -190,7 +190,8 @@ struct StepStats {
   std::string message;         // why the first rejected answer was rejected ("" if none)
   ChoiceCounts choices;        // which solver answered, per island ("dantzig:3 ldlt:1")
   int packedIslands = 0;       // of `islands`: "pgs" answers packed straight from Bullet's rows
-  ScreenCounts screened;       // degenerate rows screened by reason (row_screen.hpp), summed
+  int coneIslands = 0;    // of `islands`: answered by the friction cone's LCP (Settings::friction)
+  ScreenCounts screened;  // degenerate rows screened by reason (row_screen.hpp), summed
 };
 
 // Adds `from`'s counts and times to `into`; keeps the worst residual and status, and the first

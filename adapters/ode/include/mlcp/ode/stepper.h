@@ -38,6 +38,12 @@ typedef struct mlcp_ode_stepper mlcp_ode_stepper;
 #define MLCP_ODE_FRICTION_EXACT 0
 #define MLCP_ODE_FRICTION_FIXED_ONCE 1
 
+/* Friction model of contacts (mlcp::FrictionModel, mlcp/friction_model.hpp): ODE's own box
+ * (dContactApprox1 pyramid, the default), or the polyhedral cone's LCP with k directions per
+ * contact (friction within mu N in every direction; core solvers that take an LCP only). */
+#define MLCP_ODE_FRICTION_MODEL_BOX 0
+#define MLCP_ODE_FRICTION_MODEL_CONE 1
+
 /* A stepper with the named solver and default settings, or NULL (see mlcp_ode_last_error). */
 mlcp_ode_stepper* mlcp_ode_stepper_create(const char* solver);
 void mlcp_ode_stepper_destroy(mlcp_ode_stepper* stepper);
@@ -84,6 +90,12 @@ int mlcp_ode_stepper_set_dense_max_rows(mlcp_ode_stepper* stepper, int rows);
 int mlcp_ode_stepper_set_engine_iterations(mlcp_ode_stepper* stepper, int on);
 int mlcp_ode_stepper_set_warm_start(mlcp_ode_stepper* stepper, int on);
 int mlcp_ode_stepper_set_contact_match_distance(mlcp_ode_stepper* stepper, double distance);
+/* The friction model, MLCP_ODE_FRICTION_MODEL_BOX or MLCP_ODE_FRICTION_MODEL_CONE, and the
+ * cone's directions per contact, 3 to 64 (default 4; checked for either model). Rebuilds the
+ * stepper like the setters above. MLCP_ODE_ERROR (stepper unchanged) for an unknown model,
+ * directions out of range, or the cone with a solver that cannot take an LCP (pgs, gs, ldlt,
+ * ode-step, ode-quickstep, ode-lcp). */
+int mlcp_ode_stepper_set_friction_model(mlcp_ode_stepper* stepper, int model, int directions);
 /* Forget the warm-start cache (e.g. after teleporting bodies). */
 int mlcp_ode_stepper_reset_warm_start(mlcp_ode_stepper* stepper);
 

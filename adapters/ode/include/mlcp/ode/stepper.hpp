@@ -106,6 +106,10 @@ struct IslandStats {
   std::string choice;
   bool fellBack = false;  // the primary's answer was rejected and the fallback ran
   bool accepted = true;   // the applied answer passes mlcp::acceptable
+  // The friction model of the applied answer (Settings::friction; Box when the island has no
+  // friction rows or the fallback's box answer was applied). With Cone, residual is the cone
+  // LCP's.
+  FrictionModel friction = FrictionModel::Box;
   // Degenerate rows screened before the solve, by reason (mlcp/row_screen.hpp): inert ones
   // applied no force (lambda 0), the rest of the island was solved without them.
   ScreenCounts screened;
