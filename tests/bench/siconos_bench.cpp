@@ -70,6 +70,14 @@ std::string number(double v) {
   return s.str();
 }
 
+// A CSV field: in double quotes (doubled inside) when it holds a comma or a quote.
+std::string quoted(const std::string& text) {
+  if (text.find_first_of(",\"") == std::string::npos) return text;
+  std::string q = "\"";
+  for (char c : text) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
 class Report {
  public:
   explicit Report(std::ostream* csv) : csv_(csv) {
@@ -83,7 +91,7 @@ class Report {
       *csv_ << r.island << ',' << r.form << ',' << r.rows << ',' << r.solver << ',' << r.library
             << ',' << number(r.ms) << ',' << r.iterations << ',' << number(r.residual) << ','
             << number(r.findexResidual) << ',' << r.status << ',' << number(r.siconosError) << ','
-            << info << ',' << r.note << '\n';
+            << info << ',' << quoted(r.note) << '\n';
     std::printf("%-40s %-6s %6d %-20s %10.3f ms %6d it  residual %-10s %s%s%s\n", r.island.c_str(),
                 r.form.c_str(), r.rows, r.solver.c_str(), r.ms, r.iterations,
                 number(r.residual).c_str(), r.status.c_str(), r.note.empty() ? "" : "  ",
@@ -115,9 +123,16 @@ Row solveOurs(const std::string& name, const Problem& p, const Settings& s, Vect
   const Result r = solver->solve(p, x);
   row.ms = r.seconds * 1e3;
   row.iterations = r.iterations;
+  row.status = toString(r.status);
+  if (x.size() != p.size()) {  // nothing solved (unsupported, invalid input): no answer to measure
+    row.note = r.message;
+    return row;
+  }
   row.residual = residual(p, x);  // recomputed here, whatever the solver reported
-  row.status = row.residual <= s.tolerance ? "converged" : toString(r.status);
-  if (r.status == Status::Converged && row.residual > s.tolerance) row.status = "failed";
+  if (row.residual <= s.tolerance)
+    row.status = "converged";
+  else if (r.status == Status::Converged)
+    row.status = "failed";
   if (r.solver != name && !r.solver.empty()) row.note = "answered by " + r.solver;
   return row;
 }
