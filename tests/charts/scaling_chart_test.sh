@@ -3,16 +3,7 @@
 # tools/scaling_report.sh into a PNG and writes its section into a document twice: the second run
 # replaces the section in place and keeps the text around it. Skips (exit 77) without the venv.
 set -euo pipefail
-repo=$1
-out=$2
-py="$repo/.venv/bin/python"
-if [ ! -x "$py" ]; then
-  echo "SKIP: $py is missing; run tools/setup.sh to build the chart venv"
-  exit 77
-fi
-rm -rf "$out"
-mkdir -p "$out"
-fail() { echo "FAIL: $*"; exit 1; }
+source "$(dirname "${BASH_SOURCE[0]}")/chart_test_setup.sh" "$1" "$2"
 doc=$out/doc.md
 printf '# Title\n\nbefore\n' > "$doc"
 for run in 1 2; do
