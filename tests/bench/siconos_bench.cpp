@@ -59,7 +59,7 @@ struct Row {
   int rows = 0, iterations = 0, siconosInfo = 0;
   double ms = 0, residual = kNotComputed, findexResidual = kNotComputed,
          siconosError = kNotComputed;
-  bool siconos = false;
+  bool siconos = false;  // a Siconos solver returned: siconos_error and siconos_info hold its own
 };
 
 std::string number(double v) {
@@ -144,7 +144,6 @@ Row solveSiconos(const SiconosSolverInfo& info, const Problem& given, const Prob
   Row row;
   row.solver = info.name;
   row.library = "siconos";
-  row.siconos = true;
   row.rows = given.size();
   if (given.size() * info.sizeFactor > s.maxDenseRows) {
     row.status = "skipped";
@@ -159,6 +158,7 @@ Row solveSiconos(const SiconosSolverInfo& info, const Problem& given, const Prob
     row.note = out.message;
     return row;
   }
+  row.siconos = true;  // its counters are reported
   row.ms = out.ms;
   row.iterations = out.iterations;
   row.siconosInfo = out.info;
