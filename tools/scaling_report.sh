@@ -15,7 +15,7 @@
 # 3. tools/scaling_chart.py draws the chart and writes the section (command, commit, machine,
 #    load average, tables).
 # --quick: two small scenes, 3 steps, 10 s limits (checks the pipeline in about a minute); its
-#          chart and section go to BUILD_DIR/scaling only.
+#          CSVs, chart and section go to BUILD_DIR/scaling-quick only.
 # --chart-only: step 3 on the CSVs left in BUILD_DIR/scaling by an earlier run.
 # Environment: SCALE_STEPS (10), SCALE_LIMIT (40), SOLVE_LIMIT (20), CAPTURE_STEP (5).
 set -euo pipefail
@@ -47,6 +47,7 @@ large=(pyramid_1000 stack_1000)
 boxes=(boxes_3000)
 island_scenes=(stack_10 pyramid_15 pyramid_55 wall_120 pyramid_210)
 if [ $quick -eq 1 ]; then
+  out=$build/scaling-quick
   steps=3; limit=10; solve_limit=10
   small=(stack_10 pyramid_15); large=(); boxes=(); island_scenes=(stack_10 pyramid_15)
 fi
@@ -91,7 +92,7 @@ print(max(files, key=lambda f: json.load(open(f))["n"]))' "$cap")
   } > "$out/machine.txt"
 fi
 
-# A quick run checks the pipeline: its chart and section stay in BUILD_DIR/scaling.
+# A quick run checks the pipeline: its chart and section stay in BUILD_DIR/scaling-quick.
 if [ $quick -eq 1 ]; then
   "$python" "$repo/tools/scaling_chart.py" --dir "$out" --png "$out/scaling.png" --doc "$out/section.md"
 else
