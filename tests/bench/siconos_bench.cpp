@@ -10,7 +10,7 @@
 //           lcp_newton_minFB, lcp_lexicolemke, lcp_pgs;
 //   boxed   its friction bounds fixed at the normals of the reference answer (the lowest residual
 //           of our answers to the findex form): ours and Siconos' relay_pgs, relay_lexicolemke,
-//           relay_avi_caoferris, the latter on the box with infinite bounds capped at
+//           relay_avi_caoferris, all three on the box with its infinite bounds capped at
 //           10 (1 + |x_ref|_inf) (relay Lemke needs ub - lb finite).
 // Ours: pgs, dantzig, newton, lemke and auto from the registry, tolerance --tol, --max-iter
 // sweeps / Newton steps / friction passes, --time-limit as their time budget. Siconos': as

@@ -25,7 +25,7 @@
 // Isolation: each solve runs in a fork()ed child that writes z, the time and Siconos' counters
 // into shared memory; the parent kills it at the wall-clock limit (Siconos solvers take no time
 // budget) and reports a crash (Siconos' numerics_error ends the process) as such. Cost: one fork
-// per solve (~1 ms for a parent of a few hundred MB, copy-on-write).
+// per solve (copy-on-write pages), outside the time reported.
 #pragma once
 
 #include <string>
