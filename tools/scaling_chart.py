@@ -21,6 +21,7 @@ import math
 import os
 import re
 import sys
+import textwrap
 
 BEGIN = "<!-- scaling_report.sh: begin (generated, edit tools/scaling_chart.py) -->"
 END = "<!-- scaling_report.sh: end -->"
@@ -262,7 +263,16 @@ def section(d, step_rows, island_rows, png_name):
             if any(r["form"] == form for r in island_rows):
                 lines += ["", "*%s:*" % title, ""] + island_table(island_rows, form)
     lines += ["", END]
-    return "\n".join(lines) + "\n"
+    return "\n".join(wrap(line) for line in lines) + "\n"
+
+
+def wrap(line):
+    """Prose at 100 columns as the rest of docs/ (tables, code, images and markers as they are)."""
+    if not line or line.startswith(("|", "    ", "<!--", "![", "#")):
+        return line
+    indent = "  " if line.startswith("- ") else ""
+    return textwrap.fill(line, width=100, subsequent_indent=indent, break_long_words=False,
+                         break_on_hyphens=False)
 
 
 def write_section(doc, text):
