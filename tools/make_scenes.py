@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Writes the generated scene files scenes/ragdoll_pile.json and scenes/plank_bridge.json.
+"""Writes the generated scene files scenes/ragdoll_pile.json, scenes/plank_bridge.json and
+scenes/wall_120.json.
 
 Their bodies and joints repeat with rotations the scene generators (stack, pyramid, grid) do
 not express; this script is their source. Run it from anywhere after changing it:
@@ -170,10 +171,38 @@ def plank_bridge(planks=12, sag=0.5):
     }
 
 
+def brick_wall(width=12, height=10, size=1.0, gap=0.01):
+    """ODE's demo_crash wall (WBOXSIZE 1 m cubes in courses on the ground), 12 wide and 10 high,
+    every other course shifted by a quarter cube so that each cube rests on two below (a half
+    shift would leave each shifted course's end cube balanced on the edge below), 1 cm apart
+    sideways so that only the courses touch."""
+    bodies = [{"name": "ground", "shape": {"type": "plane", "normal": [0, 0, 1], "offset": 0}}]
+    pitch = size + gap
+    for k in range(height):
+        shift = pitch / 4 if k % 2 else 0.0
+        for i in range(width):
+            x = (i - (width - 1) / 2) * pitch + shift
+            bodies.append({"name": "brick.%d.%d" % (k, i),
+                           "shape": {"type": "box", "size": [size, size, size]}, "mass": 1,
+                           "position": r([x, 0, size / 2 + k * size])})
+    return {
+        "format": "mlcp-scene/1",
+        "name": "wall_%d" % (width * height),
+        "description": "A brick wall of %d cubes (1 m, 1 kg) on the ground in the manner of ODE's "
+                       "demo_crash wall: %d courses of %d, every other course shifted by a "
+                       "quarter cube, 1 cm apart sideways. Written by tools/make_scenes.py."
+                       % (width * height, height, width),
+        "bodies": bodies,
+        "joints": [],
+    }
+
+
 if __name__ == "__main__":
     check = sys.argv[1:] == ["--check"]
     stale = []
-    for name, scene in (("ragdoll_pile", ragdoll_pile()), ("plank_bridge", plank_bridge())):
+    generated = (("ragdoll_pile", ragdoll_pile()), ("plank_bridge", plank_bridge()),
+                 ("wall_120", brick_wall()))
+    for name, scene in generated:
         path = os.path.join(SCENES, name + ".json")
         text = text_of(scene)
         if check:

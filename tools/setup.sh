@@ -20,6 +20,11 @@ sudo_if_needed() { if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi; }
 # Python's headers, for the bindings (python/, built with nanobind from the venv below).
 packages+=(python3-dev)
 
+# Optional, for the peer benchmark only (tests/bench/siconos_bench: Siconos numerics' solvers on
+# our captured islands); the build finds it or leaves that benchmark out. On Debian 12 it brings
+# 20 packages (HDF5, MUMPS, OpenBLAS, ...) and installed in 7.5 s here.
+packages+=(libsiconos-numerics-dev)
+
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -45,6 +50,21 @@ if [ ${#missing[@]} -gt 0 ] || [ $need_update -eq 1 ]; then
   sudo_if_needed apt-get update -qq
   [ ${#missing[@]} -eq 0 ] || DEBIAN_FRONTEND=noninteractive sudo_if_needed apt-get install -y -qq --no-install-recommends "${missing[@]}" > /dev/null
 fi
+
+# Siconos pulls in OpenBLAS, whose libblas.so.3 / liblapack.so.3 outrank the reference ones in
+# Debian's alternatives: that would change, for every program, the BLAS under CHOLMOD (newton,
+# ldlt) and start its threads. The reference libraries stay the system's (as without Siconos);
+# Siconos itself links OpenBLAS directly.
+multiarch=$(dpkg-architecture -qDEB_HOST_MULTIARCH 2>/dev/null || gcc -dumpmachine)
+for pair in "libblas.so.3 blas" "liblapack.so.3 lapack"; do
+  read -r lib dir <<< "$pair"
+  ref=/usr/lib/$multiarch/$dir/$lib
+  alt=$lib-$multiarch
+  if [ -e "$ref" ] && [ "$(readlink "/etc/alternatives/$alt" 2>/dev/null)" != "$ref" ]; then
+    echo "setup: keeping the reference $lib as the system's (not OpenBLAS's)"
+    sudo_if_needed update-alternatives --set "$alt" "$ref" > /dev/null
+  fi
+done
 
 if [ -x "$repo/tools/fetch-ode-source.sh" ]; then
   "$repo/tools/fetch-ode-source.sh"

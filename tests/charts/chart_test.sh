@@ -3,17 +3,8 @@
 # SVG files, and rejects bad CSVs with a message naming what is wrong. Skips (exit 77) when the
 # venv is missing; tools/setup.sh (run by tools/test.sh) builds it.
 set -euo pipefail
-repo=$1
-out=$2
-py="$repo/.venv/bin/python"
+source "$(dirname "${BASH_SOURCE[0]}")/chart_test_setup.sh" "$1" "$2"
 data="$repo/tests/data/charts"
-if [ ! -x "$py" ]; then
-  echo "SKIP: $py is missing; run tools/setup.sh to build the chart venv"
-  exit 77
-fi
-rm -rf "$out"
-mkdir -p "$out"
-fail() { echo "FAIL: $*"; exit 1; }
 
 check_files() {  # folder, stems...
   local dir=$1; shift

@@ -230,6 +230,7 @@ const Expected kScenes[] = {
     {"boxes_3000", 3001, 3000, 0},
     {"hull_stack", 9, 8, 0},
     {"slide_diagonal", 2, 1, 0},  // the friction models' anisotropy
+    {"wall_120", 121, 120, 0},
 };
 
 TEST(SceneFiles, EveryFileIsListedAndLoadsWithItsCounts) {
@@ -279,9 +280,10 @@ TEST(SceneFiles, NothingInterpenetrates) {
 // Scenes that start at rest: every dynamic body touches (within 1 micrometre) a body or plane
 // whose centre is lower, so nothing drops at the first step.
 TEST(SceneFiles, RestingBodiesTouchTheirSupports) {
-  for (const char* name : {"resting_box", "incline_stick", "incline_slide", "stack_10",
-                           "pyramid_15", "pyramid_55", "pyramid_210", "pyramid_1000",
-                           "heavy_on_small", "mass_ratio_stack", "stack_1000", "hull_stack"}) {
+  for (const char* name :
+       {"resting_box", "incline_stick", "incline_slide", "stack_10", "pyramid_15", "pyramid_55",
+        "pyramid_210", "pyramid_1000", "heavy_on_small", "mass_ratio_stack", "stack_1000",
+        "hull_stack", "wall_120"}) {
     SCOPED_TRACE(name);
     const Scene s = load(name);
     const std::vector<Body> shapes = checkedShapes(s);
