@@ -25,6 +25,11 @@ packages+=(python3-dev)
 # 20 packages (HDF5, MUMPS, OpenBLAS, ...) and installed in 7.5 s here.
 packages+=(libsiconos-numerics-dev)
 
+# Whether OpenBLAS was on the machine before this set-up (see the alternatives below).
+had_openblas=0
+dpkg-query -W -f='${Status}' libopenblas0-pthread 2>/dev/null | grep -q "install ok installed" &&
+  had_openblas=1
+
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -53,10 +58,12 @@ fi
 
 # Siconos pulls in OpenBLAS, whose libblas.so.3 / liblapack.so.3 outrank the reference ones in
 # Debian's alternatives: that would change, for every program, the BLAS under CHOLMOD (newton,
-# ldlt) and start its threads. The reference libraries stay the system's (as without Siconos);
-# Siconos itself links OpenBLAS directly.
+# ldlt) and start its threads. When this set-up is what brought OpenBLAS, the reference libraries
+# stay the system's (as without Siconos; Siconos links OpenBLAS directly); a machine that had
+# OpenBLAS before keeps its owner's choice.
 multiarch=$(dpkg-architecture -qDEB_HOST_MULTIARCH 2>/dev/null || gcc -dumpmachine)
 for pair in "libblas.so.3 blas" "liblapack.so.3 lapack"; do
+  [ $had_openblas -eq 0 ] || break
   read -r lib dir <<< "$pair"
   ref=/usr/lib/$multiarch/$dir/$lib
   alt=$lib-$multiarch
