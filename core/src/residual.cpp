@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace mlcp {
@@ -16,12 +18,25 @@ Accuracy accuracy(const Vector& x, const Vector& w, const Vector& lo, const Vect
   return a.result(bInfNorm);
 }
 
+namespace {
+// x (and w) of another size than the problem's is a caller's error, said in one line.
+void requireSize(const Problem& problem, const Vector& v, const char* what) {
+  if (v.size() != problem.size())
+    throw std::invalid_argument(std::string("accuracy: ") + what + " has " +
+                                std::to_string(v.size()) + " entries, the problem " +
+                                std::to_string(problem.size()) + " rows");
+}
+}  // namespace
+
 Accuracy accuracy(const Problem& problem, const Vector& x, const Vector& w) {
+  requireSize(problem, x, "x");
+  requireSize(problem, w, "w");
   const double bNorm = problem.size() ? problem.b.lpNorm<Eigen::Infinity>() : 0.0;
   return accuracy(x, w, problem.lo, problem.hi, problem.findex, bNorm);
 }
 
 Accuracy accuracy(const Problem& problem, const Vector& x) {
+  requireSize(problem, x, "x");
   return accuracy(problem, x, problem.slack(x));
 }
 

@@ -4,7 +4,9 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <new>
 #include <sstream>
+#include <string>
 
 #include "mlcp/residual.hpp"
 
@@ -113,6 +115,24 @@ bool takeStartIfBetter(Result& r, const Accuracy& start, double tolerance) {
   return true;
 }
 
+// A method whose memory runs out (dense work arrays of a huge island) fails like any other: the
+// answer is the start, measured as such, and the message says why. std::bad_alloc is the one
+// exception caught here; every other error is the caller's to see.
+void Solver::runGuarded(const Problem& problem, const Vector* start, Result& r) {
+  try {
+    run(problem, start_, r);
+  } catch (const std::bad_alloc&) {
+    if (start)
+      start_ = *start;
+    else
+      start_.setZero(problem.size());
+    r.status = Status::Failed;
+    r.iterations = 0;
+    r.message = std::string(name()) + ": out of memory for " + std::to_string(problem.size()) +
+                " rows; the start is returned";
+  }
+}
+
 Result Solver::runChecked(const Problem& problem, Vector& x, const Vector* start) {
   const double t0 = timed_ ? nowSeconds() : 0.0;
   auto elapsed = [&] { return timed_ ? nowSeconds() - t0 : 0.0; };
@@ -134,7 +154,7 @@ Result Solver::runChecked(const Problem& problem, Vector& x, const Vector* start
     }
   } budget{options_, options_.timeBudget > 0 && !(options_.budgetStart > 0)};
   if (budget.set) options_.budgetStart = t0 > 0 ? t0 : nowSeconds();
-  run(problem, start_, r);
+  runGuarded(problem, start, r);
   if (r.status == Status::InvalidInput || r.status == Status::Unsupported) {
     r.seconds = elapsed();
     return r;  // x untouched: nothing was solved

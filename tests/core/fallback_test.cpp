@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <new>
+#include <string>
 
 #include "common/broken_solvers.hpp"
 #include "common/generators.hpp"
@@ -20,6 +22,33 @@ Problem linearSparse(int n, unsigned seed) {
   test::KnownProblem kp = g.linear(g.spd(n));
   kp.problem.setA(kp.problem.toSparse());
   return kp.problem;
+}
+
+// Writes into x, then runs out of memory, as dantzig's dense work arrays did on a 41k-row island
+// (std::bad_alloc ended `mlcp run`).
+class OutOfMemorySolver : public Solver {
+ public:
+  const char* name() const override { return "test-oom"; }
+
+ protected:
+  void run(const Problem&, Vector& x, Result&) override {
+    x.setConstant(1e300);
+    throw std::bad_alloc();
+  }
+};
+
+TEST(Solver, DantzigBadAllocOnHugeIslandIsAFailureNotACrash) {
+  const Problem p = linearSparse(20, 3);
+  OutOfMemorySolver oom;
+  Vector x;
+  const Result r = oom.solve(p, x);
+  EXPECT_EQ(r.status, Status::Failed);
+  EXPECT_NE(r.message.find("out of memory for 20 rows"), std::string::npos) << r.message;
+  ASSERT_EQ(x.size(), 20);
+  EXPECT_EQ(x, Vector::Zero(20));  // the start, not the half-written iterate
+  const Vector guess = Vector::Constant(20, 0.5);
+  oom.solveWithGuess(p, guess, x);
+  EXPECT_EQ(x, guess);
 }
 
 TEST(Ldlt, SolvesSymmetricAndNonSymmetricSystems) {

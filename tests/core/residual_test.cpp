@@ -53,6 +53,19 @@ TEST(Residual, NonFiniteIsReported) {
   EXPECT_EQ(a.residual, kInf);
 }
 
+// An empty x (a solver that returned no answer) read past its end.
+TEST(Residual, WrongSizedXIsAnErrorNotARead) {
+  Problem p(DenseMatrix::Identity(3, 3), Vector::Ones(3));
+  EXPECT_THROW(accuracy(p, Vector()), std::invalid_argument);
+  EXPECT_THROW(residual(p, Vector::Zero(2)), std::invalid_argument);
+  EXPECT_THROW(accuracy(p, Vector::Zero(3), Vector::Zero(4)), std::invalid_argument);
+  try {
+    residual(p, Vector());
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "accuracy: x has 0 entries, the problem 3 rows");
+  }
+}
+
 TEST(Residual, EqualityRowsMeasureW) {
   Problem p(DenseMatrix::Identity(2, 2), Vector::Zero(2));
   p.lo.setConstant(-kInf);

@@ -26,7 +26,8 @@ struct Accuracy {
 };
 
 // Accuracy of x for the problem (w computed as A x + b). A non-finite x or w gives
-// residual = +inf and finite = false.
+// residual = +inf and finite = false; an x or w whose size is not the problem's throws
+// std::invalid_argument naming both sizes.
 Accuracy accuracy(const Problem& problem, const Vector& x);
 // Same, with w supplied (w must equal A x + b; used where w is at hand already).
 Accuracy accuracy(const Problem& problem, const Vector& x, const Vector& w);

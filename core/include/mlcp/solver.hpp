@@ -72,6 +72,7 @@ class Solver {
   // Runs the algorithm on start_ (holding the start point, *start or zeros when null) and swaps
   // it into x.
   Result runChecked(const Problem& problem, Vector& x, const Vector* start);
+  void runGuarded(const Problem& problem, const Vector* start, Result& r);
   // TimeLimit: the start replaces the iterate when its residual is lower.
   void keepStartIfBetter(const Problem& problem, const Vector* start, Result& r);
   Options options_;
