@@ -7,7 +7,6 @@
 #include <cstdint>
 
 #include "mlcp/bullet/constraint_solver.hpp"
-#include "mlcp/detail/row_pack.hpp"
 
 namespace mlcp::bullet {
 
@@ -426,7 +425,7 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
   return out;
 }
 
-[[gnu::always_inline]] inline RowPgs::RowView IslandBuilder::Source::row(int r) {
+RowPgs::RowView IslandBuilder::Source::row(int r) {
   // Bullet's row r + kRowsAhead fetched: its 288 bytes start 16-byte aligned and span five or
   // six lines; the first five hold every field view() reads (bytes 0-264; m_rhsPenetration
   // among the fields past byte 224).
@@ -439,7 +438,7 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
 
 Result IslandBuilder::solvePgs(RowPgs& pgs, Island& island, bool split, Vector& x) {
   Source rows(*this, island, split);
-  return pgs.solveFrom(island.system.bodies, static_cast<int>(island.rows.size()), rows, x);
+  return pgs.solve(island.system.bodies, static_cast<int>(island.rows.size()), rows, x);
 }
 
 void IslandBuilder::fillSystem(Island& isl) {

@@ -66,8 +66,9 @@
 // components are 0 or 1 and f's are equal (any rotation); an island with another body
 // (Island::perRowWriteBack) is written back row by row as the
 // RowSolver path does (tested with factors (0.3, 1, 0.5) and linear factors (1, 0.5, 1)).
-// Its answer passes the same acceptable() rule; a rejected one (or keepIslands, or a caller
-// holding rowSolver()) goes through RowSolver on a RowSystem copy like every other solver. The
+// Its answer passes the same acceptable() rule; a rejected one (and every "pgs" island with
+// Settings::packInPlace false, keepIslands, or a capture set on rowSolver()) goes through
+// RowSolver on a RowSystem copy like every other solver. The
 // iterates are the same as RowSolver's pgs bit for bit (one packing code); the write-back differs
 // by round-off (the bodies' velocities, 1e-9 apart after ~17 steps of a settling pyramid). The
 // cached-impulse start (the default) reads the manifold points in build() and keeps answers in
@@ -157,6 +158,10 @@ struct Settings : RowSolverSettings {
   // With "si": also measure the residual of SI's answer (costs about one sweep; excluded from
   // StepStats::seconds). Default true.
   bool measureSi = true;
+  // "pgs" islands packed straight from Bullet's rows and written back per body ("The pgs path"
+  // above). false: through RowSolver on a RowSystem copy like every other solver (the same
+  // iterates; for side-by-side runs of the two). Default true.
+  bool packInPlace = true;
 };
 
 // One solved problem (an island, or its split-impulse twin) of the last step.
@@ -213,12 +218,9 @@ class ConstraintSolver : public btSequentialImpulseConstraintSolver {
   const StepStats& totals() const { return totals_; }
   // With Settings::keepIslands: the problems of the last step.
   const std::vector<IslandRecord>& islands() const { return records_; }
-  // The shared island solver (null with "si"): its capture hook writes each island's problem.
-  // Once it has been asked for, "pgs" islands go through it too (see fastPgs below).
-  RowSolver* rowSolver() {
-    shared_ = true;
-    return rows_.get();
-  }
+  // The shared island solver (null with "si"): its capture hook writes each island's problem
+  // ("pgs" islands go through it while a capture is set: the capture needs the RowSystem).
+  RowSolver* rowSolver() { return rows_.get(); }
 
   // Serialized by the solver's mutex (see "Threads" above).
   btScalar solveGroup(btCollisionObject** bodies, int numBodies, btPersistentManifold** manifolds,
@@ -258,10 +260,9 @@ class ConstraintSolver : public btSequentialImpulseConstraintSolver {
   Settings settings_;
   std::unique_ptr<RowSolver> rows_;
   bool si_ = false;
-  // "pgs" islands skip the RowSystem copy and RowSolver (solver "pgs", no keepIslands, and
-  // nobody asked for rowSolver()); same iterates, same verification rule (acceptable()).
+  // "pgs" islands skip the RowSystem copy and RowSolver (solver "pgs", packInPlace, no
+  // keepIslands, no capture); same iterates, same verification rule (acceptable()).
   bool fastPgs_ = false;
-  bool shared_ = false;
   RowPgs pgs_;
   IslandBuilder builder_;
   StepStats current_, last_, totals_;

@@ -23,7 +23,8 @@
 //     Both numberings give the same order (tested equal bit for bit).
 //  2. the conversion writes each row either into its island's RowSystem (build with system =
 //     true, or fillSystem later) or straight into RowPgs' packing through Source (the "pgs"
-//     path: read in place by RowPgs::solveFrom, Source::row and view() always_inline, no copy).
+//     path: read in place by RowPgs' engine entry point, view() inlined into Source::row, no
+//     copy).
 //     Both write the same values (one conversion function).
 // Both passes fetch Bullet's rows and the manifold points a few rows ahead: the passes are bound
 // by their first touch of each row, which sits out of cache after Bullet's setup. What remember()
@@ -136,7 +137,7 @@ class IslandBuilder {
     bool split_;
     double scratch_[12];  // J's parts not read in place (6 a side; view())
   };
-  // RowPgs' engine path on the island's rows read in place (Source, inlined into the packing).
+  // RowPgs' engine path on the island's rows read in place (Source).
   Result solvePgs(RowPgs& pgs, Island& island, bool split, Vector& x);
   // The island's RowSystem, start, splitB and splitStart (once per build).
   void fillSystem(Island& island);

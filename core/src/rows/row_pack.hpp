@@ -1,9 +1,9 @@
-// mlcp/detail/row_pack.hpp: RowPgs' packing pass and its engine entry point as templates
-// (rows.hpp), for engines whose row source the compiler should see: RowPgs::solveFrom with a
-// final source class inlines the source's row() into the packing loop (no view written to
-// memory and read back, no call per row; forced on solveFrom's lambda, which GCC otherwise
-// keeps a call: a large row() should be always_inline too). Include it only where solveFrom is
-// instantiated.
+// core/src/rows/row_pack.hpp (internal): RowPgs' packed rows and body velocities, and the
+// passes over them (rows.hpp's three stages): the packing pass as a template over the row
+// source, so that solve(RowSystem) and the engine entry point (rows.cpp) share one packing code
+// with each source's row() inlined into the loop; the sweep and check bodies are in
+// row_sweep.hpp. Each pass runs as compiled for the baseline or, where cpuPath() says so, its
+// AVX2 variant (cpu_dispatch.hpp): the same source, the same bits.
 #pragma once
 
 #include <algorithm>
@@ -11,37 +11,110 @@
 #include <cstddef>
 #include <cstring>
 #include <limits>
+#include <vector>
 
-#include "mlcp/detail/row_checks.hpp"
 #include "mlcp/rows.hpp"
 #include "mlcp/solver.hpp"
+#include "rows/cpu_dispatch.hpp"
+#include "rows/row_checks.hpp"
 
 namespace mlcp {
+
+struct RowPgs::Packing {
+  // Everything the sweep reads per row, in one stream: bodies remapped so that "the world" is
+  // a zero-velocity slot (no branches in the inner loop), M^-1 J^T, and the update
+  //     x_i <- clamp(x_i - step (J_i v + cfm_i x_i + b_i), lo', hi'),   step = omega / A_ii,
+  // regrouped as clamp(keep x_i - shift - (step J_i) v) with keep = 1 - step cfm_i and
+  // shift = step b_i: only the product with v depends on the rows just visited, so the row's
+  // latency chain (load v, dot, clamp, update v) holds one subtraction instead of a
+  // multiplication and three additions (the same iterates up to round-off).
+  // The change moving v is clamped apart, dx = clamp((c - x_i) - J v', lo - x_i, hi - x_i) with
+  // c = keep x_i - shift, while x_i itself becomes clamp(c - J v', lo, hi): the chain does not
+  // wait for x_new - x_i, v and x agree up to round-off, and x stays exactly within its bounds.
+  struct PackedRow {
+    Vector6 sA, sB;  // step * J
+    Vector6 mA, mB;  // M^-1 J^T
+    double keep, shift, lo, hi;
+    int a, b, findex;
+    int run;  // first row of a run: how many rows from here join the same two bodies a != b
+  };
+  // A body's velocity change padded to one cache line.
+  struct alignas(64) BodyVelocity {
+    Vector6 v;
+    double pad[2];
+  };
+  // Zero-velocity slots standing for "the world", taken by ground rows in turn.
+  static constexpr int kWorldSlots = 8;
+  // Longest run of rows on the same two bodies swept as one (longer ones are split): its
+  // couplings take (kMaxRun - 1) kMaxRun / 2 numbers. 8 = a box face's 4 contacts' friction rows.
+  static constexpr int kMaxRun = 8;
+  // Fills packed_ and velocity_ from rowAt(i); false at the first invalid row or non-positive
+  // A_ii (bad_, badDiagonal_ say which). relaxation is Options::relaxation.
+  // pack(), sweepOnce() and packedAccuracy() run their body (packRows, sweepRows, checkRows) as
+  // compiled for the baseline or, where cpuPath() says so, its AVX2 variant.
+  template <class RowAt>
+  bool pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& rowAt, double relaxation,
+            bool warm, double* x, bool withBase);
+  template <class RowAt>
+  bool packRows(const std::vector<BodyInverseMass>& bodies, int n, RowAt& rowAt, double relaxation,
+                bool warm, double* x, bool withBase);
+#if MLCP_CPU_DISPATCH
+  template <class RowAt>
+  MLCP_AVX2_VARIANT bool packAvx2(const std::vector<BodyInverseMass>& bodies, int n, RowAt& rowAt,
+                                  double relaxation, bool warm, double* x, bool withBase);
+  MLCP_AVX2_VARIANT void sweepAvx2(double* x);
+  MLCP_AVX2_VARIANT Accuracy checkAvx2(const Vector& x, double bNorm) const;
+#endif
+  // Wide: with 4-wide vectors (the AVX2 variants), else in pairs (row_simd.hpp).
+  template <bool Wide>
+  void sweepRows(double* x);
+  template <bool Wide>
+  Accuracy checkRows(const Vector& x, double bNorm) const;
+  // One row's update from jv = step J_i v (x[i] takes its new value); returns the change of x_i
+  // that moves the velocities.
+  static double update(const PackedRow& p, double* x, int i, double jv);
+  // One sweep over packed_ (x and the velocities updated in place).
+  void sweepOnce(double* x);
+  // The check: accuracy() of x with w = J v + cfm x + b from the packed rows and velocities.
+  Accuracy packedAccuracy(const Vector& x, double bNorm) const;
+
+  std::vector<PackedRow> packed_;  // reused between solves
+  std::vector<int> findexOf_;      // packed_[i].findex again, compact (pack() validates with it)
+  // Per row 1 / step, for the check only (kept apart: the sweep's stream stays 240 bytes a row):
+  // w_i = scale_i ((1 - keep) x_i + shift + sA va + sB vb).
+  std::vector<double> scale_;
+  // Per row of a run after its first, its couplings to the run's earlier rows k, in row order:
+  // step_i J_i M^-1 J_k^T (sA_i . mA_k + sB_i . mB_k).
+  std::vector<double> coupling_;
+  std::vector<BodyVelocity> velocity_, base_;
+  int bad_ = -1;            // the row that stopped pack()
+  double badDiagonal_ = 0;  // its A_ii, or NaN when the row was invalid
+};
 
 // How many rows ahead pack() fetches the packed rows it will write.
 constexpr int kPackAhead = 8;
 
 template <class RowAt>
-bool RowPgs::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& rowAt, bool warm,
-                  double* xOut, bool withBase) {
+bool RowPgs::Packing::pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& rowAt,
+                           double relaxation, bool warm, double* xOut, bool withBase) {
 #if MLCP_CPU_DISPATCH
-  if (detail::avx2Active()) return packAvx2(bodies, n, rowAt, warm, xOut, withBase);
+  if (detail::avx2Active()) return packAvx2(bodies, n, rowAt, relaxation, warm, xOut, withBase);
 #endif
-  return packRows(bodies, n, rowAt, warm, xOut, withBase);
+  return packRows(bodies, n, rowAt, relaxation, warm, xOut, withBase);
 }
 
 #if MLCP_CPU_DISPATCH
 template <class RowAt>
-bool RowPgs::packAvx2(const std::vector<BodyInverseMass>& bodies, int n, RowAt& rowAt, bool warm,
-                      double* xOut, bool withBase) {
-  return packRows(bodies, n, rowAt, warm, xOut, withBase);
+bool RowPgs::Packing::packAvx2(const std::vector<BodyInverseMass>& bodies, int n, RowAt& rowAt,
+                               double relaxation, bool warm, double* xOut, bool withBase) {
+  return packRows(bodies, n, rowAt, relaxation, warm, xOut, withBase);
 }
 #endif
 
 template <class RowAt>
-[[gnu::always_inline]] inline bool RowPgs::packRows(const std::vector<BodyInverseMass>& bodies,
-                                                    int n, RowAt& rowAt, bool warm, double* xOut,
-                                                    bool withBase) {
+[[gnu::always_inline]] inline bool RowPgs::Packing::packRows(
+    const std::vector<BodyInverseMass>& bodies, int n, RowAt& rowAt, double relaxation, bool warm,
+    double* xOut, bool withBase) {
   const int world = static_cast<int>(bodies.size());  // the first zero-velocity slot
   const unsigned slots = static_cast<unsigned>(world) + 1;
   // Ground rows take the world slots in turn (per run of rows on the same bodies): one shared
@@ -66,7 +139,6 @@ template <class RowAt>
     for (BodyVelocity& v : base_) v.v.setZero();
   }
   bad_ = -1;
-  const double relaxation = options_.relaxation;
   const bool unitRelaxation = relaxation == 1;
   auto stop = [&](int i, double d) {
     bad_ = i;
@@ -225,39 +297,6 @@ template <class RowAt>
   if (withBase)
     for (int k = 0; k < world; ++k) base_[k].v += velocity_[k].v;
   return true;
-}
-
-template <class Source>
-Result RowPgs::solveFrom(const std::vector<BodyInverseMass>& bodies, int n, Source& source,
-                         Vector& x) {
-  const double t0 = nowSeconds();
-  baseValid_ = false;
-  // The slow path: the same rows as a RowSystem, solved (or refused) by solve(RowSystem).
-  auto slow = [&] {
-    RowSystem s;
-    detail::resizeSystem(bodies, n, s, x);
-    for (int i = 0; i < n; ++i) detail::setRow(s, x, i, source.row(i));
-    return solve(s, x);
-  };
-  const Options& opt = options_;
-  if (n < 0) return negativeRows();
-  if (!(opt.relaxation > 0 && opt.relaxation < 2)) return slow();
-  for (const BodyInverseMass& body : bodies)
-    if (!detail::bodyValid(body)) return slow();
-  x.resize(n);
-  double bNorm = 0;
-  const bool packed = pack(
-      bodies, n,
-      [&](int i) __attribute__((always_inline)) {
-        const RowView r = source.row(i);
-        bNorm = std::max(bNorm, std::abs(r.b));
-        return r;
-      },
-      opt.warmStart, x.data(), true);
-  if (!packed) return slow();
-  // A non-finite start: solve(RowSystem) starts cold (velocity_ and base_ hold NaN here).
-  if (!x.allFinite()) return slow();
-  return iteratePacked(static_cast<int>(bodies.size()), x, bNorm, t0);
 }
 
 }  // namespace mlcp
