@@ -4,6 +4,8 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "rows/cpu_dispatch.hpp"
+
 namespace mlcp {
 
 namespace detail {

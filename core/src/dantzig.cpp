@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <sstream>
 
 #include "dantzig_block.hpp"
 #include "dantzig_small.hpp"
+#include "dantzig_workspace.hpp"
 #include "mlcp/pgs.hpp"
 #include "mlcp/residual.hpp"
 #include "mlcp/rows.hpp"
@@ -14,25 +16,12 @@
 
 namespace mlcp {
 
+using namespace dantzig;  // the workspace's vocabulary (dantzig_workspace.hpp)
+
 namespace {
-
-enum class Set : unsigned char { Unprocessed, Clamped, AtLo, AtHi, Fixed, Free };
-enum class Outcome { Done, Failed, PivotLimit, TimeUp };
-enum class Block { None, SelfZero, SelfBound, CBound, NZero };
-
-using VMap = Eigen::Map<Vector>;
-using Strided = Eigen::Map<DenseMatrix, 0, Eigen::OuterStride<>>;
-
-VMap vmap(std::vector<double>& v, int len, int offset = 0) { return VMap(v.data() + offset, len); }
-
-bool isEquality(double lo, double hi) { return lo == -kInf && hi == kInf; }
 
 // Largest residual (residual.hpp) of a guess whose friction values set the first pass's bounds.
 constexpr double kTrustedGuess = 1e-2;
-
-// Sizes (rows of a product or of the clamped block) up to which plain loops beat Eigen's
-// vectorized kernels: islands of a few joints.
-constexpr int kSmall = 8;
 
 // Projected Gauss-Seidel sweeps (pgs.hpp) over x; none when a diagonal entry is not positive.
 void preSweeps(const Problem& problem, int sweeps, Vector& x) {
@@ -47,260 +36,6 @@ void preSweeps(const Problem& problem, int sweeps, Vector& x) {
 // Bullet's redundant bridge (two ball joints per hinge line) 1e-10 left a residual of 3-5e-8 on
 // A, 1e-8 of 3-7e-7, 1e-6 of 2-7e-5 (the drift between redundant rows stays either way).
 constexpr double kRegularization = 1e-10;
-
-struct DantzigSolver::Workspace {
-  // ---- the problem in processing order: position p holds the caller's row perm[p] ----
-  int n = 0;
-  bool symmetric = true;
-  bool sparse = false;
-  std::vector<int> perm, inv, findex;
-  std::vector<double> dense, denseT;  // column-major n x n; denseT only when not symmetric
-  std::vector<int> rowPtr, rowIdx, colPtr, colIdx;  // CSR; CSC only when not symmetric
-  std::vector<double> rowVal, colVal, scatter;
-  std::vector<double> diag, b, lo, hi, muLo, muHi, x, w, xStart;
-  std::vector<double> normal;  // friction rows: the normal magnitude their bounds come from
-  std::vector<int> frictionRows;
-  DenseMatrix histG, histF;  // Anderson history of the friction fixed point (columns)
-  double pivTol = 0, epsW = 0, aMax = 0;
-  // Rows nothing limits whose w is 0 (a zero Schur pivot: A singular, e.g. redundant joints)
-  // stay free at their value; redundant counts them for the message.
-  int redundant = 0;
-  // Added to A's diagonal after build() (0: none). runPivoting sets it for its one retry of a
-  // pivoting that broke down on a singular A: A + shift I is positive definite, its answer
-  // solves A's (consistent, or nearly: engines' drift) system up to ~shift |x|.
-  double shift = 0, scale = 0;
-  Vector guess;  // the caller's start, for that retry
-
-  // ---- index sets and the factors A_CC = L D U (U = L^T when symmetric) ----
-  int m = 0;
-  int span = 0;  // 1 + the largest position ever clamped or driven in this pass
-  std::vector<double> L, Ut, D;
-  std::vector<int> C, N, slot;  // slot[p]: index of p in C or in N
-  std::vector<Set> set;
-
-  // ---- scratch ----
-  std::vector<double> a, r, u, l, z, dxFull, dwN, xs, ys;
-  std::vector<int> queue, violators;
-
-  int pivots = 0, pivotLimit = 0, passes = 0;
-  // Options::timeBudget's deadline (+inf for none), read once per clockEvery pivots (a pivot
-  // costs O(n) to O(n |C|): 1024 / n pivots between reads keep a read under ~5% of the work).
-  double deadline = 0;
-  int clockEvery = 1;
-  std::string message;
-
-  // -------------------------------------------------------------------- set-up
-  void build(const Problem& pb, const Vector& guess, bool useGuess, bool exactFriction);
-  void buildDense(const Problem& pb);
-  void buildSparse(const Problem& pb);
-
-  // ------------------------------------------------------------- matrix access
-  const double* denseRow(int i) const {
-    return (symmetric ? dense : denseT).data() + size_t(i) * n;
-  }
-  double rowDot(int i, const std::vector<double>& v, int len) const {
-    if (!sparse) {
-      const double* row = denseRow(i);
-      if (len > kSmall)
-        return Eigen::Map<const Vector>(row, len).dot(Eigen::Map<const Vector>(v.data(), len));
-      double s = 0;
-      for (int k = 0; k < len; ++k) s += row[k] * v[k];
-      return s;
-    }
-    double s = 0;
-    for (int k = rowPtr[i]; k < rowPtr[i + 1]; ++k) s += rowVal[k] * v[rowIdx[k]];
-    return s;
-  }
-  // out[c] = A(C[c], j): column j of A at the clamped positions.
-  void gatherCol(int j, std::vector<double>& out) {
-    if (!sparse) {
-      const double* col = dense.data() + size_t(j) * n;
-      for (int c = 0; c < m; ++c) out[c] = col[C[c]];
-      return;
-    }
-    const bool useRows = symmetric;
-    const std::vector<int>& ptr = useRows ? rowPtr : colPtr;
-    const std::vector<int>& idx = useRows ? rowIdx : colIdx;
-    const std::vector<double>& val = useRows ? rowVal : colVal;
-    gatherSparse(ptr, idx, val, j, out);
-  }
-  // out[c] = A(i, C[c]): row i of A at the clamped positions.
-  void gatherRow(int i, std::vector<double>& out) {
-    if (!sparse) {
-      const double* row = denseRow(i);
-      for (int c = 0; c < m; ++c) out[c] = row[C[c]];
-      return;
-    }
-    gatherSparse(rowPtr, rowIdx, rowVal, i, out);
-  }
-  void gatherSparse(const std::vector<int>& ptr, const std::vector<int>& idx,
-                    const std::vector<double>& val, int j, std::vector<double>& out) {
-    for (int k = ptr[j]; k < ptr[j + 1]; ++k) scatter[idx[k]] = val[k];
-    for (int c = 0; c < m; ++c) out[c] = scatter[C[c]];
-    for (int k = ptr[j]; k < ptr[j + 1]; ++k) scatter[idx[k]] = 0;
-  }
-
-  // ------------------------------------------------------------------ factors
-  Strided lower(std::vector<double>& f) { return Strided(f.data(), m, m, Eigen::OuterStride<>(n)); }
-  std::vector<double>& upperT() { return symmetric ? L : Ut; }
-  // y <- L^{-1} y ./ D  (the new column of U for an entering index, given A_Cj in y).
-  // Up to kSmall rows, plain loops: Eigen's blocked solves cost more in set-up than in flops
-  // there (the column-wise forward loop is Eigen's own order, so the same round-off).
-  void forward(std::vector<double>& f, std::vector<double>& y) {
-    if (m == 0) return;
-    if (m > kSmall) {
-      lower(f).triangularView<Eigen::UnitLower>().solveInPlace(vmap(y, m));
-    } else {
-      for (int k = 0; k < m; ++k) {
-        const double yk = y[k];
-        if (yk == 0) continue;
-        const double* col = f.data() + size_t(k) * n;
-        for (int i = k + 1; i < m; ++i) y[i] -= yk * col[i];
-      }
-    }
-    for (int c = 0; c < m; ++c) y[c] /= D[c];
-  }
-  // y <- U^{-1} y.
-  void backward(std::vector<double>& y) {
-    if (m == 0) return;
-    if (m > kSmall) {
-      lower(upperT()).triangularView<Eigen::UnitLower>().transpose().solveInPlace(vmap(y, m));
-      return;
-    }
-    const double* f = upperT().data();
-    for (int i = m - 2; i >= 0; --i) {
-      const double* col = f + size_t(i) * n;
-      double s = 0;
-      for (int k = i + 1; k < m; ++k) s += col[k] * y[k];
-      y[i] -= s;
-    }
-  }
-  // y <- A_CC^{-1} y.
-  void solveCC(std::vector<double>& y) {
-    forward(L, y);
-    backward(y);
-  }
-  // Prepares u = D^-1 L^-1 A_Cj and l = D^-1 U^-T A_jC; returns the Schur pivot of j.
-  double border(int j) {
-    gatherCol(j, u);
-    forward(L, u);
-    if (symmetric) {
-      double s = 0;
-      for (int c = 0; c < m; ++c) s += u[c] * u[c] * D[c];
-      return diag[j] - s;
-    }
-    gatherRow(j, l);
-    forward(Ut, l);
-    double s = 0;
-    for (int c = 0; c < m; ++c) s += l[c] * u[c] * D[c];
-    return diag[j] - s;
-  }
-  // Appends position p to C with the bordering vectors from border()/direction() and pivot.
-  void joinC(int p, double pivot) {
-    const std::vector<double>& lrow = symmetric ? u : l;
-    for (int c = 0; c < m; ++c) L[m + size_t(c) * n] = lrow[c];
-    if (!symmetric)
-      for (int c = 0; c < m; ++c) Ut[m + size_t(c) * n] = u[c];
-    D[m] = pivot;
-    C[m] = p;
-    slot[p] = m;
-    set[p] = Set::Clamped;
-    ++m;
-    span = std::max(span, p + 1);
-  }
-  static void deleteRowCol(std::vector<double>& f, int c, int m, int ld) {
-    const int below = m - c - 1;
-    for (int j = 0; j < c; ++j) {
-      double* col = f.data() + size_t(j) * ld;
-      std::memmove(col + c, col + c + 1, sizeof(double) * below);
-    }
-    for (int j = c + 1; j < m; ++j)
-      std::memmove(f.data() + size_t(j - 1) * ld + j, f.data() + size_t(j) * ld + j + 1,
-                   sizeof(double) * (m - 1 - j));
-  }
-  // Removes C[c] from the factors: delete its row and column, then restore the trailing block
-  // with the rank-one update L22 D2 U22 + d_c l_c u_c^T (Bennett). False on a zero pivot.
-  bool leaveC(int c) {
-    const int s = m - c - 1;
-    double alpha = D[c];
-    for (int k = 0; k < s; ++k) xs[k] = L[c + 1 + k + size_t(c) * n];
-    if (!symmetric)
-      for (int k = 0; k < s; ++k) ys[k] = Ut[c + 1 + k + size_t(c) * n];
-    deleteRowCol(L, c, m, n);
-    if (!symmetric) deleteRowCol(Ut, c, m, n);
-    for (int k = c; k + 1 < m; ++k) {
-      D[k] = D[k + 1];
-      C[k] = C[k + 1];
-      slot[C[k]] = k;
-    }
-    --m;
-    const std::vector<double>& yv = symmetric ? xs : ys;
-    for (int j = 0; j < s && alpha != 0; ++j) {
-      const int J = c + j;
-      const double pj = xs[j], qj = yv[j];
-      if (pj == 0 && qj == 0) continue;
-      const double dOld = D[J], dNew = dOld + alpha * pj * qj;
-      if (!(std::abs(dNew) > pivTol)) return false;
-      const double bl = alpha * qj / dNew, bu = alpha * pj / dNew;
-      alpha *= dOld / dNew;
-      D[J] = dNew;
-      const int rest = s - j - 1;
-      if (rest == 0) break;
-      VMap xr(xs.data() + j + 1, rest), lc(L.data() + J + 1 + size_t(J) * n, rest);
-      xr -= pj * lc;
-      lc += bl * xr;
-      if (!symmetric) {
-        VMap yr(ys.data() + j + 1, rest), uc(Ut.data() + J + 1 + size_t(J) * n, rest);
-        yr -= qj * uc;
-        uc += bu * yr;
-      }
-    }
-    return true;
-  }
-
-  // -------------------------------------------------------------- index sets
-  void joinN(int p, Set s) {
-    set[p] = s;
-    slot[p] = static_cast<int>(N.size());
-    N.push_back(p);
-  }
-  // p is in N (at a bound, or free) and its w breaks that set's sign condition; false for rows
-  // in C (Set::Clamped) and fixed rows.
-  bool violates(int p) const {
-    return (set[p] == Set::AtLo && w[p] < -epsW) || (set[p] == Set::AtHi && w[p] > epsW) ||
-           (set[p] == Set::Free && std::abs(w[p]) > epsW);
-  }
-  void leaveN(int k) {
-    const int last = N.back();
-    N[k] = last;
-    slot[last] = k;
-    N.pop_back();
-  }
-
-  // ----------------------------------------------------------------- the method
-  Outcome drive(int i);
-  Outcome pass(bool fixedOnce, bool reuseFactors);
-  bool bulk(bool reuseFactors);
-  Outcome finish();
-  // x_C -= A_CC^{-1} (b + A x)_C: the clamped rows' residual made zero with the factors.
-  void solveClamped() {
-    for (int c = 0; c < m; ++c) a[c] = b[C[c]] + rowDot(C[c], x, n);
-    solveCC(a);
-    for (int c = 0; c < m; ++c) x[C[c]] -= a[c];
-  }
-  void freshW() {
-    for (int p = 0; p < n; ++p) w[p] = b[p] + rowDot(p, x, n);
-  }
-  void setFrictionBounds(const Vector& nu);
-  void gatherNormals(Vector& g) const;
-  // A += delta I in the workspace's copies of A. False when a sparse A stores no diagonal entry
-  // for some row (nothing changed then).
-  bool shiftDiagonal(double delta);
-  Outcome fail(const std::string& why) {
-    message = why;
-    return Outcome::Failed;
-  }
-};
 
 // ============================================================================ set-up
 
@@ -461,160 +196,198 @@ void DantzigSolver::Workspace::buildSparse(const Problem& pb) {
 Outcome DantzigSolver::Workspace::drive(int i) {
   for (;;) {
     const double wi = w[i];
-    if (x[i] <= lo[i] && wi >= -epsW) {
-      x[i] = lo[i];
-      joinN(i, Set::AtLo);
-      return Outcome::Done;
-    }
-    if (x[i] >= hi[i] && wi <= epsW) {
-      x[i] = hi[i];
-      joinN(i, Set::AtHi);
-      return Outcome::Done;
-    }
-    if (pivots >= pivotLimit) {
-      std::ostringstream os;
-      os << "pivot limit " << pivotLimit << " reached";
-      message = os.str();
-      return Outcome::PivotLimit;
-    }
-    if (pivots % clockEvery == clockEvery - 1 && deadline != kInf && nowSeconds() > deadline) {
-      message = "time budget spent";
-      return Outcome::TimeUp;
-    }
+    if (settleAtBound(i, wi)) return Outcome::Done;
+    if (const Outcome o = checkBudget(); o != Outcome::Done) return o;
     ++pivots;
     const double d = wi < 0 ? 1.0 : -1.0;
-    // Direction: keep w_C = 0 and x_N fixed while x_i moves by d.
-    gatherCol(i, u);
-    forward(L, u);
-    std::copy(u.begin(), u.begin() + m, z.begin());
-    backward(z);
-    span = std::max(span, i + 1);
-    for (int c = 0; c < m; ++c) dxFull[C[c]] = -d * z[c];
-    dxFull[i] = d;
-    const double dwi = rowDot(i, dxFull, span);
+    const double dwi = direction(i, d);
     const double sii = d * dwi;  // Schur complement of i with respect to C
-    auto clearDx = [&] {
-      for (int c = 0; c < m; ++c) dxFull[C[c]] = 0;
-      dxFull[i] = 0;
-    };
-    auto enterC = [&](int p, double pivot) {
-      if (!symmetric) {
-        gatherRow(p, l);
-        forward(Ut, l);
-      }
-      joinC(p, pivot);
-    };
     const bool interior = x[i] > lo[i] && x[i] < hi[i];
     if (interior && std::abs(wi) <= epsW && std::abs(sii) > pivTol) {
-      clearDx();
+      clearDx(i);
       w[i] = 0;
       enterC(i, sii);
       return Outcome::Done;
     }
-    double dxMax = 1;
-    for (int c = 0; c < m; ++c) dxMax = std::max(dxMax, std::abs(z[c]));
-    const double rateTol = 1e-13 * aMax * dxMax;
-    const int nN = static_cast<int>(N.size());
-    for (int k = 0; k < nN; ++k) {
-      const Set s = set[N[k]];
-      dwN[k] = (s == Set::AtLo || s == Set::AtHi) ? rowDot(N[k], dxFull, span) : 0.0;
+    const Step step = ratioTest(i, d, wi, dwi, sii);
+    if (step.kind == Block::None) {
+      clearDx(i);
+      return unlimited(i, wi, sii);
     }
-    // Step length: the first event along the ray.
-    double best = kInf;
-    Block kind = Block::None;
-    int who = -1;
-    bool whoUp = false;  // CBound: the clamped row hit its upper bound
-    if (sii > pivTol) {
-      best = std::max(0.0, -wi / dwi);
-      kind = Block::SelfZero;
-    }
-    const double room = d > 0 ? hi[i] - x[i] : x[i] - lo[i];
-    if (room < best) {
-      best = std::max(0.0, room);
-      kind = Block::SelfBound;
-    }
-    for (int c = 0; c < m; ++c) {
-      const int p = C[c];
-      const double dx = dxFull[p];
-      double s = kInf;
-      if (dx > 0 && hi[p] < kInf) s = (hi[p] - x[p]) / dx;
-      if (dx < 0 && lo[p] > -kInf) s = (lo[p] - x[p]) / dx;
-      if (s < best) {
-        best = std::max(0.0, s);
-        kind = Block::CBound;
-        who = c;
-        whoUp = dx > 0;
-      }
-    }
-    for (int k = 0; k < nN; ++k) {
-      const int p = N[k];
-      const double dw = dwN[k];
-      double s = kInf;
-      if (set[p] == Set::AtLo && dw < -rateTol) s = -w[p] / dw;
-      if (set[p] == Set::AtHi && dw > rateTol) s = -w[p] / dw;
-      if (s < best) {
-        best = std::max(0.0, s);
-        kind = Block::NZero;
-        who = k;
-      }
-    }
-    if (kind == Block::None) {
-      clearDx();
-      if (std::abs(wi) <= epsW) {  // a redundant row: its w is 0 and stays 0 along the ray
-        ++redundant;
-        joinN(i, Set::Free);
-        return Outcome::Done;
-      }
-      std::ostringstream os;
-      os << "row " << perm[i] << ": nothing limits the step (w = " << wi
-         << ", Schur pivot = " << sii
-         << "); the problem has no solution on this path (infeasible, or A is not a P-matrix)";
-      return fail(os.str());
-    }
-    x[i] += d * best;
-    for (int c = 0; c < m; ++c) x[C[c]] += best * dxFull[C[c]];
-    w[i] += best * dwi;
-    for (int k = 0; k < nN; ++k) w[N[k]] += best * dwN[k];
-    clearDx();
-    switch (kind) {
-      case Block::SelfZero:
-        w[i] = 0;
-        enterC(i, sii);
-        return Outcome::Done;
-      case Block::SelfBound:
-        x[i] = d > 0 ? hi[i] : lo[i];
-        joinN(i, d > 0 ? Set::AtHi : Set::AtLo);
-        return Outcome::Done;
-      case Block::CBound: {
-        const int p = C[who];
-        const bool up = whoUp;
-        x[p] = up ? hi[p] : lo[p];
-        w[p] = 0;
-        if (!leaveC(who)) {
-          std::ostringstream os;
-          os << "row " << perm[p] << " left the clamped set and left a singular block behind";
-          return fail(os.str());
-        }
-        joinN(p, up ? Set::AtHi : Set::AtLo);
-        break;
-      }
-      case Block::NZero: {
-        const int p = N[who];
-        w[p] = 0;
-        leaveN(who);
-        const double pivot = border(p);
-        if (!(std::abs(pivot) > pivTol)) {
-          std::ostringstream os;
-          os << "row " << perm[p] << " must join the clamped set but its pivot is " << pivot
-             << " (singular principal block)";
-          return fail(os.str());
-        }
-        joinC(p, pivot);
-        break;
-      }
-      case Block::None: break;
+    takeStep(i, d, dwi, step.length);
+    clearDx(i);
+    if (const std::optional<Outcome> o = applyBlock(i, d, sii, step)) return *o;
+  }
+}
+
+[[gnu::always_inline]] inline bool DantzigSolver::Workspace::settleAtBound(int i, double wi) {
+  if (x[i] <= lo[i] && wi >= -epsW) {
+    x[i] = lo[i];
+    joinN(i, Set::AtLo);
+    return true;
+  }
+  if (x[i] >= hi[i] && wi <= epsW) {
+    x[i] = hi[i];
+    joinN(i, Set::AtHi);
+    return true;
+  }
+  return false;
+}
+
+[[gnu::always_inline]] inline Outcome DantzigSolver::Workspace::checkBudget() {
+  if (pivots >= pivotLimit) {
+    std::ostringstream os;
+    os << "pivot limit " << pivotLimit << " reached";
+    message = os.str();
+    return Outcome::PivotLimit;
+  }
+  if (pivots % clockEvery == clockEvery - 1 && deadline != kInf && nowSeconds() > deadline) {
+    message = "time budget spent";
+    return Outcome::TimeUp;
+  }
+  return Outcome::Done;
+}
+
+// Direction: keep w_C = 0 and x_N fixed while x_i moves by d (dxFull, with z = A_CC^-1 A_Ci).
+[[gnu::always_inline]] inline double DantzigSolver::Workspace::direction(int i, double d) {
+  gatherCol(i, u);
+  forward(L, u);
+  std::copy(u.begin(), u.begin() + m, z.begin());
+  backward(z);
+  span = std::max(span, i + 1);
+  for (int c = 0; c < m; ++c) dxFull[C[c]] = -d * z[c];
+  dxFull[i] = d;
+  return rowDot(i, dxFull, span);
+}
+
+[[gnu::always_inline]] inline void DantzigSolver::Workspace::clearDx(int i) {
+  for (int c = 0; c < m; ++c) dxFull[C[c]] = 0;
+  dxFull[i] = 0;
+}
+
+[[gnu::always_inline]] inline void DantzigSolver::Workspace::enterC(int p, double pivot) {
+  if (!symmetric) {
+    gatherRow(p, l);
+    forward(Ut, l);
+  }
+  joinC(p, pivot);
+}
+
+// Step length: the first event along the ray (dwN: the rates of N's rows at a bound).
+[[gnu::always_inline]] inline DantzigSolver::Workspace::Step DantzigSolver::Workspace::ratioTest(
+    int i, double d, double wi, double dwi, double sii) {
+  double dxMax = 1;
+  for (int c = 0; c < m; ++c) dxMax = std::max(dxMax, std::abs(z[c]));
+  const double rateTol = 1e-13 * aMax * dxMax;
+  const int nN = static_cast<int>(N.size());
+  for (int k = 0; k < nN; ++k) {
+    const Set s = set[N[k]];
+    dwN[k] = (s == Set::AtLo || s == Set::AtHi) ? rowDot(N[k], dxFull, span) : 0.0;
+  }
+  Step step;
+  double& best = step.length;
+  if (sii > pivTol) {
+    best = std::max(0.0, -wi / dwi);
+    step.kind = Block::SelfZero;
+  }
+  const double room = d > 0 ? hi[i] - x[i] : x[i] - lo[i];
+  if (room < best) {
+    best = std::max(0.0, room);
+    step.kind = Block::SelfBound;
+  }
+  for (int c = 0; c < m; ++c) {
+    const int p = C[c];
+    const double dx = dxFull[p];
+    double s = kInf;
+    if (dx > 0 && hi[p] < kInf) s = (hi[p] - x[p]) / dx;
+    if (dx < 0 && lo[p] > -kInf) s = (lo[p] - x[p]) / dx;
+    if (s < best) {
+      best = std::max(0.0, s);
+      step.kind = Block::CBound;
+      step.who = c;
+      step.up = dx > 0;
     }
   }
+  for (int k = 0; k < nN; ++k) {
+    const int p = N[k];
+    const double dw = dwN[k];
+    double s = kInf;
+    if (set[p] == Set::AtLo && dw < -rateTol) s = -w[p] / dw;
+    if (set[p] == Set::AtHi && dw > rateTol) s = -w[p] / dw;
+    if (s < best) {
+      best = std::max(0.0, s);
+      step.kind = Block::NZero;
+      step.who = k;
+    }
+  }
+  return step;
+}
+
+[[gnu::always_inline]] inline void DantzigSolver::Workspace::takeStep(int i, double d, double dwi,
+                                                                      double best) {
+  const int nN = static_cast<int>(N.size());
+  x[i] += d * best;
+  for (int c = 0; c < m; ++c) x[C[c]] += best * dxFull[C[c]];
+  w[i] += best * dwi;
+  for (int k = 0; k < nN; ++k) w[N[k]] += best * dwN[k];
+}
+
+[[gnu::always_inline]] inline Outcome DantzigSolver::Workspace::unlimited(int i, double wi,
+                                                                          double sii) {
+  if (std::abs(wi) <= epsW) {  // a redundant row: its w is 0 and stays 0 along the ray
+    ++redundant;
+    joinN(i, Set::Free);
+    return Outcome::Done;
+  }
+  std::ostringstream os;
+  os << "row " << perm[i] << ": nothing limits the step (w = " << wi << ", Schur pivot = " << sii
+     << "); the problem has no solution on this path (infeasible, or A is not a P-matrix)";
+  return fail(os.str());
+}
+
+// The event that ended the step: i settles (Done), a clamped row leaves C at its bound or a row
+// of N joins C (nothing: i moves on), or the factors break down (Failed).
+[[gnu::always_inline]] inline std::optional<Outcome> DantzigSolver::Workspace::applyBlock(
+    int i, double d, double sii, const Step& step) {
+  switch (step.kind) {
+    case Block::SelfZero:
+      w[i] = 0;
+      enterC(i, sii);
+      return Outcome::Done;
+    case Block::SelfBound:
+      x[i] = d > 0 ? hi[i] : lo[i];
+      joinN(i, d > 0 ? Set::AtHi : Set::AtLo);
+      return Outcome::Done;
+    case Block::CBound: {
+      const int p = C[step.who];
+      const bool up = step.up;
+      x[p] = up ? hi[p] : lo[p];
+      w[p] = 0;
+      if (!leaveC(step.who)) {
+        std::ostringstream os;
+        os << "row " << perm[p] << " left the clamped set and left a singular block behind";
+        return fail(os.str());
+      }
+      joinN(p, up ? Set::AtHi : Set::AtLo);
+      break;
+    }
+    case Block::NZero: {
+      const int p = N[step.who];
+      w[p] = 0;
+      leaveN(step.who);
+      const double pivot = border(p);
+      if (!(std::abs(pivot) > pivTol)) {
+        std::ostringstream os;
+        os << "row " << perm[p] << " must join the clamped set but its pivot is " << pivot
+           << " (singular principal block)";
+        return fail(os.str());
+      }
+      joinC(p, pivot);
+      break;
+    }
+    case Block::None: break;
+  }
+  return std::nullopt;
 }
 
 // Factors the guessed clamped block (or keeps the previous pass's factors), solves x_C with

@@ -1,13 +1,14 @@
 #include "mlcp/rows.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <sstream>
 #include <type_traits>
 
-#include "mlcp/detail/row_pack.hpp"
 #include "mlcp/residual.hpp"
 #include "mlcp/solver.hpp"
-#include "row_sweep.hpp"
+#include "rows/row_pack.hpp"
+#include "rows/row_sweep.hpp"
 #include "sweep_monitor.hpp"
 
 namespace mlcp {
@@ -33,7 +34,7 @@ Problem boundsOnly(const RowSystem& s) {
   return p;
 }
 
-// One row's values wherever they are stored (a RowSystem, RowPgs::Row, an engine's own rows):
+// One row's values wherever they are stored (a RowSystem, an engine's own rows):
 // what validation and RowPgs' packing read.
 using RowRef = RowPgs::RowView;
 
@@ -59,37 +60,6 @@ inline RowRef systemRow(const RowSystem& s, int i, const double* x) {
   r.start = x ? x[i] : 0.0;
   return r;
 }
-
-RowRef rowView(const RowPgs::Row& row) {
-  RowRef r = viewOf(row.bodyA, row.bodyB, row.jA, row.jB);
-  r.b = row.b;
-  r.cfm = row.cfm;
-  r.lo = row.lo;
-  r.hi = row.hi;
-  r.findex = row.findex;
-  r.start = row.start;
-  r.base = row.base;
-  return r;
-}
-
-// The rows of a RowFill, fetched in batches of 64 (a few kB, stays in L1).
-class FillSource final : public RowPgs::RowSource {
- public:
-  FillSource(const RowPgs::RowFill& fill, int n) : fill_(fill), n_(n) {}
-  RowRef row(int i) override {
-    if (i >= fetched_ || i < fetched_ - kBatch) {  // the next batch, or the slow path's re-read
-      fill_(i, std::min(kBatch, n_ - i), batch_.data());
-      fetched_ = i + kBatch;
-    }
-    return rowView(batch_[i - (fetched_ - kBatch)]);
-  }
-
- private:
-  static constexpr int kBatch = 64;
-  const RowPgs::RowFill& fill_;
-  int n_, fetched_ = 0;
-  std::vector<RowPgs::Row> batch_ = std::vector<RowPgs::Row>(kBatch);
-};
 
 // The rules rowValid assumes: the per-row arrays' sizes and finite, non-negative body masses.
 bool arraysAndBodiesValid(const RowSystem& s) {
@@ -286,17 +256,21 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
   // x is the caller's until the input is known to be valid: a cold start reads zeros.
   const bool warm = opt.warmStart && x.size() == n && x.allFinite();
   const double* start = warm ? x.data() : nullptr;
-  if (!pack(
-          s.bodies, n, [&](int i) { return systemRow(s, i, start); }, warm, nullptr, false)) {
+  Packing& packing = *packing_;
+  if (!packing.pack(
+          s.bodies, n, [&](int i) { return systemRow(s, i, start); }, opt.relaxation, warm, nullptr,
+          false)) {
     // Rows after the one that stopped the packing are not checked yet: validate them all.
     if (std::string why = s.validate(); !why.empty()) return invalid(why);
     // The input is valid: a non-positive A_ii is a failure, not invalid input.
     if (!warm) x.setZero(n);
     std::ostringstream os;
-    if (std::isfinite(badDiagonal_))
-      os << "row " << bad_ << " has A_ii = " << badDiagonal_ << ": pgs needs a positive diagonal";
+    if (std::isfinite(packing.badDiagonal_))
+      os << "row " << packing.bad_ << " has A_ii = " << packing.badDiagonal_
+         << ": pgs needs a positive diagonal";
     else  // finite entries whose products leave the double range
-      os << "row " << bad_ << ": A_ii = J M^-1 J^T + cfm overflows (" << badDiagonal_
+      os << "row " << packing.bad_ << ": A_ii = J M^-1 J^T + cfm overflows ("
+         << packing.badDiagonal_
          << ") although its entries are finite: pgs needs a positive finite diagonal";
     result.status = Status::Failed;
     result.message = os.str();
@@ -311,29 +285,60 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
   return iterate(x, n ? s.b.lpNorm<Eigen::Infinity>() : 0.0, t0);
 }
 
-void RowPgs::toSystem(const std::vector<BodyInverseMass>& bodies, int n, const RowFill& fill,
-                      RowSystem& s, Vector& start) {
-  detail::resizeSystem(bodies, n, s, start);
-  std::vector<Row> all(n);
-  if (n > 0) fill(0, n, all.data());
-  for (int i = 0; i < n; ++i) detail::setRow(s, start, i, rowView(all[i]));
-}
-
 void RowPgs::toSystem(const std::vector<BodyInverseMass>& bodies, int n, RowSource& source,
                       RowSystem& s, Vector& start) {
   detail::resizeSystem(bodies, n, s, start);
   for (int i = 0; i < n; ++i) detail::setRow(s, start, i, source.row(i));
 }
 
-Result RowPgs::solve(const std::vector<BodyInverseMass>& bodies, int n, const RowFill& fill,
-                     Vector& x) {
-  FillSource source(fill, std::max(n, 0));
-  return solve(bodies, n, source, x);
-}
-
 Result RowPgs::solve(const std::vector<BodyInverseMass>& bodies, int n, RowSource& source,
                      Vector& x) {
-  return solveFrom(bodies, n, source, x);
+  const double t0 = nowSeconds();
+  baseValid_ = false;
+  // The slow path: the same rows as a RowSystem, solved (or refused) by solve(RowSystem).
+  auto slow = [&] {
+    RowSystem s;
+    detail::resizeSystem(bodies, n, s, x);
+    for (int i = 0; i < n; ++i) detail::setRow(s, x, i, source.row(i));
+    return solve(s, x);
+  };
+  const Options& opt = options_;
+  if (n < 0) return negativeRows();
+  if (!(opt.relaxation > 0 && opt.relaxation < 2)) return slow();
+  for (const BodyInverseMass& body : bodies)
+    if (!detail::bodyValid(body)) return slow();
+  x.resize(n);
+  double bNorm = 0;
+  const bool packed = packing_->pack(
+      bodies, n,
+      [&](int i) __attribute__((always_inline)) {
+        const RowView r = source.row(i);
+        bNorm = std::max(bNorm, std::abs(r.b));
+        return r;
+      },
+      opt.relaxation, opt.warmStart, x.data(), true);
+  if (!packed) return slow();
+  // A non-finite start: solve(RowSystem) starts cold (velocity_ and base_ hold NaN here).
+  if (!x.allFinite()) return slow();
+  return iteratePacked(static_cast<int>(bodies.size()), x, bNorm, t0);
+}
+
+RowPgs::RowPgs() : packing_(std::make_unique<Packing>()) {}
+RowPgs::RowPgs(const RowPgs& other)
+    : options_(other.options_),
+      packing_(std::make_unique<Packing>(*other.packing_)),
+      baseValid_(other.baseValid_) {}
+RowPgs::RowPgs(RowPgs&&) noexcept = default;
+RowPgs& RowPgs::operator=(const RowPgs& other) {
+  if (this != &other) *this = RowPgs(other);
+  return *this;
+}
+RowPgs& RowPgs::operator=(RowPgs&&) noexcept = default;
+RowPgs::~RowPgs() = default;
+
+Vector6 RowPgs::velocityChange(int body) const {
+  assert(baseValid_ && body >= 0 && body < static_cast<int>(packing_->base_.size()));
+  return packing_->velocity_[body].v - packing_->base_[body].v;
 }
 
 Result RowPgs::negativeRows() {
@@ -347,14 +352,14 @@ Result RowPgs::iteratePacked(int bodies, Vector& x, double bNorm, double t0) {
   // A non-finite base would make every velocityChange NaN: no per-body changes then (the
   // caller applies x row by row, as after the slow path).
   for (int k = 0; k < bodies; ++k)
-    if (!base_[k].v.allFinite()) return iterate(x, bNorm, t0);
+    if (!packing_->base_[k].v.allFinite()) return iterate(x, bNorm, t0);
   baseValid_ = true;
   return iterate(x, bNorm, t0);
 }
 
 // Not inlined into iterate(): its loops there changed how the sweep loop was compiled (our
 // stages ~20% slower at 210 boxes).
-[[gnu::noinline]] Accuracy RowPgs::packedAccuracy(const Vector& x, double bNorm) const {
+[[gnu::noinline]] Accuracy RowPgs::Packing::packedAccuracy(const Vector& x, double bNorm) const {
 #if MLCP_CPU_DISPATCH
   if (detail::avx2Active()) return checkAvx2(x, bNorm);
 #endif
@@ -363,7 +368,7 @@ Result RowPgs::iteratePacked(int bodies, Vector& x, double bNorm, double t0) {
 
 // A function of its own: compiled apart from the checks and the stopping logic around it (the
 // sweep's code and speed moved with whatever else iterate() held).
-[[gnu::noinline]] void RowPgs::sweepOnce(double* xs) {
+[[gnu::noinline]] void RowPgs::Packing::sweepOnce(double* xs) {
 #if MLCP_CPU_DISPATCH
   if (detail::avx2Active()) return sweepAvx2(xs);
 #endif
@@ -372,12 +377,13 @@ Result RowPgs::iteratePacked(int bodies, Vector& x, double bNorm, double t0) {
 
 Result RowPgs::iterate(Vector& x, double bNorm, double t0) {
   const Options& opt = options_;
-  const int n = static_cast<int>(packed_.size());
+  Packing& packing = *packing_;
+  const int n = static_cast<int>(packing.packed_.size());
   Result result;
   Accuracy last;           // accuracy of x as it is after the last check
   bool lastValid = false;  // whether x is unchanged since
   auto check = [&]() {
-    last = packedAccuracy(x, bNorm);
+    last = packing.packedAccuracy(x, bNorm);
     lastValid = true;
   };
   detail::SweepMonitor monitor(opt, result, n);
@@ -386,7 +392,7 @@ Result RowPgs::iterate(Vector& x, double bNorm, double t0) {
     result.message = "empty problem";
   }
   for (int sweep = 1; n > 0 && sweep <= opt.maxIterations; ++sweep) {
-    sweepOnce(x.data());
+    packing.sweepOnce(x.data());
     lastValid = false;
     if (!monitor.wantsCheck(sweep)) {
       if (monitor.outOfTime(sweep)) break;

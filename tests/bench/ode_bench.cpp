@@ -78,7 +78,7 @@ int main(int argc, char** argv) {
     };
     add("dWorldStep", nullptr, false);
     add("dWorldQuickStep (20 it)", nullptr, true);
-    StepperOptions pgs;
+    Settings pgs;
     pgs.options.maxIterations = 20;
     pgs.options.relaxation = 1.3;
     pgs.options.checkEvery = 1000000;
@@ -86,7 +86,7 @@ int main(int argc, char** argv) {
     pgs.engineIterations = false;
     pgs.fallback = "";
     add("ours pgs (20 it, w 1.3, warm)", std::make_unique<Stepper>("pgs", pgs), false);
-    StepperOptions dz;
+    Settings dz;
     dz.reference = "ode-lcp";  // stock's residual on the very same problems
     add("ours dantzig (exact)", std::make_unique<Stepper>("dantzig", dz), false);
     Method& ref = methods[3];

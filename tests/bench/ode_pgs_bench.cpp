@@ -23,7 +23,7 @@
 // start, impulses and integration) plus the step's own (ODE's island search and arena).
 // QuickStep cannot be split from outside.
 //
-// Accuracy, on the very MLCP our stepper builds (StepperOptions::keepProblems: the rows,
+// Accuracy, on the very MLCP our stepper builds (Settings::keepProblems: the rows,
 // right-hand side, bounds and findex RowPgs received) and by the one function that measures
 // every answer (mlcp::accuracy on rows.assemble(), the scaled natural-map residual), worst over
 // islands per step, then worst and median over the timed steps:
@@ -165,7 +165,7 @@ int main(int argc, char** argv) {
     probe->recordContacts = probe->contactFeedback = true;
     ours->recordContacts = true;
 
-    StepperOptions tight;
+    Settings tight;
     tight.options.maxIterations = referenceSweeps;
     tight.options.checkEvery = 10;
     tight.options.tolerance = 1e-9;

@@ -1,9 +1,12 @@
 // The drop-in and the bridge against Bullet's own solvers on the same scenes.
 #include <BulletDynamics/MLCPSolvers/btDantzigSolver.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <string>
 #include <vector>
 
 #include "common/broken_solvers.hpp"
@@ -266,7 +269,8 @@ TEST(BulletPlumbing, PgsPackedFromBulletsRowsMatchesThePgsOfTheRowSolver) {
     for (sc::World* w : {&fast, &copied}) {
       w->info().m_splitImpulse = split;
       sc::pyramid(*w, 6);
-      w->step(30);  // stock SI: the pyramid at rest
+      w->step(30);                 // stock SI: the pyramid at rest
+      s.packInPlace = w == &fast;  // the other through the RowSystem copy and RowSolver
       w->setSolver(std::make_unique<ConstraintSolver>(s));
       // A second island: a box sunk 0.15 into the ground (Bullet's split impulse pushes
       // penetrations deeper than 0.04 out).
@@ -277,7 +281,7 @@ TEST(BulletPlumbing, PgsPackedFromBulletsRowsMatchesThePgsOfTheRowSolver) {
     }
     auto* mine = static_cast<ConstraintSolver*>(fast.solver());
     auto* reference = static_cast<ConstraintSolver*>(copied.solver());
-    ASSERT_NE(reference->rowSolver(), nullptr);  // from now on through the RowSolver
+    ASSERT_NE(reference->rowSolver(), nullptr);  // the copy path runs through it
     int pushed = 0;
     for (int i = 0; i < 12; ++i) {
       fast.step();
@@ -300,6 +304,32 @@ TEST(BulletPlumbing, PgsPackedFromBulletsRowsMatchesThePgsOfTheRowSolver) {
       EXPECT_GT(pushed, 0);  // split-impulse problems were solved
     }
   }
+}
+
+// Asking for the RowSolver does not change the path "pgs" islands take: they stay packed in
+// place from Bullet's rows; only while a capture is set do they go through RowSolver on the
+// RowSystem copy (the capture writes that copy), and after it they are packed in place again.
+TEST(BulletPlumbing, RowSolverGetterLeavesThePgsPathAlone) {
+  sc::World w;
+  sc::pyramid(w, 3);
+  w.setSolver(std::make_unique<ConstraintSolver>(fixedSweepPgs(10)));
+  auto* solver = static_cast<ConstraintSolver*>(w.solver());
+  ASSERT_NE(solver->rowSolver(), nullptr);
+  w.step();
+  EXPECT_GT(solver->lastStep().islands, 0);
+  EXPECT_EQ(solver->lastStep().packedIslands, solver->lastStep().islands);
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("bullet_pgs_capture_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  solver->rowSolver()->setCapture((dir / "step-").string());
+  w.step();
+  EXPECT_EQ(solver->lastStep().packedIslands, 0);
+  EXPECT_EQ(static_cast<int>(solver->rowSolver()->capturedFiles().size()),
+            solver->lastStep().islands);
+  solver->rowSolver()->setCapture("");
+  w.step();
+  EXPECT_EQ(solver->lastStep().packedIslands, solver->lastStep().islands);
+  std::filesystem::remove_all(dir);
 }
 
 // The packing reads M^-1 J^T's angular part from Bullet's m_angularComponentA/B where a body's
@@ -337,11 +367,12 @@ TEST(BulletPlumbing, PackedPgsImpulsesEqualTheRowSolversBitForBit) {
       ball->setSpinningFriction(0.05);
       ball->setLinearVelocity(btVector3(2, 0, 0));
       ball->setAngularVelocity(btVector3(0, 1, -4));
-      w->step(30);  // stock SI
+      w->step(30);                 // stock SI
+      s.packInPlace = w == &fast;  // the other through the RowSystem copy and RowSolver
       w->setSolver(std::make_unique<ConstraintSolver>(s));
     }
     auto* reference = static_cast<ConstraintSolver*>(copied.solver());
-    ASSERT_NE(reference->rowSolver(), nullptr);  // through the RowSolver from now on
+    ASSERT_NE(reference->rowSolver(), nullptr);  // the copy path runs through it
     fast.step();
     copied.step();
     const mlcp::bullet::StepStats& st = static_cast<ConstraintSolver*>(fast.solver())->lastStep();
@@ -774,11 +805,12 @@ TEST(BulletPlumbing, PackedPgsAppliesImpulsesAsBulletDoesForLinearAndAngularFact
         pose.setIdentity();
         pose.setOrigin(btVector3(1.05, 0.5, 0));
         w->addBox(btVector3(0.5, 0.5, 0.5), 1.0, pose);
+        s.packInPlace = w == &fast;  // the other through the RowSystem copy and RowSolver
         w->setSolver(std::make_unique<ConstraintSolver>(s));
       }
       auto* mine = static_cast<ConstraintSolver*>(fast.solver());
       auto* reference = static_cast<ConstraintSolver*>(copied.solver());
-      ASSERT_NE(reference->rowSolver(), nullptr);  // through the RowSolver from now on
+      ASSERT_NE(reference->rowSolver(), nullptr);  // the copy path runs through it
       int touching = 0;
       for (int i = 0; i < 40; ++i) {
         fast.step();

@@ -12,10 +12,11 @@
 #include <type_traits>
 #include <vector>
 
-#include "../core/src/row_simd.hpp"  // the products (internal)
+#include "../core/src/rows/cpu_dispatch.hpp"  // MLCP_CPU_DISPATCH (internal)
+#include "../core/src/rows/row_simd.hpp"      // the products (internal)
 #include "common/contact_scenes.hpp"
 #include "common/cpu_path_guard.hpp"
-#include "common/row_fill.hpp"
+#include "common/row_source.hpp"
 #include "mlcp/rows.hpp"
 
 namespace mlcp {

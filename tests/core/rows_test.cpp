@@ -8,7 +8,7 @@
 #include <limits>
 #include <random>
 
-#include "common/row_fill.hpp"
+#include "common/row_source.hpp"
 #include "mlcp/pgs.hpp"
 #include "mlcp/residual.hpp"
 
@@ -239,7 +239,7 @@ TEST(RowPgs, RejectsBadRows) {
   EXPECT_EQ(s.validate(), "");
 }
 
-// The engine entry point (RowPgs::solve with a row fill) must pack what solve(RowSystem) packs
+// The engine entry point (RowPgs::solve with a row source) must pack what solve(RowSystem) packs
 // from the same values: the same iterates bit for bit, the same result, and the velocity change
 // M^-1 J^T (x - base) per body.
 using test::solveFromRows;

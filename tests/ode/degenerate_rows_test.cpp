@@ -31,7 +31,7 @@ TEST(OdeDegenerateRows, RedundantBallJointsAreSolvedLikeDWorldStep) {
   for (const char* name : {"auto", "dantzig"}) {
     // 14 planks: 84 rows, past RowSolver's dense limit (sparse LDL^T and dantzig).
     auto ours = redundantPlankChain(14), stock = redundantPlankChain(14);
-    StepperOptions options;
+    Settings options;
     options.options.tolerance = 1e-6;  // the scene files' tolerance
     Stepper stepper(name, options);
     int solved = 0, fellBack = 0;

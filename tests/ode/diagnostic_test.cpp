@@ -1,4 +1,4 @@
-// StepperOptions::keepProblems: the kept island problems are the ones the solver received, their
+// Settings::keepProblems: the kept island problems are the ones the solver received, their
 // lambda is the one the bodies felt, and keeping them changes nothing.
 #include <gtest/gtest.h>
 
@@ -18,7 +18,7 @@ namespace {
 constexpr double kUnset = std::numeric_limits<double>::quiet_NaN();
 
 // The bench's pgs (ode_pgs_bench): 20 sweeps, no convergence test, no fallback.
-StepperOptions fixedPgs(bool keep) { return fixedSweepPgs(20, keep); }
+Settings fixedPgs(bool keep) { return fixedSweepPgs(20, keep); }
 
 std::unique_ptr<Scene> pileWithContactFeedback() {
   auto s = boxPyramid(3);
@@ -30,10 +30,10 @@ TEST(OdeDiagnostics, KeptProblemsLeaveTheTrajectoryBitwiseUnchanged) {
   for (const char* name : {"pgs", "auto"}) {
     auto on = boxPyramid(3), off = boxPyramid(3);
     const bool pgs = std::string(name) == "pgs";
-    StepperOptions withKeep = pgs ? fixedPgs(true) : StepperOptions{};
+    Settings withKeep = pgs ? fixedPgs(true) : Settings{};
     withKeep.keepProblems = true;
     withKeep.timeBudget = 0;  // compared bit for bit: no wall-clock cut
-    StepperOptions without = pgs ? fixedPgs(false) : StepperOptions{};
+    Settings without = pgs ? fixedPgs(false) : Settings{};
     without.timeBudget = 0;
     Stepper keeping(name, withKeep), notKeeping(name, without);
     for (int k = 0; k < 80; ++k) {
@@ -92,7 +92,7 @@ TEST(OdeDiagnostics, LambdaFromFeedbackIsTheAppliedLambda) {
   };
   for (const Case& c : cases) {
     auto scene = c.make();
-    StepperOptions o = std::string(c.solver) == "pgs" ? fixedPgs(true) : StepperOptions{};
+    Settings o = std::string(c.solver) == "pgs" ? fixedPgs(true) : Settings{};
     o.keepProblems = true;
     Stepper stepper(c.solver, o);
     int joints = 0;

@@ -65,7 +65,7 @@ TEST(OdeEdge, AutoDisableWorksAsWithDWorldStep) {
 
 TEST(OdeEdge, IslandWithOnlyBilateralJoints) {
   auto ours = pendulumChain(4, 0.3), stock = pendulumChain(4, 0.3);
-  StepperOptions options;
+  Settings options;
   options.fallback = "";
   Stepper stepper("dantzig", options), reference("ode-lcp");
   for (int k = 0; k < 100; ++k) {
@@ -106,7 +106,7 @@ TEST(OdeEdge, BrokenPrimariesFallBackCountedAndTheFallbackAnswers) {
   mlcp::test::registerBrokenSolvers();
   for (const char* broken : {"test-nan", "test-fail"}) {
     auto withFallback = boxStack(2), alone = boxStack(2);
-    StepperOptions options;
+    Settings options;
     options.fallback = "dantzig";
     Stepper stepper(broken, options);
     options.fallback = "";
@@ -146,7 +146,7 @@ TEST(OdeEdge, UnknownSolverNameIsAClearError) {
     EXPECT_NE(what.find("dantzig"), std::string::npos) << what;
     EXPECT_NE(what.find("ode-lcp"), std::string::npos) << what;
   }
-  StepperOptions options;
+  Settings options;
   options.fallback = "nope";
   EXPECT_THROW(Stepper("pgs", options), std::invalid_argument);
   options.fallback = "ode-step";

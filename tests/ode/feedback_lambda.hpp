@@ -1,6 +1,6 @@
 // A joint's constraint forces recovered from its dJointFeedback, for the tests and benchmarks
 // that measure a stepper whose multipliers are not returned (dWorldQuickStep) on the MLCP our
-// stepper keeps (StepperOptions::keepProblems).
+// stepper keeps (Settings::keepProblems).
 //
 // ODE's steppers (dxStepIsland, dxQuickStepIsland's stage 4b) and ours write, per joint with m
 // rows, f1 t1 = J_1^T lambda and f2 t2 = J_2^T lambda, where J_1, J_2 are the rows' 6-wide

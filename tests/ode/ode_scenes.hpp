@@ -18,8 +18,8 @@ namespace mlcp::ode::test {
 
 // Our pgs as QuickStep runs: a fixed number of sweeps with SOR factor 1.3 (QuickStep's
 // default), no convergence test, no fallback.
-inline StepperOptions fixedSweepPgs(int sweeps, bool keepProblems = false) {
-  StepperOptions o;
+inline Settings fixedSweepPgs(int sweeps, bool keepProblems = false) {
+  Settings o;
   o.options.maxIterations = sweeps;
   o.options.checkEvery = sweeps;
   o.options.tolerance = 0;

@@ -78,7 +78,7 @@ TEST(OdePlumbing, OwnRowsWithOdesLcpSolverMatchDWorldStep) {
 }
 
 TEST(OdePlumbing, CompatibleDantzigMatchesDWorldStep) {
-  StepperOptions options;
+  Settings options;
   options.options.frictionBounds = FrictionBounds::FixedOnce;
   options.warmStart = false;  // stock starts every step from zero
   options.fallback = "";

@@ -47,7 +47,7 @@ const Scenes kMonotoneScenes[] = {
 };
 
 TEST(OdeSolvers, PgsAtTightToleranceReachesDantzigsAnswer) {
-  StepperOptions options;
+  Settings options;
   options.options.tolerance = 1e-10;
   options.options.maxIterations = 20000;
   options.engineIterations = false;
@@ -71,7 +71,7 @@ TEST(OdeSolvers, PgsAtTightToleranceReachesDantzigsAnswer) {
 }
 
 TEST(OdeSolvers, ExactDantzigIsNoWorseThanStockAtEveryStep) {
-  StepperOptions options;
+  Settings options;
   options.reference = "ode-lcp";  // stock dWorldStep's solver on the same island problem
   options.fallback = "";
   int stockWorse = 0;
@@ -90,7 +90,7 @@ TEST(OdeSolvers, ExactDantzigIsNoWorseThanStockAtEveryStep) {
 
 TEST(OdeSolvers, EveryCoreSolverRunsTheStack) {
   for (const char* name : {"pgs", "dantzig", "lemke"}) {
-    StepperOptions options;
+    Settings options;
     options.fallback = "";
     auto scene = boxStack(3);
     Stepper stepper(name, options);
@@ -104,7 +104,7 @@ TEST(OdeSolvers, EveryCoreSolverRunsTheStack) {
 
 TEST(OdeSolvers, PgsIsWarmStartedFromTheLastStep) {
   // A box at rest: this step's answer is last step's, so a warm start needs almost no sweeps.
-  StepperOptions options;
+  Settings options;
   options.options.tolerance = 1e-6;
   options.engineIterations = false;  // sweeps to the tolerance, not QuickStep's fixed count
   auto warm = boxOnPlane(0.0), cold = boxOnPlane(0.0);

@@ -135,42 +135,43 @@ struct Combo {
   bool applies;
 };
 
-int runSweep(const SweepArgs& args) {
-  const std::string me = "mlcp sweep: ";
-  std::vector<double> values;
-  std::string error;
-  if (!parseValues(args, values, error)) {
-    std::cerr << me << error << "\n";
-    return kInvalidInput;
-  }
+// The values, engines and scenes of the arguments; false, with the message, on bad input.
+bool readInputs(const SweepArgs& args, std::vector<double>& values,
+                std::vector<std::string>& engines, std::vector<scene::Scene>& scenes,
+                std::string& error) {
+  if (!parseValues(args, values, error)) return false;
   const std::vector<std::string> known = engineList();
-  const std::vector<std::string> engines = args.engines.empty() ? known : args.engines;
+  engines = args.engines.empty() ? known : args.engines;
   for (const std::string& e : engines)
     if (std::find(known.begin(), known.end(), e) == known.end()) {
-      std::cerr << me << "unknown engine '" << e << "' (known: " << engineNames() << ")\n";
-      return kInvalidInput;
+      error = "unknown engine '" + e + "' (known: " + engineNames() + ")";
+      return false;
     }
   if (args.solvers.empty()) {
-    std::cerr << me << "--solvers: give at least one solver\n";
-    return kInvalidInput;
+    error = "--solvers: give at least one solver";
+    return false;
   }
-  std::vector<scene::Scene> scenes;
   for (const std::string& path : args.scenes) {
     try {
       scenes.push_back(scene::loadScene(path));
     } catch (const scene::FormatError& e) {
-      std::cerr << me << e.what() << "\n";
-      return kInvalidInput;
+      error = e.what();
+      return false;
     }
   }
+  return true;
+}
 
-  // Which engine takes which solver, asked of the engines themselves on the smallest scene.
+// Which engine takes which solver, asked of the engines themselves on the smallest scene: the
+// (engine, solver) pairs that exist. false when a solver exists in no engine.
+bool runnablePairs(const SweepArgs& args, const std::vector<std::string>& engines,
+                   const std::vector<scene::Scene>& scenes,
+                   std::vector<std::pair<std::string, std::string>>& runnable, std::string& skipped,
+                   std::string& error) {
   const scene::Scene& probe = *std::min_element(scenes.begin(), scenes.end(),
                                                 [](const scene::Scene& a, const scene::Scene& b) {
                                                   return a.bodies.size() < b.bodies.size();
                                                 });
-  std::vector<std::pair<std::string, std::string>> runnable;  // (engine, solver)
-  std::string skipped;
   for (const std::string& solver : args.solvers) {
     std::string lastError;
     bool anywhere = false;
@@ -186,15 +187,19 @@ int runSweep(const SweepArgs& args) {
       }
     }
     if (!anywhere) {
-      std::cerr << me << lastError << "\n";
-      return kInvalidInput;
+      error = lastError;
+      return false;
     }
   }
-  if (!skipped.empty())
-    std::cerr << me << "skipped (not a solver of that engine): " << skipped << "\n";
+  return true;
+}
 
+std::vector<Combo> combinations(const SweepArgs& args, std::size_t sceneCount,
+                                const std::vector<std::string>& engines,
+                                const std::vector<std::pair<std::string, std::string>>& runnable,
+                                const std::vector<double>& values) {
   std::vector<Combo> combos;
-  for (std::size_t s = 0; s < scenes.size(); ++s)
+  for (std::size_t s = 0; s < sceneCount; ++s)
     for (const std::string& engine : engines)
       for (const auto& [e, solver] : runnable) {
         if (e != engine) continue;
@@ -202,136 +207,192 @@ int runSweep(const SweepArgs& args) {
         for (std::size_t k = 0; k < (applies ? values.size() : 1); ++k)
           combos.push_back({s, engine, solver, values[k], applies});
       }
+  return combos;
+}
 
-  const std::string header = std::string(kSweepColumns) + kStepCsvHeader;
-  bool fresh = true;
+// The CSV opened for writing (fresh: with the header) or, with --append, for appending to a sweep
+// CSV of the same header. false, with the message, when it cannot be.
+bool openCsv(const SweepArgs& args, const std::string& header, std::ofstream& csv, bool& fresh,
+             std::string& error) {
+  fresh = true;
   if (args.append && std::filesystem::exists(args.csv)) {
     try {  // a FIFO or /dev/zero would be read forever for its first line
       io::checkInputFile(args.csv, io::kMaxTrajectoryFileBytes, "sweep CSV");
     } catch (const io::FormatError& e) {
-      std::cerr << me << "--append: " << e.what() << "\n";
-      return kInvalidInput;
+      error = std::string("--append: ") + e.what();
+      return false;
     }
     std::ifstream old(args.csv);
     std::string first;
     if (old && std::getline(old, first)) {
       if (first != header) {
-        std::cerr << me << "--append: " << args.csv
-                  << " is not a sweep CSV of this version (its header differs)\n";
-        return kInvalidInput;
+        error =
+            "--append: " + args.csv + " is not a sweep CSV of this version (its header differs)";
+        return false;
       }
       fresh = false;
     }
   }
-  std::ofstream csv(args.csv, fresh ? std::ios::trunc : std::ios::app);
+  csv.open(args.csv, fresh ? std::ios::trunc : std::ios::app);
   if (!csv) {
-    std::cerr << me << "cannot write " << args.csv << "\n";
-    return kInvalidInput;
+    error = "cannot write " + args.csv;
+    return false;
   }
   if (fresh) csv << header << "\n";
   csv << std::setprecision(9);
+  return true;
+}
 
-  const bool tty = isatty(fileno(stderr)) != 0;
-  // On a terminal the bar redraws in place; elsewhere (CI, logs) one line per run.
-  const int passes = args.repeat;
-  Progress bar("sweep", static_cast<int>(combos.size()) * passes, !tty);
-  struct Kept {  // a combination's steps from the first pass, times lowered by later passes
+// What the passes keep: each combination's steps from the first pass (times lowered by later
+// passes), the runs that blew up or differed, the rows written.
+struct SweepRecord {
+  struct Kept {
     std::string scene, engine, prefix;
     std::vector<scene::StepMeasures> steps;
   };
-  std::vector<Kept> kept(combos.size());
+  std::vector<Kept> kept;
   std::vector<std::string> blownUp, differing;
   std::size_t rows = 0;
-  for (int pass = 0; pass < passes; ++pass)
-    for (std::size_t c = 0; c < combos.size(); ++c) {
-      const Combo& combo = combos[c];
-      const scene::Scene& sc = scenes[combo.scene];
-      scene::RunSettings run = runSettings(args, sc, combo.solver);
-      if (args.setting == "iterations")
-        run.iterations = static_cast<int>(combo.value);
-      else
-        run.tolerance = combo.value;
-      const int steps = args.steps >= 0 ? args.steps : sc.settings.steps;
-      const std::string label = sc.name + " " + combo.engine + " " + combo.solver + " " +
-                                args.setting + "=" +
-                                (combo.applies ? fmtValue(combo.value) : "(ignored)") +
-                                (passes > 1 ? " pass " + std::to_string(pass + 1) : "");
-      const std::string prefix =
-          args.setting + "," + fmtValue(combo.value) + "," + (combo.applies ? "1" : "0") + ",";
-      bar.start(label);
-      std::unique_ptr<scene::World> world;
-      try {
-        world = makeWorld(combo.engine, sc, run);  // the pair was checked on the smallest scene
-      } catch (const std::exception& e) {
-        std::cerr << me << label << ": " << e.what() << "\n";
-        return kInvalidInput;
-      }
-      Kept& k = kept[c];
-      k.prefix = prefix;
-      bool matching = true;  // this pass's steps still match the first pass's
-      auto lastDraw = std::chrono::steady_clock::now();
-      const RunSummary sum = runWorld(*world, steps, [&](const scene::World& w, int i) {
-        const scene::StepMeasures& m = w.last();
-        if (pass == 0) {
-          if (i == 0) k.scene = w.scene().name, k.engine = w.engine();
-          k.steps.push_back(m);
-        } else if (matching && i < static_cast<int>(k.steps.size()) && sameStep(k.steps[i], m)) {
-          k.steps[i].solverMs = std::min(k.steps[i].solverMs, m.solverMs);
-          k.steps[i].stepMs = std::min(k.steps[i].stepMs, m.stepMs);
-        } else if (matching) {
-          matching = false;
-          differing.push_back(label + " from step " + std::to_string(i));
-        }
-        if (passes == 1) {  // streamed; with repeats the first pass's rows are written last
-          csv << prefix;
-          writeStepCsv(csv, w, combo.solver, i);
-        }
-        const auto now = std::chrono::steady_clock::now();
-        if (tty && now - lastDraw > std::chrono::milliseconds(200)) {
-          bar.start(label + " step " + std::to_string(i + 1) + "/" + std::to_string(steps));
-          lastDraw = now;
-        }
-      });
-      if (pass == 0) {  // the rows and the blow-ups are the first pass's
-        csv.flush();
-        rows += sum.steps;
-        if (!sum.finite) blownUp.push_back(label + " at step " + std::to_string(sum.steps - 1));
-      }
-      bar.done();
-      if (!tty) {
-        const double s = bar.seconds();
-        const std::size_t done = pass * combos.size() + c + 1;
-        const double eta = s / double(done) * double(combos.size() * passes - done);
-        std::cerr << "sweep " << done << "/" << combos.size() * passes << " " << label << ": "
-                  << sum.steps << " steps, solver " << std::setprecision(3) << sum.meanSolverMs
-                  << " ms/step, worst residual " << sum.worstResidual
-                  << (sum.finite ? "" : ", BLEW UP") << " (" << minutes(s) << " elapsed, ETA "
-                  << minutes(eta) << ")\n";
-      }
+};
+
+// Off a terminal: one line per finished run, with the time elapsed and the time left.
+void printRunLine(const Progress& bar, std::size_t combos, int passes, std::size_t done,
+                  const std::string& label, const RunSummary& sum) {
+  const double s = bar.seconds();
+  const double eta = s / double(done) * double(combos * passes - done);
+  std::cerr << "sweep " << done << "/" << combos * passes << " " << label << ": " << sum.steps
+            << " steps, solver " << std::setprecision(3) << sum.meanSolverMs
+            << " ms/step, worst residual " << sum.worstResidual << (sum.finite ? "" : ", BLEW UP")
+            << " (" << minutes(s) << " elapsed, ETA " << minutes(eta) << ")\n";
+}
+
+// One pass of combination c: its world stepped, its rows streamed (one pass) or kept. false,
+// with the message, when its world cannot be made.
+bool runCombination(const SweepArgs& args, const std::vector<scene::Scene>& scenes,
+                    const std::vector<Combo>& combos, std::size_t c, int pass, bool tty,
+                    Progress& bar, std::ofstream& csv, SweepRecord& record, std::string& error) {
+  const int passes = args.repeat;
+  const Combo& combo = combos[c];
+  const scene::Scene& sc = scenes[combo.scene];
+  scene::RunSettings run = runSettings(args, sc, combo.solver);
+  if (args.setting == "iterations")
+    run.iterations = static_cast<int>(combo.value);
+  else
+    run.tolerance = combo.value;
+  const int steps = args.steps >= 0 ? args.steps : sc.settings.steps;
+  const std::string label = sc.name + " " + combo.engine + " " + combo.solver + " " + args.setting +
+                            "=" + (combo.applies ? fmtValue(combo.value) : "(ignored)") +
+                            (passes > 1 ? " pass " + std::to_string(pass + 1) : "");
+  const std::string prefix =
+      args.setting + "," + fmtValue(combo.value) + "," + (combo.applies ? "1" : "0") + ",";
+  bar.start(label);
+  std::unique_ptr<scene::World> world;
+  try {
+    world = makeWorld(combo.engine, sc, run);  // the pair was checked on the smallest scene
+  } catch (const std::exception& e) {
+    error = label + ": " + e.what();
+    return false;
+  }
+  SweepRecord::Kept& k = record.kept[c];
+  k.prefix = prefix;
+  bool matching = true;  // this pass's steps still match the first pass's
+  auto lastDraw = std::chrono::steady_clock::now();
+  const RunSummary sum = runWorld(*world, steps, [&](const scene::World& w, int i) {
+    const scene::StepMeasures& m = w.last();
+    if (pass == 0) {
+      if (i == 0) k.scene = w.scene().name, k.engine = w.engine();
+      k.steps.push_back(m);
+    } else if (matching && i < static_cast<int>(k.steps.size()) && sameStep(k.steps[i], m)) {
+      k.steps[i].solverMs = std::min(k.steps[i].solverMs, m.solverMs);
+      k.steps[i].stepMs = std::min(k.steps[i].stepMs, m.stepMs);
+    } else if (matching) {
+      matching = false;
+      record.differing.push_back(label + " from step " + std::to_string(i));
     }
+    if (passes == 1) {  // streamed; with repeats the first pass's rows are written last
+      csv << prefix;
+      writeStepCsv(csv, w, combo.solver, i);
+    }
+    const auto now = std::chrono::steady_clock::now();
+    if (tty && now - lastDraw > std::chrono::milliseconds(200)) {
+      bar.start(label + " step " + std::to_string(i + 1) + "/" + std::to_string(steps));
+      lastDraw = now;
+    }
+  });
+  if (pass == 0) {  // the rows and the blow-ups are the first pass's
+    csv.flush();
+    record.rows += sum.steps;
+    if (!sum.finite) record.blownUp.push_back(label + " at step " + std::to_string(sum.steps - 1));
+  }
+  bar.done();
+  if (!tty) printRunLine(bar, combos.size(), passes, pass * combos.size() + c + 1, label, sum);
+  return true;
+}
+
+// After the passes: the kept rows (with repeats), the summary line, the runs that differed or
+// blew up; the exit code.
+int finishSweep(const SweepArgs& args, const std::vector<Combo>& combos, bool fresh, Progress& bar,
+                std::ofstream& csv, const SweepRecord& record) {
+  const std::string me = "mlcp sweep: ";
+  const int passes = args.repeat;
   if (passes > 1)
     for (std::size_t c = 0; c < combos.size(); ++c)
-      for (std::size_t i = 0; i < kept[c].steps.size(); ++i) {
-        csv << kept[c].prefix;
-        writeStepCsv(csv, kept[c].scene, kept[c].engine, combos[c].solver, static_cast<int>(i),
-                     kept[c].steps[i]);
+      for (std::size_t i = 0; i < record.kept[c].steps.size(); ++i) {
+        csv << record.kept[c].prefix;
+        writeStepCsv(csv, record.kept[c].scene, record.kept[c].engine, combos[c].solver,
+                     static_cast<int>(i), record.kept[c].steps[i]);
       }
   csv.flush();
   bar.finish();
   std::cout << (fresh ? "wrote " : "appended to ") << args.csv << ": " << combos.size() << " runs"
-            << (passes > 1 ? " x " + std::to_string(passes) + " passes" : "") << ", " << rows
+            << (passes > 1 ? " x " + std::to_string(passes) + " passes" : "") << ", " << record.rows
             << " rows in " << std::fixed << std::setprecision(1) << bar.seconds() << " s\n";
-  if (!differing.empty()) {
-    std::cerr << me << differing.size()
+  if (!record.differing.empty()) {
+    std::cerr << me << record.differing.size()
               << " repeated run(s) differed from their first pass (times not used from there):\n";
-    for (const std::string& d : differing) std::cerr << "  " << d << "\n";
+    for (const std::string& d : record.differing) std::cerr << "  " << d << "\n";
   }
-  if (!blownUp.empty()) {
-    std::cerr << me << blownUp.size() << " run(s) blew up (rows kept up to the blow-up):\n";
-    for (const std::string& b : blownUp) std::cerr << "  " << b << "\n";
+  if (!record.blownUp.empty()) {
+    std::cerr << me << record.blownUp.size() << " run(s) blew up (rows kept up to the blow-up):\n";
+    for (const std::string& b : record.blownUp) std::cerr << "  " << b << "\n";
     return kNotSolved;
   }
   return kSolved;
+}
+
+// The stages: read the inputs, find the runnable pairs, list the combinations, open the CSV,
+// run every combination in each pass, finish.
+int runSweep(const SweepArgs& args) {
+  const std::string me = "mlcp sweep: ";
+  std::vector<double> values;
+  std::vector<std::string> engines;
+  std::vector<scene::Scene> scenes;
+  std::vector<std::pair<std::string, std::string>> runnable;  // (engine, solver)
+  std::string skipped, error;
+  auto invalid = [&] {
+    std::cerr << me << error << "\n";
+    return kInvalidInput;
+  };
+  if (!readInputs(args, values, engines, scenes, error)) return invalid();
+  if (!runnablePairs(args, engines, scenes, runnable, skipped, error)) return invalid();
+  if (!skipped.empty())
+    std::cerr << me << "skipped (not a solver of that engine): " << skipped << "\n";
+  const std::vector<Combo> combos = combinations(args, scenes.size(), engines, runnable, values);
+  std::ofstream csv;
+  bool fresh = true;
+  if (!openCsv(args, std::string(kSweepColumns) + kStepCsvHeader, csv, fresh, error))
+    return invalid();
+
+  const bool tty = isatty(fileno(stderr)) != 0;
+  // On a terminal the bar redraws in place; elsewhere (CI, logs) one line per run.
+  Progress bar("sweep", static_cast<int>(combos.size()) * args.repeat, !tty);
+  SweepRecord record;
+  record.kept.resize(combos.size());
+  for (int pass = 0; pass < args.repeat; ++pass)
+    for (std::size_t c = 0; c < combos.size(); ++c)
+      if (!runCombination(args, scenes, combos, c, pass, tty, bar, csv, record, error))
+        return invalid();
+  return finishSweep(args, combos, fresh, bar, csv, record);
 }
 
 }  // namespace

@@ -177,7 +177,8 @@ btScalar ConstraintSolver::solveGroupCacheFriendlyIterations(
     const Start start = !settings_.warmStart ? Start::Zero
                         : settings_.siStart  ? Start::AppliedImpulse
                                              : Start::CachedImpulse;
-    fastPgs_ = settings_.solver == "pgs" && !settings_.keepIslands && !shared_;
+    fastPgs_ = settings_.solver == "pgs" && settings_.packInPlace && !settings_.keepIslands &&
+               !rows_->capturing();
     builder_.build(rows, info, settings_.cfm, start, !fastPgs_);
     current_.inertRows += builder_.inertRows();
     for (int k = 0; k < builder_.count(); ++k) {

@@ -7,7 +7,6 @@
 #include <cstdint>
 
 #include "mlcp/bullet/constraint_solver.hpp"
-#include "mlcp/detail/row_pack.hpp"
 #include "mlcp/row_screen.hpp"
 
 namespace mlcp::bullet {
@@ -77,25 +76,32 @@ int IslandBuilder::find(int k) {
 
 void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info, CfmModel cfm,
                           Start start, bool system) {
-  const btAlignedObjectArray<btSolverBody>& bodies = *in.bodies;
-  const int nb = bodies.size();
-  const int nj = in.joints->size(), nc = in.contacts->size(), nf = in.friction->size(),
-            nr = in.rolling->size();
-  const int n = nj + nc + nf + nr;
   in_ = in;
   cfm_ = cfm;
   start_ = start;
-  nj_ = nj;
-  nc_ = nc;
-  nf_ = nf;
+  nj_ = in.joints->size();
+  nc_ = in.contacts->size();
+  nf_ = in.friction->size();
+  const int n = nj_ + nc_ + nf_ + in.rolling->size();
+  prepareBodies();
+  const bool single = linkRows(n);
+  numberIslands(n, single);
+  sizeIslands(single);
+  placeRows(n, single);
+  readSolverInfo(info);
+  if (system)
+    for (int k = 0; k < count_; ++k) fillSystem(islands_[k]);
+}
 
+void IslandBuilder::prepareBodies() {
+  const btAlignedObjectArray<btSolverBody>& bodies = *in_.bodies;
+  const int nb = bodies.size();
   dynamic_.resize(nb);
   parent_.resize(nb);
   unit_.resize(nb);
   bodyLocal_.assign(nb, -1);
   if (islands_.empty()) islands_.resize(1);
-  std::vector<int>& firstUse = islands_[0].solverBody;
-  firstUse.clear();
+  islands_[0].solverBody.clear();
   for (int k = 0; k < nb; ++k) {
     const btSolverBody& sb = bodies[k];
     const btRigidBody* rb = sb.m_originalBody;
@@ -105,7 +111,12 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
       unit_[k] = (allOnes(sb.m_linearFactor) ? kUnitLinear : 0) |
                  (allOnes(sb.m_angularFactor) ? kUnitAngular : 0);
   }
+}
 
+bool IslandBuilder::linkRows(int n) {
+  const BulletRows& in = in_;
+  const int nj = nj_, nc = nc_, nf = nf_, nr = in.rolling->size();
+  std::vector<int>& firstUse = islands_[0].solverBody;
   // One pass over Bullet's rows for the graph: rows in the stock order, friction rows pointing at
   // their contact row, each row's dynamic bodies kept compact for the passes below.
   all_.resize(n);
@@ -164,60 +175,50 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     btSolverConstraint& c = (*in.rolling)[i];
     add(nj + nc + nf + i, c, nj + c.m_frictionIndex);
   }
+  // The bodies the rows name less the unions that joined two components is the number of
+  // components.
+  return n > 0 && inert == 0 && static_cast<int>(firstUse.size()) - joined == 1;
+}
 
+void IslandBuilder::addBody(Island& isl, int d) {
+  const btSolverBody& sb = (*in_.bodies)[d];
+  const btRigidBody* rb = sb.m_originalBody;
+  BodyInverseMass m;
+  m.invMass = rb->getInvMass();
+  const Eigen::Vector3d af = toEigen(sb.m_angularFactor);
+  const btMatrix3x3& I = rb->getInvInertiaTensorWorld();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) m.invInertia(r, c) = af[r] * I[r][c] * af[c];
+  if (!sameUpdate(sb)) isl.perRowWriteBack = true;
+  isl.system.bodies.push_back(m);
+}
+
+void IslandBuilder::openIsland() {
+  if (static_cast<int>(islands_.size()) < ++count_) islands_.resize(count_);
+  rowsIn_.push_back(0);
+  Island& isl = islands_[count_ - 1];
+  isl.system.bodies.clear();
+  isl.solverBody.clear();
+  isl.hasSplit = false;
+  isl.filled = false;
+  isl.perRowWriteBack = false;
+  isl.beyondReach = false;
+}
+
+void IslandBuilder::numberIslands(int n, bool single) {
   // Islands numbered by first appearance in row order; rows keep their relative order, bodies
   // are numbered by first use in their island's rows.
-  islandOfRoot_.assign(nb, -1);
+  islandOfRoot_.assign(dynamic_.size(), -1);
   rowIsland_.resize(n);
   rowLocal_.resize(n);
   count_ = 0;
   inert_ = 0;
-  auto mass = [&](Island& isl, int d) {
-    const btSolverBody& sb = bodies[d];
-    const btRigidBody* rb = sb.m_originalBody;
-    BodyInverseMass m;
-    m.invMass = rb->getInvMass();
-    const Eigen::Vector3d af = toEigen(sb.m_angularFactor);
-    const btMatrix3x3& I = rb->getInvInertiaTensorWorld();
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) m.invInertia(r, c) = af[r] * I[r][c] * af[c];
-    if (!sameUpdate(sb)) isl.perRowWriteBack = true;
-    isl.system.bodies.push_back(m);
-  };
-  auto localBody = [&](Island& isl, int d) -> int {
-    if (d < 0) return -1;
-    if (bodyLocal_[d] < 0) {
-      bodyLocal_[d] = static_cast<int>(isl.system.bodies.size());
-      mass(isl, d);
-      isl.solverBody.push_back(d);
-    }
-    return bodyLocal_[d];
-  };
-  // First each row's island and its place there (a manifold's rows repeat the previous row's
-  // bodies: no find() for them), then each island's arrays at their final sizes, written by
-  // index (no growth checks per row).
   rowsIn_.clear();
-  auto newIsland = [&] {
-    if (static_cast<int>(islands_.size()) < ++count_) islands_.resize(count_);
-    rowsIn_.push_back(0);
-    Island& isl = islands_[count_ - 1];
-    isl.system.bodies.clear();
-    isl.solverBody.clear();
-    isl.hasSplit = false;
-    isl.filled = false;
-    isl.perRowWriteBack = false;
-    isl.beyondReach = false;
-  };
+  const std::vector<int>& firstUse = islands_[0].solverBody;
   // One component with every row on a dynamic body (a pile, a pyramid): the rows are island 0 in
   // their own order, its bodies were numbered in the pass above (first use, as the general
   // numbering does), its rows and findex are the pass's arrays themselves (swapped in) and its
-  // rowIndex the identity (not written). The bodies the rows name less the unions that joined
-  // two components is the number of components.
-  const bool single = n > 0 && inert == 0 && static_cast<int>(firstUse.size()) - joined == 1;
-  int lastPairA = -2, lastPairB = -2, lastIsland = -1;
-  // The current island's row count kept here (written back when the island changes): counting
-  // in rowsIn_ chained every row through a store and a load.
-  int counted = 0;
+  // rowIndex the identity (not written).
   if (single) {
     count_ = 1;
     rowsIn_.push_back(n);
@@ -227,11 +228,31 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     isl.filled = false;
     isl.perRowWriteBack = false;
     isl.beyondReach = false;
-    for (const int d : firstUse) mass(isl, d);
-  } else {
-    for (const int d : firstUse) bodyLocal_[d] = -1;
+    for (const int d : firstUse) addBody(isl, d);
+    return;
   }
-  for (int i = 0; i < n && !single; ++i) {
+  for (const int d : firstUse) bodyLocal_[d] = -1;
+  numberComponents(n);
+}
+
+void IslandBuilder::numberComponents(int n) {
+  auto localBody = [&](Island& isl, int d) -> int {
+    if (d < 0) return -1;
+    if (bodyLocal_[d] < 0) {
+      bodyLocal_[d] = static_cast<int>(isl.system.bodies.size());
+      addBody(isl, d);
+      isl.solverBody.push_back(d);
+    }
+    return bodyLocal_[d];
+  };
+  // First each row's island and its place there (a manifold's rows repeat the previous row's
+  // bodies: no find() for them), then each island's arrays at their final sizes, written by
+  // index (no growth checks per row; sizeIslands, placeRows).
+  int lastPairA = -2, lastPairB = -2, lastIsland = -1;
+  // The current island's row count kept here (written back when the island changes): counting
+  // in rowsIn_ chained every row through a store and a load.
+  int counted = 0;
+  for (int i = 0; i < n; ++i) {
     const auto [a, b] = rowBodies_[i];
     if (a < 0 && b < 0) {
       rowIsland_[i] = -1;
@@ -243,7 +264,7 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
       const int root = find(a >= 0 ? a : b);
       if (islandOfRoot_[root] < 0) {
         islandOfRoot_[root] = count_;
-        newIsland();
+        openIsland();
       }
       k = islandOfRoot_[root];
       if (k != lastIsland) {
@@ -260,6 +281,9 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     rowLocal_[i] = counted++;
   }
   if (lastIsland >= 0) rowsIn_[lastIsland] = counted;
+}
+
+void IslandBuilder::sizeIslands(bool single) {
   for (int k = 0; k < count_; ++k) {
     Island& isl = islands_[k];
     const std::size_t m = static_cast<std::size_t>(rowsIn_[k]);
@@ -270,12 +294,16 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
       isl.system.findex.resize(m);
     }
     // Only the cached-impulse start reads the points (and remember() keeps answers for it).
-    const std::size_t withPoints = start == Start::CachedImpulse ? m : 0;
+    const std::size_t withPoints = start_ == Start::CachedImpulse ? m : 0;
     isl.point.resize(withPoints);
     isl.last.resize(withPoints);
     isl.memo.resize(withPoints);
   }
-  points_ = start == Start::CachedImpulse;
+  points_ = start_ == Start::CachedImpulse;
+}
+
+void IslandBuilder::placeRows(int n, bool single) {
+  const int nj = nj_, nc = nc_, nf = nf_;
   for (int i = 0; i < n && (points_ || !single); ++i) {
     const int k = single ? 0 : rowIsland_[i];
     if (k < 0) continue;
@@ -319,7 +347,10 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
     islands_[0].rows.swap(all_);
     islands_[0].system.findex.swap(findex_);
   }
+}
 
+void IslandBuilder::readSolverInfo(const btContactSolverInfo& info) {
+  const Start start = start_;
   stockCfm_ = info.m_globalCfm / info.m_timeStep;
   // SI starts contacts and friction from the cached impulse times m_warmstartingFactor (0.85); a
   // solver that can use a guess gets the cached impulse itself.
@@ -333,8 +364,6 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
   lateralCache_ = start == Start::CachedImpulse && (info.m_solverMode & SOLVER_USE_WARMSTARTING) &&
                   (info.m_solverMode & (SOLVER_ENABLE_FRICTION_DIRECTION_CACHING |
                                         SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION));
-  if (system)
-    for (int k = 0; k < count_; ++k) fillSystem(islands_[k]);
 }
 
 [[gnu::always_inline]] inline RowPgs::RowView IslandBuilder::view(Island& isl, int r, bool split,
@@ -430,7 +459,7 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
   return out;
 }
 
-[[gnu::always_inline]] inline RowPgs::RowView IslandBuilder::Source::row(int r) {
+RowPgs::RowView IslandBuilder::Source::row(int r) {
   // Bullet's row r + kRowsAhead fetched: its 288 bytes start 16-byte aligned and span five or
   // six lines; the first five hold every field view() reads (bytes 0-264; m_rhsPenetration
   // among the fields past byte 224).
@@ -443,7 +472,7 @@ void IslandBuilder::build(const BulletRows& in, const btContactSolverInfo& info,
 
 Result IslandBuilder::solvePgs(RowPgs& pgs, Island& island, bool split, Vector& x) {
   Source rows(*this, island, split);
-  return pgs.solveFrom(island.system.bodies, static_cast<int>(island.rows.size()), rows, x);
+  return pgs.solve(island.system.bodies, static_cast<int>(island.rows.size()), rows, x);
 }
 
 void IslandBuilder::fillSystem(Island& isl) {

@@ -9,7 +9,7 @@
 // they give the same answers bit for bit (tests/core/cpu_test.cpp, and a Bullet pyramid stepped
 // under both in tests/bullet/plumbing_test.cpp); only the time differs. The AVX2 code uses the
 // VEX encodings throughout and 4-wide vectors for the sweep's and the check's 12-wide row
-// products and velocity updates (core/src/row_simd.hpp). AVX2 is chosen for these loops alone
+// products and velocity updates (core/src/rows/row_simd.hpp). AVX2 is chosen for these loops alone
 // because they are where fixed-sweep pgs spends its time; building the whole library for
 // x86-64-v3 gains about what this dispatch gains (docs/decisions.md). docs/benchmarks.md has
 // the times of both paths (bullet_bench --pgs-vs-si, MLCP_CPU_PATH=baseline).
@@ -19,13 +19,9 @@
 // other value is named on stderr and ignored). setCpuPath() changes it for the whole process (for
 // comparisons; the solvers read it once per loop, so change it between solves). Builds without
 // the dispatch (another compiler or architecture, or CMake's -DMLCP_CPU_DISPATCH=OFF, which
-// defines MLCP_NO_CPU_DISPATCH) always run the baseline. A program that instantiates
-// RowPgs::solveFrom itself (mlcp/detail/row_pack.hpp) compiles that packing with its own flags:
-// with FMA enabled (-mfma, -march=native) GCC fuses a * b + c in C++ unless -ffp-contract=off,
-// so such a program keeps the guarantee with that flag.
+// defines MLCP_NO_CPU_DISPATCH) always run the baseline. The variants and the choice between
+// them are internal (core/src/rows/cpu_dispatch.hpp).
 #pragma once
-
-#include <atomic>
 
 namespace mlcp {
 
@@ -43,27 +39,3 @@ bool cpuPathAvailable(CpuPath path);
 bool setCpuPath(CpuPath path);
 
 }  // namespace mlcp
-
-// For the solvers' sources: MLCP_CPU_DISPATCH is 1 where an AVX2 variant is compiled, and
-// MLCP_AVX2_VARIANT marks its functions (noinline: a variant is one function with the shared
-// body inlined into it; flatten: everything that body calls is inlined into it too, so the
-// variant has the baseline's code shape; without it GCC compiles the Bullet packing's variant
-// to different code).
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && \
-    !defined(MLCP_NO_CPU_DISPATCH)
-#define MLCP_CPU_DISPATCH 1
-#define MLCP_AVX2_VARIANT __attribute__((noinline, flatten, target("avx2,bmi,bmi2")))
-#else
-#define MLCP_CPU_DISPATCH 0
-#endif
-
-namespace mlcp::detail {
-// 1 = Avx2, 0 = Baseline, -1 = not decided yet.
-int decideCpuPath();
-extern std::atomic<int> cpuPathState;
-// Whether the hot loops take their AVX2 variant (decided at the first call).
-inline bool avx2Active() {
-  const int s = cpuPathState.load(std::memory_order_relaxed);
-  return (s < 0 ? decideCpuPath() : s) == 1;
-}
-}  // namespace mlcp::detail

@@ -268,6 +268,7 @@ class RowSolver {
   // While prefix is not "", every solve() with rows writes the island's assembled problem
   // (mlcp-problem/1, io.hpp) to prefix + "island<K>.json", K = 0, 1, ... from this call on.
   void setCapture(const std::string& prefix);
+  bool capturing() const { return !capturePrefix_.empty(); }
   // The files written since the last setCapture.
   const std::vector<std::string>& capturedFiles() const { return captured_; }
 

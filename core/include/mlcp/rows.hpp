@@ -17,12 +17,10 @@
 #pragma once
 
 #include <Eigen/Dense>
-#include <cassert>
-#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
-#include "mlcp/cpu.hpp"
 #include "mlcp/problem.hpp"
 #include "mlcp/residual.hpp"
 #include "mlcp/result.hpp"
@@ -84,13 +82,14 @@ class RowSystem {
 //
 // A solve runs three stages over buffers kept between solves (no allocation once they have
 // grown), each one pass over the rows:
-//  1. pack: each row becomes a PackedRow (below) holding step J, M^-1 J^T and the constants of
+//  1. pack: each row becomes a packed row (core/src/rows/row_pack.hpp) holding step J, M^-1 J^T and
+//  the constants of
 //     its update. The pass is also the validation: each row is checked by the one-pass rule of
 //     RowSystem::validate as it is packed (the bodies and array sizes before), and only a row
 //     that fails calls validate() itself to say what is wrong; the caller's x is untouched until
 //     every row has passed. Engines that hold their rows in their own form pack them straight
-//     from there (solve with a RowFill, a RowSource or solveFrom: no RowSystem copy in between;
-//     same packing, same validation).
+//     from there (solve with a RowSource: no RowSystem copy in between; same packing, same
+//     validation).
 //  2. sweep: up to Options::maxIterations sweeps over the packed rows in row order (fewer when a
 //     check meets Options::tolerance).
 //  3. check: every Options::checkEvery sweeps, the natural-map residual of residual.hpp at the
@@ -118,11 +117,11 @@ class RowSystem {
 //    through a multiply-add, and v takes the run's changes at its end;
 //  - the run's loop is unrolled per length, so its changes stay in registers;
 //  - the update is regrouped so that only the product with v sits on the chain, and the change
-//    that moves v is clamped on its own (PackedRow below).
+//    that moves v is clamped on its own (the packed row's update).
 // The packing, sweeps and check are compiled for the baseline and for AVX2 and chosen at run
 // time (mlcp/cpu.hpp); the 12-wide products are written in the order of Eigen's Vector6
-// expressions (core/src/row_simd.hpp), so both variants, solve(RowSystem) and the engine entry
-// points give the same iterates bit for bit.
+// expressions (core/src/rows/row_simd.hpp), so both variants, solve(RowSystem) and the engine
+// entry point give the same iterates bit for bit.
 //
 // The first sweep is not fused into the packing: with a warm start, row i's first update needs
 // v = M^-1 J^T x_start over all rows, later ones included, which exists only after the pass.
@@ -137,28 +136,10 @@ class RowPgs {
   Result solve(const RowSystem& system, Vector& x);
 
   // Packing straight from an engine's own rows, without a RowSystem copy (one pass where the
-  // adapter would otherwise write a RowSystem and the packing read it back). The rows are
-  // fetched in order, in batches: fill(first, count, out) writes rows first .. first+count-1.
-  // Each row is packed bitwise as solve(RowSystem) packs the same values, and validated by the
-  // same rules as it is packed; when a row is invalid or has A_ii <= 0 the rows are fetched once
-  // more into a RowSystem and solve(RowSystem) gives the answer and the message (the slow path).
-  // x is output only (size rows): it starts from the rows' `start` (from zero without
-  // options().warmStart or with a non-finite start).
-  struct Row {
-    int bodyA = -1, bodyB = -1;  // indices into bodies, -1 = world
-    Vector6 jA, jB;              // [linear; angular] Jacobian blocks
-    double b = 0, cfm = 0, lo = 0, hi = 0;
-    int findex = -1;
-    double start = 0;  // x_i's warm start
-    double base = 0;   // the part of x_i the engine's bodies already carry (velocityChange)
-  };
-  using RowFill = std::function<void(int first, int count, Row* out)>;
-  Result solve(const std::vector<BodyInverseMass>& bodies, int rows, const RowFill& fill,
-               Vector& x);
-
-  // The same without any copy of a row: one row as the engine holds it, read in place by the
-  // packing pass (pointers into the engine's own rows; the values must stay put until solve
-  // returns). Each 3-vector is 3 contiguous doubles: J_A = [linA; angA], J_B = [linB; angB].
+  // adapter would otherwise write a RowSystem and the packing read it back): one row as the
+  // engine holds it, read in place by the packing pass (pointers into the engine's own rows; the
+  // values must stay put until solve returns). Each 3-vector is 3 contiguous doubles:
+  // J_A = [linA; angA], J_B = [linB; angB].
   // invAngA / invAngB, when not null, are the engine's own I^-1 angA / I^-1 angB for the row's
   // body (I = BodyInverseMass::invInertia): packing takes them instead of the 3x3 products. The
   // caller promises they are what those products give bit for bit (invInertia(k, 0) * ang[0] +
@@ -172,9 +153,10 @@ class RowPgs {
     const double* angB = nullptr;
     const double* invAngA = nullptr;
     const double* invAngB = nullptr;
-    // As in Row. lo and hi are kept apart: the packing copies them to neighbouring places, and
-    // a 16-byte load of two neighbours just written as 8-byte values by the source would stall
-    // store forwarding.
+    // The row's MLCP data as in RowSystem; start is x_i's warm start, base the part of x_i the
+    // engine's bodies already carry (velocityChange). lo and hi are kept apart: the packing
+    // copies them to neighbouring places, and a 16-byte load of two neighbours just written as
+    // 8-byte values by the source would stall store forwarding.
     double lo = 0, b = 0, hi = 0, cfm = 0;
     int findex = -1;
     double start = 0, base = 0;
@@ -188,107 +170,46 @@ class RowPgs {
    protected:
     ~RowSource() = default;
   };
+  // Each row is packed bitwise as solve(RowSystem) packs the same values, and validated by the
+  // same rules as it is packed; when a row is invalid or has A_ii <= 0 the rows are fetched once
+  // more into a RowSystem and solve(RowSystem) gives the answer and the message (the slow path).
+  // x is output only (size rows): it starts from the rows' `start` (from zero without
+  // options().warmStart or with a non-finite start).
   Result solve(const std::vector<BodyInverseMass>& bodies, int rows, RowSource& source, Vector& x);
-  // The same for any class with RowView row(int) (a final RowSource, or none): defined in
-  // mlcp/detail/row_pack.hpp, where the source's row() can be inlined into the packing loop.
-  template <class Source>
-  Result solveFrom(const std::vector<BodyInverseMass>& bodies, int rows, Source& source, Vector& x);
-  // After solve(bodies, rows, fill, x) took the fast path: body k's M^-1 J^T (x - base),
+  // After solve(bodies, rows, source, x) took the fast path: body k's M^-1 J^T (x - base),
   // [linear; angular], from the velocities the sweeps maintain (what an engine adds to its
   // body's velocity to apply the answer, instead of one impulse per row). velocityChanges()
   // is false after the slow path, after solve(RowSystem), and when a row's base is not finite
   // (then apply x row by row).
   bool velocityChanges() const { return baseValid_; }
-  // The rows fill gives, as a RowSystem with these bodies, and their starts: the slow path's
-  // copy, for callers that need a RowSystem after all.
-  static void toSystem(const std::vector<BodyInverseMass>& bodies, int rows, const RowFill& fill,
-                       RowSystem& system, Vector& start);
+  Vector6 velocityChange(int body) const;
+  // The rows the source gives, as a RowSystem with these bodies, and their starts: the slow
+  // path's copy, for callers that need a RowSystem after all.
   static void toSystem(const std::vector<BodyInverseMass>& bodies, int rows, RowSource& source,
                        RowSystem& system, Vector& start);
-  Vector6 velocityChange(int body) const {
-    assert(baseValid_ && body >= 0 && body < static_cast<int>(base_.size()));
-    return velocity_[body].v - base_[body].v;
-  }
+
+  RowPgs();
+  RowPgs(const RowPgs& other);
+  RowPgs(RowPgs&&) noexcept;
+  RowPgs& operator=(const RowPgs& other);
+  RowPgs& operator=(RowPgs&&) noexcept;
+  ~RowPgs();
 
  private:
-  // Everything the sweep reads per row, in one stream: bodies remapped so that "the world" is
-  // a zero-velocity slot (no branches in the inner loop), M^-1 J^T, and the update
-  //     x_i <- clamp(x_i - step (J_i v + cfm_i x_i + b_i), lo', hi'),   step = omega / A_ii,
-  // regrouped as clamp(keep x_i - shift - (step J_i) v) with keep = 1 - step cfm_i and
-  // shift = step b_i: only the product with v depends on the rows just visited, so the row's
-  // latency chain (load v, dot, clamp, update v) holds one subtraction instead of a
-  // multiplication and three additions (the same iterates up to round-off).
-  // The change moving v is clamped apart, dx = clamp((c - x_i) - J v', lo - x_i, hi - x_i) with
-  // c = keep x_i - shift, while x_i itself becomes clamp(c - J v', lo, hi): the chain does not
-  // wait for x_new - x_i, v and x agree up to round-off, and x stays exactly within its bounds.
-  struct PackedRow {
-    Vector6 sA, sB;  // step * J
-    Vector6 mA, mB;  // M^-1 J^T
-    double keep, shift, lo, hi;
-    int a, b, findex;
-    int run;  // first row of a run: how many rows from here join the same two bodies a != b
-  };
-  // A body's velocity change padded to one cache line.
-  struct alignas(64) BodyVelocity {
-    Vector6 v;
-    double pad[2];
-  };
-  // Zero-velocity slots standing for "the world", taken by ground rows in turn.
-  static constexpr int kWorldSlots = 8;
-  // Longest run of rows on the same two bodies swept as one (longer ones are split): its
-  // couplings take (kMaxRun - 1) kMaxRun / 2 numbers. 8 = a box face's 4 contacts' friction rows.
-  static constexpr int kMaxRun = 8;
-  // Fills packed_ and velocity_ from rowAt(i) (detail/row_pack.hpp); false at the first invalid row
-  // or non-positive A_ii (bad_, badDiagonal_ say which).
-  // pack(), sweepOnce() and packedAccuracy() run their body (packRows, sweepRows, checkRows) as
-  // compiled for the baseline or, where cpuPath() says so, its AVX2 variant (mlcp/cpu.hpp): the
-  // same source, the same bits.
-  template <class RowAt>
-  bool pack(const std::vector<BodyInverseMass>& bodies, int n, RowAt&& rowAt, bool warm, double* x,
-            bool withBase);
-  template <class RowAt>
-  bool packRows(const std::vector<BodyInverseMass>& bodies, int n, RowAt& rowAt, bool warm,
-                double* x, bool withBase);
-#if MLCP_CPU_DISPATCH
-  template <class RowAt>
-  MLCP_AVX2_VARIANT bool packAvx2(const std::vector<BodyInverseMass>& bodies, int n, RowAt& rowAt,
-                                  bool warm, double* x, bool withBase);
-  MLCP_AVX2_VARIANT void sweepAvx2(double* x);
-  MLCP_AVX2_VARIANT Accuracy checkAvx2(const Vector& x, double bNorm) const;
-#endif
-  // Wide: with 4-wide vectors (the AVX2 variants), else in pairs (core/src/row_simd.hpp).
-  template <bool Wide>
-  void sweepRows(double* x);
-  template <bool Wide>
-  Accuracy checkRows(const Vector& x, double bNorm) const;
-  // One row's update from jv = step J_i v (x[i] takes its new value); returns the change of x_i
-  // that moves the velocities.
-  static double update(const PackedRow& p, double* x, int i, double jv);
-  // One sweep over packed_ (x and the velocities updated in place).
-  void sweepOnce(double* x);
+  // The packed rows, the body velocities and the packing, sweep and check over them, with their
+  // CPU variants (core/src/rows/row_pack.hpp: internal).
+  struct Packing;
   static Result negativeRows();
   // After the engine path's packing: per-body changes offered when the bases are finite, then
   // iterate().
   Result iteratePacked(int bodies, Vector& x, double bNorm, double t0);
-  // The sweeps and checks on packed_ from x (the check reads the bounds and findex from the
-  // packed rows too); bNorm = ||b||_inf for the check.
+  // The sweeps and checks on the packed rows from x (the check reads the bounds and findex from
+  // the packed rows too); bNorm = ||b||_inf for the check.
   Result iterate(Vector& x, double bNorm, double t0);
-  // The check: accuracy() of x with w = J v + cfm x + b from the packed rows and velocities.
-  Accuracy packedAccuracy(const Vector& x, double bNorm) const;
 
   Options options_;
-  std::vector<PackedRow> packed_;  // reused between solves
-  std::vector<int> findexOf_;      // packed_[i].findex again, compact (pack() validates with it)
-  // Per row 1 / step, for the check only (kept apart: the sweep's stream stays 240 bytes a row):
-  // w_i = scale_i ((1 - keep) x_i + shift + sA va + sB vb).
-  std::vector<double> scale_;
-  // Per row of a run after its first, its couplings to the run's earlier rows k, in row order:
-  // step_i J_i M^-1 J_k^T (sA_i . mA_k + sB_i . mB_k).
-  std::vector<double> coupling_;
-  std::vector<BodyVelocity> velocity_, base_;
+  std::unique_ptr<Packing> packing_;  // reused between solves
   bool baseValid_ = false;
-  int bad_ = -1;            // the row that stopped pack()
-  double badDiagonal_ = 0;  // its A_ii, or NaN when the row was invalid
 };
 
 }  // namespace mlcp

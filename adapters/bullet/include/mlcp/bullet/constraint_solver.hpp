@@ -69,7 +69,8 @@
 // Its answer passes the same acceptable() rule; a rejected one goes through RowSolver on a
 // RowSystem copy like every other solver when RowSolver has a fallback to run (without one it
 // would repeat the same sweeps from the same start: the packed answer stays, counted in
-// failures), and so does every island with keepIslands or a caller holding rowSolver(). The
+// failures), and so does every "pgs" island with Settings::packInPlace false, keepIslands, or a
+// capture set on rowSolver(). The
 // iterates are the same as RowSolver's pgs bit for bit (one packing code); the write-back differs
 // by round-off (the bodies' velocities, 1e-9 apart after ~17 steps of a settling pyramid). The
 // cached-impulse start (the default) reads the manifold points in build() and keeps answers in
@@ -159,6 +160,10 @@ struct Settings : RowSolverSettings {
   // With "si": also measure the residual of SI's answer (costs about one sweep; excluded from
   // StepStats::seconds). Default true.
   bool measureSi = true;
+  // "pgs" islands packed straight from Bullet's rows and written back per body ("The pgs path"
+  // above). false: through RowSolver on a RowSystem copy like every other solver (the same
+  // iterates; for side-by-side runs of the two). Default true.
+  bool packInPlace = true;
 };
 
 // One solved problem (an island, or its split-impulse twin) of the last step.
@@ -216,12 +221,9 @@ class ConstraintSolver : public btSequentialImpulseConstraintSolver {
   const StepStats& totals() const { return totals_; }
   // With Settings::keepIslands: the problems of the last step.
   const std::vector<IslandRecord>& islands() const { return records_; }
-  // The shared island solver (null with "si"): its capture hook writes each island's problem.
-  // Once it has been asked for, "pgs" islands go through it too (see fastPgs below).
-  RowSolver* rowSolver() {
-    shared_ = true;
-    return rows_.get();
-  }
+  // The shared island solver (null with "si"): its capture hook writes each island's problem
+  // ("pgs" islands go through it while a capture is set: the capture needs the RowSystem).
+  RowSolver* rowSolver() { return rows_.get(); }
 
   // Serialized by the solver's mutex (see "Threads" above).
   btScalar solveGroup(btCollisionObject** bodies, int numBodies, btPersistentManifold** manifolds,
@@ -262,10 +264,9 @@ class ConstraintSolver : public btSequentialImpulseConstraintSolver {
   Settings settings_;
   std::unique_ptr<RowSolver> rows_;
   bool si_ = false;
-  // "pgs" islands skip the RowSystem copy and RowSolver (solver "pgs", no keepIslands, and
-  // nobody asked for rowSolver()); same iterates, same verification rule (acceptable()).
+  // "pgs" islands skip the RowSystem copy and RowSolver (solver "pgs", packInPlace, no
+  // keepIslands, no capture); same iterates, same verification rule (acceptable()).
   bool fastPgs_ = false;
-  bool shared_ = false;
   RowPgs pgs_;
   IslandBuilder builder_;
   StepStats current_, last_, totals_;

@@ -23,7 +23,8 @@
 //     Both numberings give the same order (tested equal bit for bit).
 //  2. the conversion writes each row either into its island's RowSystem (build with system =
 //     true, or fillSystem later) or straight into RowPgs' packing through Source (the "pgs"
-//     path: read in place by RowPgs::solveFrom, Source::row and view() always_inline, no copy).
+//     path: read in place by RowPgs' engine entry point, view() inlined into Source::row, no
+//     copy).
 //     Both write the same values (one conversion function).
 // Both passes fetch Bullet's rows and the manifold points a few rows ahead: the passes are bound
 // by their first touch of each row, which sits out of cache after Bullet's setup. What remember()
@@ -140,7 +141,7 @@ class IslandBuilder {
     bool split_;
     double scratch_[12];  // J's parts not read in place (6 a side; view())
   };
-  // RowPgs' engine path on the island's rows read in place (Source, inlined into the packing).
+  // RowPgs' engine path on the island's rows read in place (Source).
   Result solvePgs(RowPgs& pgs, Island& island, bool split, Vector& x);
   // The island's RowSystem, start, splitB and splitStart (once per build).
   void fillSystem(Island& island);
@@ -169,6 +170,30 @@ class IslandBuilder {
 
  private:
   int find(int k);
+  // build()'s stages, in order (see the passes above):
+  // Each solver body's dynamic index (-1 for static and kinematic bodies), union-find root and
+  // unit factors.
+  void prepareBodies();
+  // The graph pass over Bullet's n rows: all_, findex_, rowBodies_, the unions, and the bodies
+  // numbered by first use into island 0's solverBody. Returns whether the group is one component
+  // with every row on a dynamic body (the single-island shortcut).
+  bool linkRows(int n);
+  // Each row's island and place (rowIsland_, rowLocal_, rowsIn_) and each island's bodies; with
+  // single, island 0 takes every row in order and the first-use numbering.
+  void numberIslands(int n, bool single);
+  void numberComponents(int n);  // the general case of numberIslands
+  // Each island's per-row arrays at their final sizes.
+  void sizeIslands(bool single);
+  // Each row into its island by index: Bullet's row, its builder index, findex, and with the
+  // cached-impulse start its manifold point and last step's answer.
+  void placeRows(int n, bool single);
+  // What view() takes from the solver info: the stock CFM, the contacts' unscaling, the lateral
+  // friction cache.
+  void readSolverInfo(const btContactSolverInfo& info);
+  // A dynamic body's inverse mass into the island (and whether it needs the per-row write-back).
+  void addBody(Island& island, int body);
+  // A new island, cleared, at the end (count_, rowsIn_).
+  void openIsland();
   // The island's row r; split: the split-impulse problem's b, start and base. scratch: 12
   // doubles for J's parts that are not read in place (6 a side; see view()).
   RowPgs::RowView view(Island& island, int r, bool split, double* scratch);

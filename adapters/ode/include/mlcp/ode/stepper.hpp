@@ -89,7 +89,8 @@ struct Settings : RowSolverSettings {
   // solvers ("ode-step", "ode-quickstep"). Default false.
   bool keepProblems = false;
 };
-// The name the stepper's settings had before they shared RowSolverSettings.
+// The name the stepper's settings had before they shared RowSolverSettings (kept for code
+// written against it; the project itself says Settings).
 using StepperOptions = Settings;
 
 struct IslandStats {
@@ -177,7 +178,7 @@ class Stepper {
   mlcp::Options& solverOptions();
   // The fallback's options (Settings::fallbackOptions), adjustable between steps.
   mlcp::Options& fallbackOptions();
-  // StepperOptions::timeBudget, adjustable between steps (seconds, finite, >= 0; throws
+  // Settings::timeBudget, adjustable between steps (seconds, finite, >= 0; throws
   // std::invalid_argument otherwise). The "ode-..." solvers ignore it.
   void setTimeBudget(double seconds);
   // Statistics of the last step (cleared at the start of each step).

@@ -1,8 +1,8 @@
-// row_sweep.hpp: the bodies of RowPgs' sweep and check (rows.hpp), always inlined into the
-// functions that run them: rows.cpp's baseline sweepOnce and packedAccuracy, and rows_avx2.cpp's
-// AVX2 variants (mlcp/cpu.hpp). Each of the two files holds one copy: two copies of the unrolled
-// sweep in one file made GCC stop inlining Eigen's 6-vector operations into them (its unit growth
-// limit), which the sweep's speed depends on.
+// core/src/rows/row_sweep.hpp (internal): the bodies of RowPgs' sweep and check (rows.hpp),
+// always inlined into the functions that run them: rows.cpp's baseline sweepOnce and
+// packedAccuracy, and rows_avx2.cpp's AVX2 variants (cpu_dispatch.hpp). Each of the two files holds
+// one copy: two copies of the unrolled sweep in one file made GCC stop inlining Eigen's 6-vector
+// operations into them (its unit growth limit), which the sweep's speed depends on.
 #pragma once
 
 #include <algorithm>
@@ -10,13 +10,14 @@
 #include <type_traits>
 
 #include "mlcp/residual.hpp"
-#include "mlcp/rows.hpp"
-#include "row_simd.hpp"
+#include "rows/row_pack.hpp"
+#include "rows/row_simd.hpp"
 
 namespace mlcp {
 
 template <bool Wide>
-[[gnu::always_inline]] inline Accuracy RowPgs::checkRows(const Vector& x, double bNorm) const {
+[[gnu::always_inline]] inline Accuracy RowPgs::Packing::checkRows(const Vector& x,
+                                                                  double bNorm) const {
   // step_i w_i = (1 - keep) x_i + shift + sA va + sB vb, the sweep's own terms (rows.hpp),
   // scaled back by scale_i = 1 / step_i; the bounds with findex applied at x. In blocks of rows
   // that stay in L1 (w in a small buffer, the rows read twice): one loop for both spilled the
@@ -44,8 +45,8 @@ template <bool Wide>
   return a.result(bNorm);
 }
 
-[[gnu::always_inline]] inline double RowPgs::update(const PackedRow& p, double* xs, int i,
-                                                    double jv) {
+[[gnu::always_inline]] inline double RowPgs::Packing::update(const PackedRow& p, double* xs, int i,
+                                                             double jv) {
   double lo = p.lo, hi = p.hi;
   if (p.findex >= 0) {
     const double normal = std::abs(xs[p.findex]);
@@ -62,10 +63,10 @@ template <bool Wide>
 }
 
 template <bool Wide>
-[[gnu::always_inline]] inline void RowPgs::sweepRows(double* xs) {
+[[gnu::always_inline]] inline void RowPgs::Packing::sweepRows(double* xs) {
   const int n = static_cast<int>(packed_.size());
   auto update = [&](const PackedRow& p, int i, double jv) __attribute__((always_inline)) {
-    return RowPgs::update(p, xs, i, jv);
+    return Packing::update(p, xs, i, jv);
   };
   const double* coupling = coupling_.data();
   for (int i = 0; i < n;) {

@@ -1,5 +1,5 @@
-// mlcp/detail/row_checks.hpp: the per-row rules and products RowPgs' packing pass applies to
-// each row as it reads it (detail/row_pack.hpp), and the copy of a row view into a RowSystem
+// core/src/rows/row_checks.hpp (internal): the per-row rules and products RowPgs' packing pass
+// applies to each row as it reads it (row_pack.hpp), and the copy of a row view into a RowSystem
 // (the packing's slow path). Inline and allocation-free: they run once per row per solve.
 #pragma once
 
