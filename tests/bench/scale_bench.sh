@@ -6,6 +6,7 @@
 # rows: the island's rows at step 0 (captured once per scene and engine with pgs); limited: 1 when
 # the wall-clock limit ended the run (first_ms / median_ms then cover the steps that finished).
 # Usage: tests/bench/scale_bench.sh MLCP_BINARY OUT.csv [STEPS] [LIMIT_SECONDS] [SCENES...]
+# MLCP_RUN_ARGS (environment): more `mlcp run` options for every run, e.g. "--time-budget 0".
 set -uo pipefail
 mlcp=$1
 out=$2
@@ -31,7 +32,7 @@ print(sum(json.load(open(f))["n"] for f in glob.glob(sys.argv[1] + "/*.json")))'
       csv=$work/run.csv
       rm -f "$csv"
       timeout "$limit" "$mlcp" run "$file" --engine "$engine" --solver "$solver" --steps "$steps" \
-        --tol 1e-6 --fallback none --csv "$csv" > /dev/null 2>&1
+        --tol 1e-6 --fallback none ${MLCP_RUN_ARGS:-} --csv "$csv" > /dev/null 2>&1
       rc=$?
       limited=0
       [ $rc -eq 124 ] && limited=1

@@ -8,20 +8,26 @@
 #include "common/contact_scenes.hpp"
 #include "common/generators.hpp"
 #include "mlcp/dantzig.hpp"
+#include "mlcp/io.hpp"
 #include "mlcp/lemke.hpp"
 #include "mlcp/residual.hpp"
 
 namespace mlcp {
 namespace {
 
-// A sparse problem of the pyramid's rows (levels boxes at the bottom).
-Problem pyramidProblem(int levels, double mu, double side, unsigned seed = 1) {
+// A pyramid of levels boxes at the bottom, friction coefficient mu, horizontal velocities up to
+// side.
+test::PyramidSpec pyramidSpec(int levels, double mu, double side = 0) {
   test::PyramidSpec spec;
   spec.levels = levels;
   spec.muLo = spec.muHi = mu;
   spec.sideVelocity = side;
-  spec.seed = seed;
-  test::BoxPyramid pyramid(spec);
+  return spec;
+}
+
+// Its rows' problem, sparse.
+Problem pyramidProblem(int levels, double mu, double side) {
+  test::BoxPyramid pyramid(pyramidSpec(levels, mu, side));
   return pyramid.rows().assemble(true);
 }
 
@@ -72,10 +78,7 @@ TEST(Newton, PyramidSparseMatchesDantzig) {
 // A warm start at the answer of a nearby problem settles in a few steps, and the symbolic
 // analysis is done once for the pattern.
 TEST(Newton, WarmSequenceTakesFewStepsAndOneAnalysis) {
-  test::PyramidSpec spec;
-  spec.levels = 6;
-  spec.muLo = spec.muHi = 0;
-  test::BoxPyramid pyramid(spec);
+  test::BoxPyramid pyramid(pyramidSpec(6, 0));
   NewtonSolver newton;
   newton.options().tolerance = 1e-10;
   Vector x;
@@ -144,12 +147,9 @@ TEST(Newton, FrictionPyramidStepLimitIsHonest) {
 
 // A friction island warm-started from the last step's answer, where the lagged friction bounds
 // (one refresh per step, each step symmetric) ended at 2e-6 after 100 steps: with the friction
-// rows' exact Jacobian it converges to 1e-6 in a few steps, and agrees with dantzig.
+// rows' exact Jacobian it converges to 1e-6 in a few steps, to dantzig's answer.
 TEST(Newton, WarmFrictionPyramidConvergesWhereLaggedBoundsStalled) {
-  test::PyramidSpec spec;
-  spec.levels = 6;
-  spec.muLo = spec.muHi = 0.6;
-  test::BoxPyramid pyramid(spec);
+  test::BoxPyramid pyramid(pyramidSpec(6, 0.6));
   DantzigSolver dantzig;
   dantzig.options().tolerance = 1e-10;
   Vector last;
@@ -164,6 +164,29 @@ TEST(Newton, WarmFrictionPyramidConvergesWhereLaggedBoundsStalled) {
   const Result r = newton.solveWithGuess(p, last, x);
   ASSERT_TRUE(r.converged()) << r.message;
   EXPECT_LE(accuracy(p, x).residual, 1e-6);
+  Vector xd;
+  ASSERT_TRUE(dantzig.solve(p, xd).converged());
+  EXPECT_LE((x - xd).lpNorm<Eigen::Infinity>(), 1e-3 * (1 + xd.lpNorm<Eigen::Infinity>()));
+}
+
+// Friction islands captured from scenes (`mlcp run SCENE --capture 30`: a box sliding down an
+// incline in both engines, a row of dominoes in Bullet), cold on the dense path: newton
+// converges to 1e-9 with dantzig, and the answers agree.
+TEST(Newton, CapturedFrictionIslandsAgreeWithDantzig) {
+  for (const char* name : {"incline_slide_bullet", "incline_slide_ode", "dominoes_bullet"}) {
+    const Problem p =
+        io::readProblem(std::string(MLCP_SOURCE_DIR) + "/tests/data/islands/" + name + ".json");
+    ASSERT_TRUE(p.hasFindex()) << name;
+    NewtonSolver newton;
+    DantzigSolver dantzig;
+    newton.options().tolerance = dantzig.options().tolerance = 1e-9;
+    Vector xn, xd;
+    const Result rn = newton.solve(p, xn);
+    ASSERT_TRUE(rn.converged()) << name << ": " << rn.message;
+    ASSERT_TRUE(dantzig.solve(p, xd).converged()) << name;
+    EXPECT_LE((xn - xd).lpNorm<Eigen::Infinity>(), 1e-6 * (1 + xd.lpNorm<Eigen::Infinity>()))
+        << name;
+  }
 }
 
 // Nonsymmetric positive definite A (a P-matrix: one solution), on the dense path and on the
