@@ -56,7 +56,7 @@
 // iterate.
 //
 // Linear algebra. Problems of at most NewtonParams::denseMaxRows rows build J densely and
-// factor it with Eigen's PartialPivLU (O(n^3) per step, ~1 ms at 150 rows); a solution that
+// factor it with Eigen's PartialPivLU (O(n^3) per step, 0.3 ms at 108 rows); a solution that
 // does not solve the system to 1e-9 relative (singular J) is replaced by
 // CompleteOrthogonalDecomposition's least-squares one. Larger problems factor the whole n x n
 // J + rho D by KLU (linalg/sparse_lu.hpp): its pattern is A's plus the diagonal plus each
@@ -74,8 +74,11 @@
 // patterns) would need a correction of rank |T|, the number of sliding friction rows: ~60 on
 // captured 55-box pyramids, i.e. ~60 extra solves per step, which costs what the LU saves
 // (docs/benchmarks.md, "newton: factorization costs"). KLU and UMFPACK factor these patterns
-// equally fast; KLU needs no BLAS. The dense path's threshold is where a dense LU stops being
-// cheaper than a sparse analysis and factorization of a small island.
+// equally fast; KLU needs no BLAS. The dense path's threshold: on pyramid patterns KLU's
+// factorization and solve overtake the dense LU near 100 rows (0.03 against 0.015 ms at 48 rows,
+// 0.11 against 0.31 ms at 108, 0.89 against 1.18 ms at 192); below it the dense path's
+// least-squares and Levenberg-Marquardt steps also take singular J (the circuit MLCPs' equality
+// blocks, up to 61 rows in the Siconos corpus), which the sparse LU refuses.
 //
 // Starts. A warm start (Options::warmStart, solveWithGuess) is used as given. A cold start (x =
 // 0), where sweeps apply, first takes NewtonParams::coldSweeps projected Gauss-Seidel sweeps;
@@ -105,8 +108,8 @@ struct NewtonParams {
   // Projected Gauss-Seidel sweeps over a cold start (x = 0) before the first step. Default 10.
   int coldSweeps = 10;
   // Problems of at most this many rows take the dense path (Eigen's LU of J); larger ones the
-  // sparse LU (KLU). Default 150.
-  int denseMaxRows = 150;
+  // sparse LU (KLU). Default 100.
+  int denseMaxRows = 100;
   // mu's start and its largest value (the sparse path's proximal weight rho = mu max |A_ii|
   // min(1, r)). Defaults 1e-3 and 1e3.
   double proximal = 1e-3;
