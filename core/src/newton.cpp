@@ -123,12 +123,7 @@ void NewtonSolver::run(const Problem& pb, Vector& x, Result& result) {
     return;
   }
   Work& wk = *work_;
-  std::string why;
-  if (!wk.system.prepare(pb, params_.denseMaxRows, why)) {
-    result.status = Status::Failed;
-    result.message = why;
-    return;
-  }
+  wk.system.prepare(pb, params_.denseMaxRows);
   // Sweeps (the cold start, the fallback) need A_ii > 0 and descend for symmetric A.
   const bool sweeps = detail::inverseDiagonal(pb, wk.invDiag) < 0 && detail::symmetricMatrix(pb);
   wk.best.x = x;  // the start as given counts as an iterate: never return worse

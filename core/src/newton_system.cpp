@@ -69,7 +69,7 @@ double naturalMap(const Problem& pb, const Vector& x, const Vector& w, Vector& h
   return sum;
 }
 
-bool NewtonSystem::prepare(const Problem& pb, int denseMaxRows, std::string& why) {
+void NewtonSystem::prepare(const Problem& pb, int denseMaxRows) {
   problem_ = &pb;
   const int n = pb.size();
   da_.setZero(n);
@@ -77,7 +77,7 @@ bool NewtonSystem::prepare(const Problem& pb, int denseMaxRows, std::string& why
   cf_.setZero(n);
   sparse_ = n > denseMaxRows;
   a_ = nullptr;
-  if (!sparse_) return true;
+  if (!sparse_) return;
   if (pb.isSparse() && pb.sparseA().isCompressed()) {
     a_ = &pb.sparseA();
   } else {
@@ -85,46 +85,6 @@ bool NewtonSystem::prepare(const Problem& pb, int denseMaxRows, std::string& why
     own_.makeCompressed();
     a_ = &own_;
   }
-  return preparePattern(why);
-}
-
-// Row i of J's pattern: A's columns of row i, the diagonal and the findex column, sorted.
-bool NewtonSystem::preparePattern(std::string& why) {
-  const Problem& pb = *problem_;
-  const int n = pb.size();
-  rowStart_.assign(1, 0);
-  columns_.clear();
-  source_.clear();
-  diagonalAt_.assign(n, -1);
-  findexAt_.assign(n, -1);
-  std::vector<std::pair<int, int>> row;
-  for (int i = 0; i < n; ++i) {
-    row.clear();
-    const int f = pb.hasFindex() ? pb.findex[i] : -1;
-    bool haveDiagonal = false, haveFindex = f < 0;
-    for (int k = a_->outerIndexPtr()[i]; k < a_->outerIndexPtr()[i + 1]; ++k) {
-      const int j = a_->innerIndexPtr()[k];
-      row.emplace_back(j, k);
-      haveDiagonal |= j == i;
-      haveFindex |= j == f;
-    }
-    if (!haveDiagonal) row.emplace_back(i, -1);
-    if (!haveFindex) row.emplace_back(f, -1);
-    std::sort(row.begin(), row.end());
-    for (const auto& [j, k] : row) {
-      if (j == i) diagonalAt_[i] = static_cast<int>(columns_.size());
-      if (j == f) findexAt_[i] = static_cast<int>(columns_.size());
-      columns_.push_back(j);
-      source_.push_back(k);
-    }
-    rowStart_.push_back(static_cast<int>(columns_.size()));
-  }
-  values_.resize(columns_.size());
-  if (!lu_.analyze(n, rowStart_, columns_)) {
-    why = "the sparse LU analysis rejected the pattern of A";
-    return false;
-  }
-  return true;
 }
 
 int NewtonSystem::linearize(const Vector& x, const Vector& w) {
@@ -172,21 +132,92 @@ bool NewtonSystem::factorDense(double rho) {
   return true;
 }
 
+// The reduced system on the free rows C (newton.hpp "Linear algebra"): row i of K holds A_ij for
+// free j and A_it c_t at the normal j = findex[t] of each bound friction row t whose normal is
+// free (c_t = -cf_t), plus rho on the diagonal; columns sorted, duplicates summed.
 bool NewtonSystem::factorSparse(double rho) {
   const Problem& pb = *problem_;
-  const double* a = a_->valuePtr();
-  for (int i = 0; i < pb.size(); ++i) {
-    const double d = db_[i];
-    for (int k = rowStart_[i]; k < rowStart_[i + 1]; ++k)
-      values_[k] = source_[k] >= 0 && d != 0 ? d * a[source_[k]] : 0.0;
-    values_[diagonalAt_[i]] += da_[i] + d * rho;
-    if (findexAt_[i] >= 0) values_[findexAt_[i]] += cf_[i];
+  const int n = pb.size();
+  const bool coupled = pb.hasFindex();
+  freeRows_.clear();
+  position_.assign(n, -1);
+  for (int i = 0; i < n; ++i)
+    if (db_[i] != 0) {
+      position_[i] = static_cast<int>(freeRows_.size());
+      freeRows_.push_back(i);
+    }
+  const int m = static_cast<int>(freeRows_.size());
+  rowStart_.assign(1, 0);
+  columns_.clear();
+  values_.clear();
+  accumulator_.assign(m, 0.0);
+  seen_.assign(m, -1);
+  std::vector<int>& row = rowColumns_;
+  for (int c = 0; c < m; ++c) {
+    const int i = freeRows_[c];
+    row.clear();
+    auto add = [&](int column, double value) {
+      if (seen_[column] != c) {
+        seen_[column] = c;
+        accumulator_[column] = 0;
+        row.push_back(column);
+      }
+      accumulator_[column] += value;
+    };
+    add(c, rho);
+    for (SparseMatrix::InnerIterator it(*a_, i); it; ++it) {
+      const int j = static_cast<int>(it.col());
+      if (position_[j] >= 0) {
+        add(position_[j], it.value());
+      } else if (coupled && cf_[j] != 0 && position_[pb.findex[j]] >= 0) {
+        add(position_[pb.findex[j]], -cf_[j] * it.value());
+      }
+    }
+    std::sort(row.begin(), row.end());
+    for (const int column : row) {
+      columns_.push_back(column);
+      values_.push_back(accumulator_[column]);
+    }
+    rowStart_.push_back(static_cast<int>(columns_.size()));
   }
-  return lu_.factor(values_);
+  if (m == 0) return true;
+  return lu_.analyze(m, rowStart_, columns_) && lu_.factor(values_);
+}
+
+// rhs holds the right side of J dx = rhs (all n rows); on return dx. Rows at a bound: dx_t =
+// rhs_t - cf_t dx_findex; their known part moves to the free rows' right side, the free rows
+// solve K, and the coupled bound rows follow from their normals.
+bool NewtonSystem::solveReduced(Vector& rhs) {
+  const Problem& pb = *problem_;
+  const int n = pb.size();
+  const bool coupled = pb.hasFindex();
+  known_.setZero(n);
+  for (int t = 0; t < n; ++t) {
+    if (position_[t] >= 0) continue;
+    const int f = coupled ? pb.findex[t] : -1;
+    known_[t] = rhs[t];
+    if (f >= 0 && cf_[t] != 0 && position_[f] < 0) known_[t] -= cf_[t] * rhs[f];
+  }
+  const int m = static_cast<int>(freeRows_.size());
+  reduced_.resize(m);
+  for (int c = 0; c < m; ++c) {
+    const int i = freeRows_[c];
+    double sum = rhs[i];
+    for (SparseMatrix::InnerIterator it(*a_, i); it; ++it) sum -= it.value() * known_[it.col()];
+    reduced_[c] = sum;
+  }
+  if (m > 0 && !lu_.solve(reduced_)) return false;
+  for (int c = 0; c < m; ++c) rhs[freeRows_[c]] = reduced_[c];
+  for (int t = 0; t < n; ++t) {
+    if (position_[t] >= 0) continue;
+    const int f = coupled ? pb.findex[t] : -1;
+    rhs[t] = f >= 0 && cf_[t] != 0 && position_[f] >= 0 ? rhs[t] - cf_[t] * rhs[f] : known_[t];
+  }
+  return rhs.allFinite();
 }
 
 bool NewtonSystem::solve(Vector& rhs) {
-  if (sparse_) return lu_.solve(rhs);
+  if (sparse_) return solveReduced(rhs);
   // Partial pivoting first; a (near) singular J, seen as a solution that does not solve the
   // system, is answered by the least-squares solution of least norm.
   check_ = denseLu_.solve(rhs);

@@ -21,14 +21,14 @@ double naturalMap(const Problem& problem, const Vector& x, const Vector& w, Vect
 class NewtonSystem {
  public:
   // Per solve, before the steps: the problem (kept by reference until the next prepare); whole
-  // problems of at most denseMaxRows rows take the dense path. False (with why) when the sparse
-  // pattern is rejected.
-  bool prepare(const Problem& problem, int denseMaxRows, std::string& why);
+  // problems of at most denseMaxRows rows take the dense path.
+  void prepare(const Problem& problem, int denseMaxRows);
   // The Jacobian's rows at (x, w): free rows (x - w strictly inside the bounds) take row i of
   // A, the others e_i minus the bound's derivative in the normal. Returns the free rows' count.
   int linearize(const Vector& x, const Vector& w);
-  // Factors J + rho D (D: 1 on the free rows, 0 elsewhere). False when it is singular (sparse
-  // path; the dense path then answers by least squares).
+  // Factors J + rho D (D: 1 on the free rows, 0 elsewhere); the sparse path its reduced system
+  // on the free rows. False when it is singular (sparse path; the dense path then answers by
+  // least squares).
   bool factor(double rho);
   // rhs <- (J + rho D)^-1 rhs with the last factor. False when the result is not finite.
   bool solve(Vector& rhs);
@@ -39,14 +39,14 @@ class NewtonSystem {
   void transposeTimes(const Vector& v, Vector& out) const;
   // out = J v (without rho).
   void times(const Vector& v, Vector& out) const;
-  // Symbolic analyses of the sparse path (one per pattern seen in a row).
+  // Symbolic analyses of the sparse path (one per reduced pattern seen in a row).
   int analyses() const { return lu_.analyses(); }
   bool isSparse() const { return sparse_; }
 
  private:
   bool factorDense(double rho);
   bool factorSparse(double rho);
-  bool preparePattern(std::string& why);
+  bool solveReduced(Vector& rhs);
 
   linalg::SparseLu lu_;
   const Problem* problem_ = nullptr;
@@ -56,10 +56,11 @@ class NewtonSystem {
 
   // Row i of J: db_i A_i + da_i e_i + cf_i e_findex[i].
   Vector da_, db_, cf_;
-  // The sparse path's pattern of J by rows: A's row, the diagonal and the findex column; per
-  // entry the index of its value in a_'s storage (-1: none, value 0).
-  std::vector<int> rowStart_, columns_, source_, diagonalAt_, findexAt_;
-  std::vector<double> values_;
+  // The sparse path's reduced system K on the free rows (by rows, columns sorted), the free rows
+  // in order and each row's position among them (-1: at a bound), and workspaces.
+  std::vector<int> rowStart_, columns_, freeRows_, position_, seen_, rowColumns_;
+  std::vector<double> values_, accumulator_;
+  Vector known_, reduced_;
   DenseMatrix dense_;
   Eigen::PartialPivLU<DenseMatrix> denseLu_;
   Eigen::CompleteOrthogonalDecomposition<DenseMatrix> cod_;

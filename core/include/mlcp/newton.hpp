@@ -1,7 +1,7 @@
 // mlcp/newton.hpp: a semismooth Newton method on the natural map of a boxed MLCP with findex
 // (registry "newton"), for any square A (symmetric or not): small problems by dense LU (the
-// Siconos circuit MLCPs with zero diagonals), large contact islands by a sparse LU whose
-// symbolic analysis is kept while A's pattern holds, warm-started from the last step's answer.
+// Siconos circuit MLCPs with zero diagonals), large contact islands by a sparse LU of the
+// reduced system on the free rows, warm-started from the last step's answer.
 //
 // Map. With w = A x + b and the bounds l(x), u(x) (a friction row i with findex j has l_i =
 // lo_i |x_j|, u_i = hi_i |x_j|; problem.hpp), the MLCP is the equation
@@ -58,27 +58,33 @@
 // Linear algebra. Problems of at most NewtonParams::denseMaxRows rows build J densely and
 // factor it with Eigen's PartialPivLU (O(n^3) per step, 0.3 ms at 108 rows); a solution that
 // does not solve the system to 1e-9 relative (singular J) is replaced by
-// CompleteOrthogonalDecomposition's least-squares one. Larger problems factor the whole n x n
-// J + rho D by KLU (linalg/sparse_lu.hpp): its pattern is A's plus the diagonal plus each
-// friction row's findex column, whatever the pieces are (rows at a bound hold explicit zeros),
-// so the symbolic analysis (block triangular form, AMD order) is done once per pattern of A and
-// reused by every step and by later solves of this object on the same pattern (RowSolver keeps
-// one solver object per island key: an island's analysis lives as long as its contact
-// pattern). The LU is taken on the rows of J as the columns of J^T and solved transposed, so no
-// transposed copy is made. A step costs one numeric factorization (threshold partial pivoting
-// on the analyzed order), one solve, one product with J^T, and one product with A per trial
-// step length.
+// CompleteOrthogonalDecomposition's least-squares one. Larger problems eliminate the rows at a
+// bound (dx_t = -H_t + c_t dx_j: known when the normal j is at a bound too, coupled when it is
+// free) and factor the reduced system on the free rows,
 //
-// Why these choices. An LU of the whole nonsymmetric J keeps the coupling exact at the cost of
-// one factorization, where a Cholesky factorization of A_CC (2-2.5x cheaper on the pyramids'
-// patterns) would need a correction of rank |T|, the number of sliding friction rows: ~60 on
-// captured 55-box pyramids, i.e. ~60 extra solves per step, which costs what the LU saves
-// (docs/benchmarks.md, "newton: factorization costs"). KLU and UMFPACK factor these patterns
-// equally fast; KLU needs no BLAS. The dense path's threshold: on pyramid patterns KLU's
-// factorization and solve overtake the dense LU near 100 rows (0.03 against 0.015 ms at 48 rows,
-// 0.11 against 0.31 ms at 108, 0.89 against 1.18 ms at 192); below it the dense path's
-// least-squares and Levenberg-Marquardt steps also take singular J (the circuit MLCPs' equality
-// blocks, up to 61 rows in the Siconos corpus), which the sparse LU refuses.
+//     (K + rho I) dx_C = -H_C - A_CB dx_B^known,   K = A_CC + A_CT S E_T,
+//
+// by KLU (linalg/sparse_lu.hpp), assembled by rows from A's rows (duplicates summed); the
+// coupled bound rows then follow from their normals. KLU's symbolic analysis (block triangular
+// form, AMD order) is kept while the reduced pattern (the free set, and the coupled rows'
+// normals) holds from one factorization to the next: the retries of one step with a larger rho
+// and the last steps of a converging solve reuse it. The LU is taken on K's rows as the
+// columns of K^T and solved transposed, so no transposed copy is made. A step costs one
+// assembly of K (O(nnz A)), its factorization, one solve, one product with J^T, and one
+// product with A per trial step length.
+//
+// Why these choices. An LU of the nonsymmetric K keeps the coupling exact. The reduced K is
+// far sparser than the whole-pattern J (429 free rows with 11k entries against 1140 rows with
+// 81k at the captured 55-box Bullet island's answer): a solve of that island is 2.7x faster
+// than with a factorization of the whole J on one kept analysis, with the same iterates. A
+// Cholesky factorization of A_CC would need a correction of rank |T|, the sliding friction
+// rows: ~60 on that island, i.e. ~60 extra solves per step (docs/benchmarks.md, "newton:
+// factorization costs"). KLU and UMFPACK factor these patterns equally fast; KLU needs no BLAS.
+// The dense path's threshold: on pyramid patterns KLU's factorization and solve overtake the
+// dense LU near 100 rows (0.03 against 0.015 ms at 48 rows, 0.11 against 0.31 ms at 108, 0.89
+// against 1.18 ms at 192); below it the dense path's least-squares and Levenberg-Marquardt
+// steps also take singular J (the circuit MLCPs' equality blocks, up to 61 rows in the Siconos
+// corpus), which the sparse LU refuses.
 //
 // Starts. A warm start (Options::warmStart, solveWithGuess) is used as given. A cold start (x =
 // 0), where sweeps apply, first takes NewtonParams::coldSweeps projected Gauss-Seidel sweeps;
@@ -142,7 +148,7 @@ class NewtonSolver : public Solver {
 
   // Of the last solve: numeric factorizations (sparse or dense).
   int factorizations() const { return factorizations_; }
-  // Symbolic analyses this object has done (one per pattern of A seen in a row).
+  // Symbolic analyses this object has done (one per reduced pattern seen in a row).
   int analyses() const;
 
  protected:
