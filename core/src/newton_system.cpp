@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 namespace mlcp::detail {
 
@@ -54,115 +55,220 @@ bool symmetricMatrix(const Problem& pb) {
   return true;
 }
 
-bool NewtonSystem::prepare(const Problem& pb, int denseMaxRows, std::string& why) {
-  problem_ = &pb;
-  denseMaxRows_ = denseMaxRows;
+double naturalMap(const Problem& pb, const Vector& x, const Vector& w, Vector& h, double& inf) {
   const int n = pb.size();
+  h.resize(n);
+  double sum = 0;
+  inf = 0;
+  for (int i = 0; i < n; ++i) {
+    h[i] = x[i] - std::clamp(x[i] - w[i], pb.effectiveLo(i, x), pb.effectiveHi(i, x));
+    sum += h[i] * h[i];
+    inf = std::max(inf, std::abs(h[i]));
+  }
+  if (!std::isfinite(sum)) inf = sum = kInf;
+  return sum;
+}
+
+void NewtonSystem::prepare(const Problem& pb, int denseMaxRows) {
+  problem_ = &pb;
+  const int n = pb.size();
+  da_.setZero(n);
+  db_.setZero(n);
+  cf_.setZero(n);
+  sparse_ = n > denseMaxRows;
   a_ = nullptr;
-  if (n <= denseMaxRows) return true;  // the dense path only
-  if (pb.isSparse()) {
+  if (!sparse_) return;
+  if (pb.isSparse() && pb.sparseA().isCompressed()) {
     a_ = &pb.sparseA();
   } else {
-    own_ = pb.toSparse();
-    a_ = &own_;
-  }
-  if (!a_->isCompressed()) {
-    own_ = *a_;
+    own_ = pb.isSparse() ? pb.sparseA() : pb.toSparse();
     own_.makeCompressed();
     a_ = &own_;
   }
-  // Column j of the upper triangle: row j's entries left of the diagonal (sorted), then (j, j).
-  colStart_.assign(1, 0);
-  rowIndex_.clear();
-  source_.clear();
-  column_.clear();
-  std::vector<std::pair<int, int>> row;
-  for (int j = 0; j < n; ++j) {
-    row.clear();
-    int diagonal = -1;
-    for (int k = a_->outerIndexPtr()[j]; k < a_->outerIndexPtr()[j + 1]; ++k) {
-      const int i = a_->innerIndexPtr()[k];
-      if (i < j) row.emplace_back(i, k);
-      if (i == j) diagonal = k;
+}
+
+int NewtonSystem::linearize(const Vector& x, const Vector& w) {
+  const Problem& pb = *problem_;
+  const bool coupled = pb.hasFindex();
+  int free = 0;
+  for (int i = 0; i < pb.size(); ++i) {
+    const double lo = pb.effectiveLo(i, x), hi = pb.effectiveHi(i, x), z = x[i] - w[i];
+    // The piece of mid(l, z, u) that holds at z; a fixed row (l = u) takes the bound z points at.
+    const bool atLo = z < lo || (lo == hi && z <= hi), atHi = !atLo && (z > hi || lo == hi);
+    const bool isFree = !atLo && !atHi;
+    da_[i] = isFree ? 0.0 : 1.0;
+    db_[i] = isFree ? 1.0 : 0.0;
+    cf_[i] = 0;
+    free += isFree;
+    const int f = coupled ? pb.findex[i] : -1;
+    if (!isFree && f >= 0) {
+      // l_i = lo_i |x_f|, u_i = hi_i |x_f|: minus the bound's derivative in x_f, sign(0) = +1.
+      const double sign = x[f] < 0 ? -1.0 : 1.0;
+      cf_[i] = -(atHi ? pb.hi[i] : pb.lo[i]) * sign;
     }
-    std::sort(row.begin(), row.end());
-    row.emplace_back(j, diagonal);
-    for (const auto& [i, k] : row) {
-      rowIndex_.push_back(i);
-      source_.push_back(k);
-      column_.push_back(j);
+  }
+  return free;
+}
+
+bool NewtonSystem::factor(double rho) { return sparse_ ? factorSparse(rho) : factorDense(rho); }
+
+bool NewtonSystem::factorDense(double rho) {
+  const Problem& pb = *problem_;
+  const int n = pb.size();
+  dense_.setZero(n, n);
+  for (int i = 0; i < n; ++i) {
+    if (db_[i] != 0) {
+      if (pb.isSparse())
+        for (SparseMatrix::InnerIterator it(pb.sparseA(), i); it; ++it)
+          dense_(i, it.col()) = db_[i] * it.value();
+      else
+        dense_.row(i) = db_[i] * pb.denseA().row(i);
     }
-    colStart_.push_back(static_cast<int>(rowIndex_.size()));
+    dense_(i, i) += da_[i] + db_[i] * rho;
+    if (cf_[i] != 0) dense_(i, pb.findex[i]) += cf_[i];
   }
-  values_.resize(rowIndex_.size());
-  if (!cholmod_.analyze(n, colStart_, rowIndex_)) {
-    why = "CHOLMOD rejected the pattern of A";
-    return false;
-  }
+  denseLu_.compute(dense_);
+  leastSquares_ = false;
   return true;
 }
 
-double NewtonSystem::entry(int i, int j) const {
+// The reduced system on the free rows C (newton.hpp "Linear algebra"): row i of K holds A_ij for
+// free j and A_it c_t at the normal j = findex[t] of each bound friction row t whose normal is
+// free (c_t = -cf_t), plus rho on the diagonal; columns sorted, duplicates summed.
+bool NewtonSystem::factorSparse(double rho) {
   const Problem& pb = *problem_;
-  return pb.isSparse() ? pb.sparseA().coeff(i, j) : pb.denseA()(i, j);
+  const int n = pb.size();
+  const bool coupled = pb.hasFindex();
+  freeRows_.clear();
+  position_.assign(n, -1);
+  for (int i = 0; i < n; ++i)
+    if (db_[i] != 0) {
+      position_[i] = static_cast<int>(freeRows_.size());
+      freeRows_.push_back(i);
+    }
+  const int m = static_cast<int>(freeRows_.size());
+  rowStart_.assign(1, 0);
+  columns_.clear();
+  values_.clear();
+  accumulator_.assign(m, 0.0);
+  seen_.assign(m, -1);
+  std::vector<int>& row = rowColumns_;
+  for (int c = 0; c < m; ++c) {
+    const int i = freeRows_[c];
+    row.clear();
+    auto add = [&](int column, double value) {
+      if (seen_[column] != c) {
+        seen_[column] = c;
+        accumulator_[column] = 0;
+        row.push_back(column);
+      }
+      accumulator_[column] += value;
+    };
+    add(c, rho);
+    for (SparseMatrix::InnerIterator it(*a_, i); it; ++it) {
+      const int j = static_cast<int>(it.col());
+      if (position_[j] >= 0) {
+        add(position_[j], it.value());
+      } else if (coupled && cf_[j] != 0 && position_[pb.findex[j]] >= 0) {
+        add(position_[pb.findex[j]], -cf_[j] * it.value());
+      }
+    }
+    std::sort(row.begin(), row.end());
+    for (const int column : row) {
+      columns_.push_back(column);
+      values_.push_back(accumulator_[column]);
+    }
+    rowStart_.push_back(static_cast<int>(columns_.size()));
+  }
+  if (m == 0) return true;
+  return lu_.analyze(m, rowStart_, columns_) && lu_.factor(values_);
 }
 
-bool NewtonSystem::factor(const std::vector<char>& inC, double rho) {
-  const int m = static_cast<int>(std::count(inC.begin(), inC.end(), 1));
-  lastSparse_ = a_ != nullptr && m > denseMaxRows_;
-  return lastSparse_ ? factorSparse(inC, rho) : factorDense(inC, rho);
-}
-
-bool NewtonSystem::solve(Vector& rhs) {
-  if (lastSparse_) {
-    cholmod_.solve(rhs);
-  } else if (!clamped_.empty()) {
-    const int m = static_cast<int>(clamped_.size());
-    for (int c = 0; c < m; ++c) sub_[c] = rhs[clamped_[c]];
-    sub_ = llt_.solve(sub_);
-    for (int c = 0; c < m; ++c) rhs[clamped_[c]] = sub_[c];
+// rhs holds the right side of J dx = rhs (all n rows); on return dx. Rows at a bound: dx_t =
+// rhs_t - cf_t dx_findex; their known part moves to the free rows' right side, the free rows
+// solve K, and the coupled bound rows follow from their normals.
+bool NewtonSystem::solveReduced(Vector& rhs) {
+  const Problem& pb = *problem_;
+  const int n = pb.size();
+  const bool coupled = pb.hasFindex();
+  known_.setZero(n);
+  for (int t = 0; t < n; ++t) {
+    if (position_[t] >= 0) continue;
+    const int f = coupled ? pb.findex[t] : -1;
+    known_[t] = rhs[t];
+    if (f >= 0 && cf_[t] != 0 && position_[f] < 0) known_[t] -= cf_[t] * rhs[f];
+  }
+  const int m = static_cast<int>(freeRows_.size());
+  reduced_.resize(m);
+  for (int c = 0; c < m; ++c) {
+    const int i = freeRows_[c];
+    double sum = rhs[i];
+    for (SparseMatrix::InnerIterator it(*a_, i); it; ++it) sum -= it.value() * known_[it.col()];
+    reduced_[c] = sum;
+  }
+  if (m > 0 && !lu_.solve(reduced_)) return false;
+  for (int c = 0; c < m; ++c) rhs[freeRows_[c]] = reduced_[c];
+  for (int t = 0; t < n; ++t) {
+    if (position_[t] >= 0) continue;
+    const int f = coupled ? pb.findex[t] : -1;
+    rhs[t] = f >= 0 && cf_[t] != 0 && position_[f] >= 0 ? rhs[t] - cf_[t] * rhs[f] : known_[t];
   }
   return rhs.allFinite();
 }
 
-bool NewtonSystem::factorDense(const std::vector<char>& inC, double rho) {
-  const Problem& pb = *problem_;
-  const int n = pb.size();
-  clamped_.clear();
-  for (int i = 0; i < n; ++i)
-    if (inC[i]) clamped_.push_back(i);
-  const int m = static_cast<int>(clamped_.size());
-  if (m == 0) return true;
-  block_.resize(m, m);
-  sub_.resize(m);
-  if (pb.isSparse()) {
-    pos_.assign(n, -1);
-    for (int c = 0; c < m; ++c) pos_[clamped_[c]] = c;
-    block_.setZero();
-    const SparseMatrix& a = pb.sparseA();
-    for (int c = 0; c < m; ++c)
-      for (SparseMatrix::InnerIterator it(a, clamped_[c]); it; ++it)
-        if (pos_[it.col()] >= 0) block_(c, pos_[it.col()]) = it.value();
-  } else {
-    for (int c = 0; c < m; ++c)
-      for (int d = 0; d < m; ++d) block_(c, d) = entry(clamped_[c], clamped_[d]);
+bool NewtonSystem::solve(Vector& rhs) {
+  if (sparse_) return solveReduced(rhs);
+  // Partial pivoting first; a (near) singular J, seen as a solution that does not solve the
+  // system, is answered by the least-squares solution of least norm.
+  check_ = denseLu_.solve(rhs);
+  if (check_.allFinite() &&
+      (dense_ * check_ - rhs).lpNorm<Eigen::Infinity>() <=
+          1e-9 * (1 + rhs.lpNorm<Eigen::Infinity>()) * (1 + check_.lpNorm<Eigen::Infinity>())) {
+    rhs.swap(check_);
+    return true;
   }
-  block_.diagonal().array() += rho;
-  llt_.compute(block_);
-  return llt_.info() == Eigen::Success;
+  if (!leastSquares_) {
+    cod_.compute(dense_);
+    leastSquares_ = true;
+  }
+  rhs = cod_.solve(rhs).eval();
+  return rhs.allFinite();
 }
 
-bool NewtonSystem::factorSparse(const std::vector<char>& inC, double rho) {
-  const double* a = a_->valuePtr();
-  const size_t nnz = values_.size();
-  for (size_t k = 0; k < nnz; ++k) {
-    const int i = rowIndex_[k], j = column_[k];
-    if (i == j)
-      values_[k] = inC[i] ? (source_[k] >= 0 ? a[source_[k]] : 0.0) + rho : 1.0;
-    else
-      values_[k] = inC[i] && inC[j] ? a[source_[k]] : 0.0;
+bool NewtonSystem::solveRegularized(double lambda, Vector& rhs) {
+  if (sparse_) return false;
+  normal_.noalias() = dense_.transpose() * dense_;
+  normal_.diagonal().array() += lambda;
+  rhs = normal_.llt().solve(dense_.transpose() * rhs).eval();
+  return rhs.allFinite();
+}
+
+void NewtonSystem::times(const Vector& v, Vector& out) const {
+  const Problem& pb = *problem_;
+  const int n = pb.size();
+  out.resize(n);
+  for (int i = 0; i < n; ++i) {
+    out[i] = da_[i] * v[i] + (db_[i] != 0 ? db_[i] * pb.rowDot(i, v) : 0.0);
+    if (cf_[i] != 0) out[i] += cf_[i] * v[pb.findex[i]];
   }
-  return cholmod_.factor(values_);
+}
+
+void NewtonSystem::transposeTimes(const Vector& v, Vector& out) const {
+  const Problem& pb = *problem_;
+  const int n = pb.size();
+  out.setZero(n);
+  for (int i = 0; i < n; ++i) {
+    const double vi = db_[i] * v[i];
+    if (vi != 0) {
+      if (pb.isSparse())
+        for (SparseMatrix::InnerIterator it(pb.sparseA(), i); it; ++it)
+          out[it.col()] += vi * it.value();
+      else
+        out += vi * pb.denseA().row(i).transpose();
+    }
+    out[i] += da_[i] * v[i];
+    if (cf_[i] != 0) out[pb.findex[i]] += cf_[i] * v[i];
+  }
 }
 
 }  // namespace mlcp::detail

@@ -1,12 +1,11 @@
-// The linear system of one Newton step of NewtonSolver (see "Linear algebra" in mlcp/newton.hpp):
-// (A_CC + rho I) dx_C = r_C with dx_N given, factored densely for small clamped sets and by
-// CHOLMOD on the whole-pattern matrix K = P_C (A + rho I) P_C + (I - P_C) for large ones.
-// Internal to the library.
+// The generalized Jacobian of the natural map and its linear solves for NewtonSolver (see
+// "Jacobian" and "Linear algebra" in mlcp/newton.hpp). Internal to the library.
 #pragma once
 
+#include <string>
 #include <vector>
 
-#include "linalg/cholmod_factor.hpp"
+#include "linalg/sparse_lu.hpp"
 #include "mlcp/problem.hpp"
 
 namespace mlcp::detail {
@@ -15,40 +14,59 @@ namespace mlcp::detail {
 // sparse A with sorted rows, O(n^2) dense.
 bool symmetricMatrix(const Problem& problem);
 
+// The natural map h = x - mid(l(x), x - w, u(x)) at x with w = A x + b (friction bounds at x).
+// Returns ||h||_2^2 (+inf when not finite); inf gets ||h||_inf.
+double naturalMap(const Problem& problem, const Vector& x, const Vector& w, Vector& h, double& inf);
+
 class NewtonSystem {
  public:
-  explicit NewtonSystem(linalg::CholmodFactor& cholmod) : cholmod_(cholmod) {}
-  // Per solve, before the steps: the problem (symmetric A, kept by reference until the next
-  // prepare). False (with why) when CHOLMOD rejects the pattern.
-  bool prepare(const Problem& problem, int denseMaxRows, std::string& why);
-  // Factors the system of the clamped rows inC with the proximal weight rho. False when the block
-  // is not positive definite.
-  bool factor(const std::vector<char>& inC, double rho);
-  // With the last factor: rhs (size n) holds r_C on the clamped rows and dx_N on the others; on
-  // return dx (both parts). False when the result is not finite.
+  // Per solve, before the steps: the problem (kept by reference until the next prepare); whole
+  // problems of at most denseMaxRows rows take the dense path.
+  void prepare(const Problem& problem, int denseMaxRows);
+  // The Jacobian's rows at (x, w): free rows (x - w strictly inside the bounds) take row i of
+  // A, the others e_i minus the bound's derivative in the normal. Returns the free rows' count.
+  int linearize(const Vector& x, const Vector& w);
+  // Factors J + rho D (D: 1 on the free rows, 0 elsewhere); the sparse path its reduced system
+  // on the free rows. False when it is singular (sparse path; the dense path then answers by
+  // least squares).
+  bool factor(double rho);
+  // rhs <- (J + rho D)^-1 rhs with the last factor. False when the result is not finite.
   bool solve(Vector& rhs);
-  // Whether the last factor is CHOLMOD's.
-  bool lastSparse() const { return lastSparse_; }
+  // Dense path: rhs <- (J^T J + lambda I)^-1 J^T rhs (Levenberg-Marquardt; J of the last
+  // factor, without rho). False on the sparse path or when the result is not finite.
+  bool solveRegularized(double lambda, Vector& rhs);
+  // out = J^T v (without rho).
+  void transposeTimes(const Vector& v, Vector& out) const;
+  // out = J v (without rho).
+  void times(const Vector& v, Vector& out) const;
+  // Symbolic analyses of the sparse path (one per reduced pattern seen in a row).
+  int analyses() const { return lu_.analyses(); }
+  bool isSparse() const { return sparse_; }
 
  private:
-  bool factorDense(const std::vector<char>& inC, double rho);
-  bool factorSparse(const std::vector<char>& inC, double rho);
-  double entry(int i, int j) const;
+  bool factorDense(double rho);
+  bool factorSparse(double rho);
+  bool solveReduced(Vector& rhs);
 
-  linalg::CholmodFactor& cholmod_;
+  linalg::SparseLu lu_;
   const Problem* problem_ = nullptr;
-  const SparseMatrix* a_ = nullptr;  // CSR A: the problem's, or own_ for dense storage
+  const SparseMatrix* a_ = nullptr;  // CSR A: the problem's, or own_ for dense or uncompressed
   SparseMatrix own_;
-  int denseMaxRows_ = 0;
-  bool lastSparse_ = false;
-  // The upper triangle of A in compressed columns: per stored entry its row, column and the
-  // index of its value in a_'s storage (-1: a diagonal A lacks, value 0).
-  std::vector<int> colStart_, rowIndex_, source_, column_;
-  std::vector<double> values_;
-  std::vector<int> clamped_, pos_;  // the dense path's gathered rows and their positions
-  DenseMatrix block_;
-  Eigen::LLT<DenseMatrix> llt_;
-  Vector sub_;
+  bool sparse_ = false;
+
+  // Row i of J: db_i A_i + da_i e_i + cf_i e_findex[i].
+  Vector da_, db_, cf_;
+  // The sparse path's reduced system K on the free rows (by rows, columns sorted), the free rows
+  // in order and each row's position among them (-1: at a bound), and workspaces.
+  std::vector<int> rowStart_, columns_, freeRows_, position_, seen_, rowColumns_;
+  std::vector<double> values_, accumulator_;
+  Vector known_, reduced_;
+  DenseMatrix dense_;
+  Eigen::PartialPivLU<DenseMatrix> denseLu_;
+  Eigen::CompleteOrthogonalDecomposition<DenseMatrix> cod_;
+  bool leastSquares_ = false;
+  Vector check_;
+  DenseMatrix normal_;
 };
 
 }  // namespace mlcp::detail

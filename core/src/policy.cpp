@@ -11,7 +11,7 @@ Choice Policy::choose(ProblemClass c, int rows, double tolerance, bool positiveD
     case ProblemClass::Linear: return {"ldlt", "pgs", "bilateral rows only"};
     default: break;
   }
-  if (!positiveDiagonal) return {"lemke", "dantzig", "a row with A_ii <= 0"};
+  if (!positiveDiagonal) return {"lemke", "newton", "a row with A_ii <= 0"};
   if (rows <= smallIslandRows) return {"dantzig", "pgs", "small contact island"};
   if (budgetSpent) return {"pgs", "", "large contact island, step budget spent"};
   if (tolerance >= looseTolerance)

@@ -21,7 +21,9 @@ std::vector<SolverInfo>& registered() {
       {"pgs", "projected Gauss-Seidel / SOR for boxed problems with findex", &make<PgsSolver>},
       {"dantzig", "Dantzig principal pivoting for boxed problems with findex (ODE-style)",
        &make<DantzigSolver>},
-      {"newton", "semismooth Newton on the natural map, CHOLMOD-factored: large islands",
+      {"newton",
+       "semismooth Newton on the natural map (exact findex Jacobian), LU-factored: warm large "
+       "islands, small nonsymmetric MLCPs",
        &make<NewtonSolver>},
       {"lemke", "Lemke's lexicographic complementary pivoting, dense; boxes, findex by fixed point",
        &make<LemkeSolver>},

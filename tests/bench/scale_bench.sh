@@ -22,7 +22,7 @@
 # Usage: tests/bench/scale_bench.sh MLCP_BINARY OUT.csv [STEPS] [LIMIT_SECONDS] [SCENES...]
 # Environment: ENGINES (default "bullet ode"), SOLVERS (ours, default "pgs dantzig newton auto"),
 # DENSE_ROWS (default 12000), MEMORY_KB (address-space limit of each run, default 8000000),
-# CAPTURE_STEP (default 0).
+# CAPTURE_STEP (default 0), MLCP_RUN_ARGS (more `mlcp run` options for every run).
 set -uo pipefail
 mlcp=$1
 out=$2
@@ -89,7 +89,7 @@ for scene in "${scenes[@]}"; do
       [[ $solver == bullet-* || $solver == ode-* ]] && budget=()
       (ulimit -v "$memory_kb"
        exec timeout "$limit" "$mlcp" run "$file" --engine "$engine" --solver "$solver" \
-         --steps "$steps" --tol 1e-6 --fallback none "${budget[@]}" --csv "$csv") \
+         --steps "$steps" --tol 1e-6 --fallback none "${budget[@]}" ${MLCP_RUN_ARGS:-} --csv "$csv") \
         > /dev/null 2>&1
       rc=$?
       limited=0

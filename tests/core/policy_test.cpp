@@ -37,7 +37,7 @@ TEST(Policy, ChoosesByClassSizeAndTolerance) {
     EXPECT_STREQ(p.choose(c, large, p.looseTolerance).solver, "pgs");
     EXPECT_STREQ(p.choose(c, large, 1e-6, true, true).solver, "pgs");
     EXPECT_STREQ(p.choose(c, 12, 1e-6, false).solver, "lemke");
-    EXPECT_STREQ(p.choose(c, 12, 1e-6, false).fallback, "dantzig");
+    EXPECT_STREQ(p.choose(c, 12, 1e-6, false).fallback, "newton");
   }
   EXPECT_STREQ(p.choose(ProblemClass::Findex, 12, 1e-6).fallback, "pgs");
 }

@@ -1,76 +1,107 @@
-// mlcp/newton.hpp: a projected Newton method for boxed MLCPs with findex and a symmetric
-// positive semidefinite A (registry "newton"), meant for large islands: each step is one sparse
-// Cholesky factorization of the free rows, by CHOLMOD on a symbolic analysis kept while A's
-// pattern holds, so that a step costs what a factorization of A costs and grows with the island
-// as its fill does, not as pivot counts do.
+// mlcp/newton.hpp: a semismooth Newton method on the natural map of a boxed MLCP with findex
+// (registry "newton"), for any square A (symmetric or not): small problems by dense LU (the
+// Siconos circuit MLCPs with zero diagonals), large contact islands by a sparse LU of the
+// reduced system on the free rows, warm-started from the last step's answer.
 //
-// Problem. With symmetric A and fixed bounds l <= x <= u the MLCP is the optimality condition of
-// the convex box-constrained quadratic program
+// Map. With w = A x + b and the bounds l(x), u(x) (a friction row i with findex j has l_i =
+// lo_i |x_j|, u_i = hi_i |x_j|; problem.hpp), the MLCP is the equation
 //
-//     min f(x) = x^T A x / 2 + b^T x   subject to  l <= x <= u,     grad f = w = A x + b.
+//     H(x) = x - mid(l(x), x - w, u(x)) = 0,
 //
-// Friction rows (findex) have the bounds l_i = lo_i |x_j|, u_i = hi_i |x_j| of their normal j.
-// Inside one step they are constants, taken from the current normals; every step refreshes them
-// (an outer fixed point over the bounds, one refresh per step) and projects x onto them. The
-// accuracy measure is the natural map H(x) = x - clamp(x - w, l(x), u(x)) with the true, moving
-// bounds (residual.hpp): the solve converges when ||H||_inf <= Options::tolerance (1 + ||b||_inf).
+// H piecewise linear and semismooth. Its inf-norm is the accuracy measure (residual.hpp): the
+// solve converges when ||H||_inf <= Options::tolerance (1 + ||b||_inf).
 //
-// Step (Bertsekas' projected Newton). At a feasible x a row is held when it is fixed (l = u) or
-// within eps of a bound with w pushing outward (x - l <= eps, w > 0 or u - x <= eps, w < 0; eps =
-// min(1e-3, ||H||_inf), the eps-active set that lets rows near a bound leave the free set a step
-// sooner); the others are free (C). The direction solves the free rows' Newton system, the held
-// rows taking a diagonally scaled gradient step that the projection ends on their bound,
+// Jacobian. At x each row takes the piece of mid() that holds at z_i = x_i - w_i:
+//   free        (l_i < z_i < u_i)    H_i = w_i,        row i of J = row i of A;
+//   at a bound  (z_i <= l_i or >= u_i; l_i = u_i)  H_i = x_i - bound_i,  row i = e_i, and for a
+//               friction row also - c_i e_j, c_i = d bound_i / d x_j = (lo_i or hi_i) sign(x_j),
+//               sign(0) = +1.
+// J is an element of the generalized (B-) Jacobian of H. The friction rows' coupling is exact:
+// eliminating the rows at their bounds leaves, on the free set C, K dx_C = r with K = A_CC +
+// A_CT S E_T (T: friction rows on a bound whose normal is free, S their +-mu, E_T picking the
+// normals), nonsymmetric even for symmetric A. With the coupling, Newton converges locally
+// quadratically once the active pieces are the solution's; a lagged friction bound (taken from
+// the normals of the last step, the system kept symmetric) converges only linearly, in mu.
 //
-//     (A_CC + rho I) dx_C = -w_C,   dx_i = -w_i / A_ii (i held, not fixed),   0 (fixed),
+// Step. The direction solves
 //
-// symmetric positive definite for rho > 0. The step is x(t) = P(x + t dx), P the projection onto
-// the step's bounds, with t = 1, 1/2, ... (at most NewtonParams::maxHalvings halvings) until
-// Armijo's rule on f holds, f(x(t)) <= f(x) + 1e-4 w^T (x(t) - x). f decreases at every accepted
-// step, so for fixed bounds the iteration converges to the QP's minimizer, identifies its active
-// set in finitely many steps and then converges quadratically (rho -> 0). rho is a proximal
-// (Levenberg-Marquardt) weight,
+//     (J + rho D) dx = -H,    D = diag(1 on the free rows),
 //
-//     rho = mu max_i A_ii min(1, r),   r the scaled residual at x,
+// and the step is x + t dx with t = 1, 1/2, ... (NewtonParams::maxHalvings halvings at most,
+// sparseMaxHalvings on the sparse path),
+// the first t with Armijo's rule on the merit theta = ||H||_2^2,
 //
-// that keeps the near-singular clamped blocks of coplanar contacts from throwing the null-space
-// part far away and vanishes with the residual. mu starts at NewtonParams::proximal, is divided
-// by 10 after a full step, and multiplied by 10 (up to NewtonParams::proximalMax) with the step
-// recomputed from the same x when no step length satisfies Armijo's rule; a step that finds none
-// even there counts as a stall, and NewtonParams::maxStalls of them in a row end the solve
-// (Failed). Before every step but the first NewtonParams::stepSweeps projected Gauss-Seidel sweeps
-// (pgs.hpp; coordinate descent on the same f) move the rows the Newton step would leave held.
+//     theta(x + t dx) <= theta(x) + sigma t theta'(x; dx),   theta' = 2 (J^T H) . dx, sigma 1e-4.
 //
-// Symmetric system. A friction row on its bound whose normal is free would, substituted as
-// x_t = mu x_n, make the system nonsymmetric (K = A_CC + U E^T). Lagging its bound keeps the
-// system symmetric positive definite, so one Cholesky factorization serves it; the price is that
-// the coupling converges only through the per-step refresh, linearly in the friction coefficient.
+// rho is a proximal (Levenberg-Marquardt) weight on the sparse path,
 //
-// Linear algebra. Up to NewtonParams::denseMaxRows free rows (and for every problem of at most
-// that many rows), A_CC + rho I is gathered and factored densely (Eigen's LLT). Larger systems
-// factor the whole n x n matrix
+//     rho = mu max_i |A_ii| min(1, r),   r the scaled residual at x,
 //
-//     K = P_C (A + rho I) P_C + (I - P_C),     P_C the diagonal 0/1 projector on C,
+// that keeps the near-singular free blocks of coplanar contacts (redundant rows, only cfm on
+// their null space) from throwing the null-space part of dx far away, and vanishes with the
+// residual. mu starts at NewtonParams::proximal; a full step divides it by 10, a step that
+// needed two or more halvings multiplies it by 10, and a direction without an acceptable t is
+// recomputed from the same x with mu 10 times larger, up to NewtonParams::proximalMax. The dense
+// path uses rho = 0 and answers a singular J by least squares (the least-norm solution); when
+// the Newton direction fails there, Levenberg-Marquardt directions (J^T J + lambda I) dx =
+// -J^T H with lambda = ||H||_2 10^k, k < 4, are tried before the fallback.
 //
-// whose pattern is A's whatever C is (held rows and columns hold explicit zeros and a unit
-// diagonal, their right-hand side 0), so CHOLMOD's symbolic analysis (fill-reducing order,
-// elimination tree, supernodal or simplicial as CHOLMOD decides; linalg/cholmod_factor.hpp) is
-// done once per pattern of A and reused by every step and by later solves of this object on the
-// same pattern (RowSolver keeps one solver object per island key, so an island's analysis lives
-// in its slot as long as its contact pattern holds). A step costs one numeric factorization,
-// one solve, the sweeps (O(nnz A) each) and one product with A per trial step length.
+// Fallback. When no direction descends: NewtonParams::stepSweeps projected Gauss-Seidel sweeps
+// (pgs.hpp) where they apply (A symmetric with a positive diagonal: they decrease the QP's
+// objective, a restart from a point with other active pieces), otherwise a Cauchy step along
+// -J^T H (the linear model's minimizer on that line) with the same line search. After
+// NewtonParams::maxStalls failed Newton steps in a row, a Cauchy step that does not descend, or
+// NewtonParams::maxStagnation steps without a new best iterate (the rounding floor of a
+// tolerance below what the problem's conditioning allows), the solve ends Failed with its best
+// iterate.
 //
-// Starts. A warm start (Options::warmStart, solveWithGuess) is used as it is (projected onto its
-// bounds). A cold start (x = 0) first takes NewtonParams::coldSweeps projected Gauss-Seidel
-// sweeps; pivoting from zero never runs here.
+// Linear algebra. Problems of at most NewtonParams::denseMaxRows rows build J densely and
+// factor it with Eigen's PartialPivLU (O(n^3) per step, 0.3 ms at 108 rows); a solution that
+// does not solve the system to 1e-9 relative (singular J) is replaced by
+// CompleteOrthogonalDecomposition's least-squares one. Larger problems eliminate the rows at a
+// bound (dx_t = -H_t + c_t dx_j: known when the normal j is at a bound too, coupled when it is
+// free) and factor the reduced system on the free rows,
 //
-// Limits. Options::maxIterations bounds the steps (MaxIterations), Options::timeBudget the wall
-// time (checked before each step; TimeLimit). Both return the best iterate by ||H||_2, the start
-// included, so never worse than the start; the base class reports its true residual.
-// Result::iterations counts the steps.
+//     (K + rho I) dx_C = -H_C - A_CB dx_B^known,   K = A_CC + A_CT S E_T,
 //
-// Applies to symmetric A (checked each solve: O(nnz log) for sparse A, no transposed copy); a
-// nonsymmetric A is Unsupported. No state carries from one solve to the next except the symbolic
-// analysis, a function of A's pattern only: the same problem and start give the same answer.
+// by KLU (linalg/sparse_lu.hpp), assembled by rows from A's rows (duplicates summed); the
+// coupled bound rows then follow from their normals. KLU's symbolic analysis (block triangular
+// form, AMD order) is kept while the reduced pattern (the free set, and the coupled rows'
+// normals) holds from one factorization to the next: the retries of one step with a larger rho
+// and the last steps of a converging solve reuse it. The LU is taken on K's rows as the
+// columns of K^T and solved transposed, so no transposed copy is made. A step costs one
+// assembly of K (O(nnz A)), its factorization, one solve, one product with J^T, and one
+// product with A per trial step length.
+//
+// Why these choices. An LU of the nonsymmetric K keeps the coupling exact. The reduced K is
+// far sparser than the whole-pattern J (429 free rows with 11k entries against 1140 rows with
+// 81k at the captured 55-box Bullet island's answer): a solve of that island is 2.7x faster
+// than with a factorization of the whole J on one kept analysis, with the same iterates. A
+// Cholesky factorization of A_CC would need a correction of rank |T|, the sliding friction
+// rows: ~60 on that island, i.e. ~60 extra solves per step (docs/benchmarks.md, "newton:
+// factorization costs"). KLU and UMFPACK factor these patterns equally fast; KLU needs no BLAS.
+// The dense path's threshold: on pyramid patterns KLU's factorization and solve overtake the
+// dense LU near 100 rows (0.03 against 0.015 ms at 48 rows, 0.11 against 0.31 ms at 108, 0.89
+// against 1.18 ms at 192); below it the dense path's least-squares and Levenberg-Marquardt
+// steps also take singular J (the circuit MLCPs' equality blocks, up to 61 rows in the Siconos
+// corpus), which the sparse LU refuses.
+//
+// Starts. A warm start (Options::warmStart, solveWithGuess) is used as given. A cold start (x =
+// 0), where sweeps apply, first takes NewtonParams::coldSweeps projected Gauss-Seidel sweeps;
+// pivoting from zero never runs here. Newton is fast from a start whose active pieces are
+// nearly the answer's: warm-started from the previous step's exact answer, synthetic pyramids
+// of 192-768 rows converge in 1-9 steps (10 of 12 cases), small captured islands in 1-6 steps
+// even cold. On large islands from a cold or an engine's start the pieces of thousands of rows
+// change a few per step along the ill-conditioned directions of redundant contacts, and the
+// step limit often ends a solve at residuals 1e-3..1e-5 (docs/benchmarks.md): large islands
+// stay dantzig's or pgs's in `auto` (policy.hpp).
+//
+// Limits and invariants. Options::maxIterations bounds the Newton steps (MaxIterations),
+// Options::timeBudget the wall time (checked before each step; TimeLimit). Every non-converged
+// end returns the best iterate by ||H||_inf, the start included, so never worse than the start;
+// the base class reports the true residual of what is returned. Result::iterations counts the
+// steps. No state carries from one solve to the next except the symbolic analysis, a function
+// of the pattern only: the same problem and start give the same answer.
 #pragma once
 
 #include <memory>
@@ -79,27 +110,28 @@
 
 namespace mlcp {
 
-namespace linalg {
-class CholmodFactor;
-}
-
 struct NewtonParams {
   // Projected Gauss-Seidel sweeps over a cold start (x = 0) before the first step. Default 10.
   int coldSweeps = 10;
-  // Clamped blocks of at most this many rows are factored densely (Eigen); larger ones, or any
-  // block of a problem with more than denseMaxRows rows, by CHOLMOD. Default 150.
-  int denseMaxRows = 150;
-  // mu_k's start and its largest value (the proximal weight rho = mu_k max A_ii min(1, r_k)).
-  // Defaults 1e-3 and 1e3.
+  // Problems of at most this many rows take the dense path (Eigen's LU of J); larger ones the
+  // sparse LU (KLU). Default 100.
+  int denseMaxRows = 100;
+  // mu's start and its largest value (the sparse path's proximal weight rho = mu max |A_ii|
+  // min(1, r)). Defaults 1e-3 and 1e3.
   double proximal = 1e-3;
   double proximalMax = 1e3;
-  // Halvings of the step length in the line search. Default 8.
-  int maxHalvings = 8;
-  // Projected Gauss-Seidel sweeps before each step after the first. Default 10.
+  // Halvings of the step length in the line search: the dense path's (fine steps cross the
+  // kinks of small nonsymmetric problems' maps) and the sparse path's (a direction that needs
+  // more is recomputed with a larger proximal weight instead). Defaults 30 and 12.
+  int maxHalvings = 30;
+  int sparseMaxHalvings = 12;
+  // Projected Gauss-Seidel sweeps of the fallback. Default 10.
   int stepSweeps = 10;
-  // Steps in a row without descent at the largest proximal weight before the solve stops.
-  // Default 3.
+  // Newton steps in a row without descent (each followed by the fallback) before the solve
+  // stops. Default 3.
   int maxStalls = 3;
+  // Steps in a row without a new best iterate before the solve stops (Failed). Default 50.
+  int maxStagnation = 50;
 };
 
 class NewtonSolver : public Solver {
@@ -114,9 +146,9 @@ class NewtonSolver : public Solver {
   NewtonParams& params() { return params_; }
   const NewtonParams& params() const { return params_; }
 
-  // Of the last solve: numeric factorizations (CHOLMOD or dense).
+  // Of the last solve: numeric factorizations (sparse or dense).
   int factorizations() const { return factorizations_; }
-  // Symbolic analyses this object has done (one per pattern of A seen in a row).
+  // Symbolic analyses this object has done (one per reduced pattern seen in a row).
   int analyses() const;
 
  protected:
@@ -124,9 +156,12 @@ class NewtonSolver : public Solver {
 
  private:
   struct Work;
-  bool search(const Problem& problem, const Vector& x, double res, double dMax, double& mu);
+  int lineSearch(const Problem& problem, double slope);
+  double slope();
+  bool newtonStep(const Problem& problem, double res, double rhoScale, double& mu);
+  bool fallbackStep(const Problem& problem, bool sweeps);
+  void start(const Problem& problem, Vector& x, bool sweeps);
   std::unique_ptr<Work> work_;
-  std::unique_ptr<linalg::CholmodFactor> cholmod_;
   NewtonParams params_;
   int factorizations_ = 0;
 };

@@ -13,8 +13,10 @@
 // findex alone), its size in rows, the requested tolerance and whether a time budget is spent:
 //   Empty                           -> "none"     nothing to solve
 //   Linear (bilateral joints only)  -> "ldlt"     one LDL^T solve: exact, the cheapest answer
-//   a row with A_ii <= 0            -> "lemke"    (fallback "dantzig"): neither pgs nor dantzig's
-//                                                 ratio tests can divide by it
+//   a row with A_ii <= 0            -> "lemke"    (fallback "newton"): neither pgs nor dantzig's
+//                                                 ratio tests can divide by it; newton's dense
+//                                                 LU / least-squares steps take the singular
+//                                                 equality blocks (diode bridges) lemke cannot
 //   contacts, rows <= smallIslandRows          -> "dantzig" exact pivoting answer (~1e-12)
 //   contacts, rows >  smallIslandRows:
 //     the step's time budget spent             -> "pgs"      (improves any start in any share)
