@@ -12,7 +12,7 @@
 //         Its lambda rows have zero diagonal entries and A is not symmetric (and, with the
 //         redundant contacts of a resting face, singular in its friction block): lemke is the
 //         method for it (auto's choice); dantzig takes it but, made for P-matrices, often stalls
-//         and says so; newton refuses a non-symmetric A; pgs, gs and ldlt cannot take it at all
+//         and says so; newton takes it (any square A); pgs, gs and ldlt cannot take it at all
 //         and are refused when the settings are made. Lemke needs a little cfm on the rows (the
 //         engines' cfm / dt, 6e-4 at a world cfm of 1e-5, as the scenes set): at 1e-10..1e-8
 //         (ODE's double-precision default world CFM is 1e-10) the four coplanar contacts of a
