@@ -213,8 +213,9 @@ TEST(TimeBudget, LaterIslandsOfAStepGetTheMinimalShareAndACheapSolver) {
   EXPECT_NEAR(solver.islandBudget(nowSeconds()), s.minShare * s.timeBudget, 1e-12);
   const double t0 = nowSeconds();
   const IslandSolve second = solver.solve(rows, start, x, 2);
-  EXPECT_LT(nowSeconds() - t0, 0.1 * test::kTimingSlack);  // two 1 ms shares, plus slack for a loaded machine
-  EXPECT_EQ(second.requested, "pgs");  // the budget is spent: the cheap method
+  EXPECT_LT(nowSeconds() - t0,
+            0.1 * test::kTimingSlack);  // two 1 ms shares, plus slack for a loaded machine
+  EXPECT_EQ(second.requested, "pgs");   // the budget is spent: the cheap method
   EXPECT_LT(second.result.residual, residual(rows.assemble(true), start));
   // A new step has the whole budget again.
   solver.beginStep();

@@ -231,14 +231,20 @@ TEST(RowSolverCone, APrimaryThatFailsOnTheLcpFallsBackToTheBox) {
   EXPECT_TRUE(x.allFinite());
 }
 
-// A rejected cone answer (lemke's false ray termination at cfm 1e-8, see friction_model.hpp)
-// falls back to the box for that solve only: the box's pgs-first memory after a breakdown does
-// not take the cone from the island for its next solves.
+// A rejected cone answer falls back to the box for that solve only: the box's pgs-first memory
+// after a breakdown does not take the cone from the island for its next solves. The rejection is
+// lemke's pivot limit (Options::maxPivots), which a cube on 16 coplanar ground points exceeds and
+// one on its 4 corners does not.
 TEST(RowSolverCone, ARejectedConeAnswerDoesNotCostTheIslandTheConeLater) {
   const Vector6 v = pushed(2, kPi / 8);
-  const RowSystem hard = cubeOnGround(kCorners, v, 0.5, 1e-8);
+  std::vector<Eigen::Vector3d> grid;
+  for (const double x : {-0.5, -1.0 / 6, 1.0 / 6, 0.5})
+    for (const double y : {-0.5, -1.0 / 6, 1.0 / 6, 0.5}) grid.push_back({x, y, -0.5});
+  const RowSystem hard = cubeOnGround(grid, v, 0.5, kCfm);
   const RowSystem easy = cubeOnGround(kCorners, v, 0.5, kCfm);
-  RowSolver solver(coneSettings(8));
+  RowSolverSettings settings = coneSettings(8);  // auto: the memory is auto's
+  settings.options.maxPivots = 60;  // the 16-point cone LCP takes 73, the 4-corner one fewer
+  RowSolver solver(settings);
   Vector x;
   IslandSolve s = solver.solve(hard, Vector::Zero(hard.size()), x, 7);
   ASSERT_TRUE(s.fellBack) << "lemke solved the hard case: " << s.result.message;
