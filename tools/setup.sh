@@ -61,17 +61,18 @@ fi
 # ldlt) and start its threads. When this set-up is what brought OpenBLAS, the reference libraries
 # stay the system's (as without Siconos; Siconos links OpenBLAS directly); a machine that had
 # OpenBLAS before keeps its owner's choice.
-multiarch=$(dpkg-architecture -qDEB_HOST_MULTIARCH 2>/dev/null || gcc -dumpmachine)
-for pair in "libblas.so.3 blas" "liblapack.so.3 lapack"; do
-  [ $had_openblas -eq 0 ] || break
-  read -r lib dir <<< "$pair"
-  ref=/usr/lib/$multiarch/$dir/$lib
-  alt=$lib-$multiarch
-  if [ -e "$ref" ] && [ "$(readlink "/etc/alternatives/$alt" 2>/dev/null)" != "$ref" ]; then
-    echo "setup: keeping the reference $lib as the system's (not OpenBLAS's)"
-    sudo_if_needed update-alternatives --set "$alt" "$ref" > /dev/null
-  fi
-done
+if [ $had_openblas -eq 0 ]; then
+  multiarch=$(dpkg-architecture -qDEB_HOST_MULTIARCH 2>/dev/null || gcc -dumpmachine)
+  for pair in "libblas.so.3 blas" "liblapack.so.3 lapack"; do
+    read -r lib dir <<< "$pair"
+    ref=/usr/lib/$multiarch/$dir/$lib
+    alt=$lib-$multiarch
+    if [ -e "$ref" ] && [ "$(readlink "/etc/alternatives/$alt" 2>/dev/null)" != "$ref" ]; then
+      echo "setup: keeping the reference $lib as the system's (not OpenBLAS's)"
+      sudo_if_needed update-alternatives --set "$alt" "$ref" > /dev/null
+    fi
+  done
+fi
 
 if [ -x "$repo/tools/fetch-ode-source.sh" ]; then
   "$repo/tools/fetch-ode-source.sh"

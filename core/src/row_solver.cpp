@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
+#include <string_view>
 
 #include "mlcp/io.hpp"
 #include "mlcp/registry.hpp"
@@ -105,6 +106,12 @@ RowSolver::RowSolver(const RowSolverSettings& settings) : settings_(settings) {
     throw std::invalid_argument("mlcp::RowSolver: " + why);
 }
 
+// The step's budget is spent when this island's share is down to the minimal one (policy.hpp:
+// auto then takes pgs, which improves any start in any share).
+bool RowSolver::budgetSpent(double share) const {
+  return share > 0 && share <= settings_.minShare * settings_.timeBudget;
+}
+
 void RowSolver::setTimeBudget(double seconds) {
   if (!(seconds >= 0) || !std::isfinite(seconds))
     throw std::invalid_argument("mlcp::RowSolver: timeBudget must be finite and >= 0 seconds");
@@ -163,10 +170,14 @@ RowSolver::Slot& RowSolver::slot(std::uint64_t key) {
 }
 
 Solver* RowSolver::assembledSolver(Slot& island, const std::string& name, const char* tag) {
-  for (auto& [n, solver] : island.solvers)
-    if (n.size() == name.size() + std::strlen(tag) && n.compare(0, std::strlen(tag), tag) == 0 &&
-        n.compare(std::strlen(tag), std::string::npos, name) == 0)
+  // The slot's key is tag + name, matched without building it (this runs every island solve).
+  const std::string_view prefix(tag);
+  for (auto& [n, solver] : island.solvers) {
+    const std::string_view key(n);
+    if (key.size() == prefix.size() + name.size() && key.substr(0, prefix.size()) == prefix &&
+        key.substr(prefix.size()) == name)
       return solver.get();
+  }
   island.solvers.emplace_back(tag + name, makeSolver(name));
   // solve() times the whole island (assembly, solve, check) with fewer clock reads.
   island.solvers.back().second->setTimed(false);
@@ -260,7 +271,7 @@ Result RowSolver::solveCone(const Vector& start, Vector& x, Slot& island, Island
                             double share, double t0) {
   const Problem& p = cone_.problem();
   if (equals(settings_.solver, "auto")) {
-    const bool spent = share > 0 && share <= settings_.minShare * settings_.timeBudget;
+    const bool spent = budgetSpent(share);
     out.requested =
         settings_.policy
             .choose(ProblemClass::StandardLcp, p.size(), settings_.options.tolerance, false, spent)
@@ -383,7 +394,7 @@ IslandSolve RowSolver::solveScreened(const RowSystem& rows, const Vector& start,
   if (cone) {
     r = solveCone(start, x, island, out, share, t0);
   } else if (autoChoice) {
-    const bool spent = share > 0 && share <= settings_.minShare * settings_.timeBudget;
+    const bool spent = budgetSpent(share);
     const Choice c = policy.choose(out.problemClass, n, settings_.options.tolerance, true, spent);
     out.requested = c.solver;
     if (island.pgsFirst > 0 && !equals(out.requested, "ldlt") && !equals(out.requested, "pgs")) {

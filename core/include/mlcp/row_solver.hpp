@@ -258,6 +258,8 @@ class RowSolver {
   // (see above); 0 without a budget. For callers that solve an island themselves (Bullet's
   // packed pgs path) under the same budget.
   double islandBudget(double now);
+  // True when `share` (islandBudget()) is down to the minimal share: the step's budget is spent.
+  bool budgetSpent(double share) const;
 
   // Solves the island's rows from `start` (size rows.size(), used as given: pass zeros for a
   // cold start) into x. islandKey identifies the island across steps (any stable number, e.g.
