@@ -5,7 +5,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "dantzig_body.hpp"
+#include "linalg/body_space.hpp"
 #include "mlcp/residual.hpp"
 #include "mlcp/solver.hpp"
 
@@ -267,7 +267,7 @@ bool BlockPivoting::solveClamped(const Problem& pb, Vector& x, const Vector& pre
   const int s = static_cast<int>(sliding_.size());
   useLu_ = s > limits_.woodburyRows && m > 0;
   useBody_ = false;
-  // Body space (dantzig_body.hpp) whenever it applies: a fresh factor there costs less than
+  // Body space (linalg/body_space.hpp) whenever it applies: a fresh factor there costs less than
   // reusing one here (no base is kept for the bordered updates then).
   if (m > 0 && bodyReady_) {
     useBody_ = body_->factor(order_, pos_, sliding_, coeff_, problemFindex_, rho,

@@ -60,8 +60,8 @@ class BlockPivoting {
   BlockPivoting();
   ~BlockPivoting();
   // The rows the next runs' problem was assembled from (nullptr: none): block steps may then be
-  // solved in body space (dantzig_body.hpp). Not owned; must outlive the runs. Prepared once, at
-  // the first run after this call (DantzigSolver's cold trial and warm stage share it): call it
+  // solved in body space (linalg/body_space.hpp). Not owned; must outlive the runs. Prepared once,
+  // at the first run after this call (DantzigSolver's cold trial and warm stage share it): call it
   // again for another problem.
   void setRows(const RowSystem* rows) {
     rows_ = rows;

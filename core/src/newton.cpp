@@ -38,6 +38,8 @@ NewtonSolver::NewtonSolver(NewtonSolver&&) noexcept = default;
 NewtonSolver& NewtonSolver::operator=(NewtonSolver&&) noexcept = default;
 
 int NewtonSolver::analyses() const { return work_->system.analyses(); }
+int NewtonSolver::bodyFactorizations() const { return work_->system.bodyFactorizations(); }
+void NewtonSolver::useRows(const RowSystem* rows) { work_->system.useRows(rows); }
 
 // Backtracking from t = 1 along wk.dx from wk.at: the first t = 2^-k (k <= the halvings) with
 // ||H(x + t dx)||^2 <= ||H(x)||^2 + sigma t slope (slope < 0, the directional derivative). On

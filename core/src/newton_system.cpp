@@ -4,9 +4,15 @@
 #include <cmath>
 #include <numeric>
 
+#include "linalg/body_space.hpp"
+
 namespace mlcp::detail {
 
 namespace {
+// Body space applies while every cfm_c + rho is at least this times max |A_ii|.
+constexpr double kBodyMinDiagonal = 1e-11;
+// Steps of iterative refinement after a body-space solve.
+constexpr int kBodyRefinements = 2;
 
 double largestEntry(const Problem& pb) {
   return pb.isSparse() ? (pb.sparseA().nonZeros() ? pb.sparseA().coeffs().cwiseAbs().maxCoeff() : 0)
@@ -69,6 +75,9 @@ double naturalMap(const Problem& pb, const Vector& x, const Vector& w, Vector& h
   return sum;
 }
 
+NewtonSystem::NewtonSystem() : body_(std::make_unique<BodySpaceSystem>()) {}
+NewtonSystem::~NewtonSystem() = default;
+
 void NewtonSystem::prepare(const Problem& pb, int denseMaxRows) {
   problem_ = &pb;
   const int n = pb.size();
@@ -85,6 +94,20 @@ void NewtonSystem::prepare(const Problem& pb, int denseMaxRows) {
     own_.makeCompressed();
     a_ = &own_;
   }
+  prepareBody(pb);
+}
+
+// Body space applies when the rows handed over are A's: checked on the diagonal.
+void NewtonSystem::prepareBody(const Problem& pb) {
+  const int n = pb.size();
+  bodyFactorizations_ = 0;
+  double dMax = 0;
+  for (int i = 0; i < n; ++i) dMax = std::max(dMax, std::abs(pb.diagonal(i)));
+  minDiagonal_ = kBodyMinDiagonal * dMax;
+  bodyReady_ = rows_ != nullptr && body_->prepare(*rows_, n);
+  for (int i = 0; bodyReady_ && i < n; ++i)
+    bodyReady_ = std::abs(body_->diagonal(i) - pb.diagonal(i)) <= 1e-10 * std::max(dMax, 1e-300);
+  findex_ = pb.hasFindex() ? pb.findex : std::vector<int>(n, -1);
 }
 
 int NewtonSystem::linearize(const Vector& x, const Vector& w) {
@@ -147,6 +170,9 @@ bool NewtonSystem::factorSparse(double rho) {
       freeRows_.push_back(i);
     }
   const int m = static_cast<int>(freeRows_.size());
+  rho_ = rho;
+  useBody_ = false;
+  if (m > 0 && bodyReady_ && factorBody(rho)) return true;
   rowStart_.assign(1, 0);
   columns_.clear();
   values_.clear();
@@ -206,7 +232,7 @@ bool NewtonSystem::solveReduced(Vector& rhs) {
     for (SparseMatrix::InnerIterator it(*a_, i); it; ++it) sum -= it.value() * known_[it.col()];
     reduced_[c] = sum;
   }
-  if (m > 0 && !lu_.solve(reduced_)) return false;
+  if (m > 0 && !solveFactored(reduced_)) return false;
   for (int c = 0; c < m; ++c) rhs[freeRows_[c]] = reduced_[c];
   for (int t = 0; t < n; ++t) {
     if (position_[t] >= 0) continue;
@@ -214,6 +240,53 @@ bool NewtonSystem::solveReduced(Vector& rhs) {
     rhs[t] = f >= 0 && cf_[t] != 0 && position_[f] >= 0 ? rhs[t] - cf_[t] * rhs[f] : known_[t];
   }
   return rhs.allFinite();
+}
+
+// K (with rho) in body space: the coupled bound rows (their normal free) are its sliding rows.
+bool NewtonSystem::factorBody(double rho) {
+  const Problem& pb = *problem_;
+  sliding_.clear();
+  coeff_.clear();
+  for (int t = 0; t < pb.size(); ++t)
+    if (position_[t] < 0 && cf_[t] != 0 && position_[findex_[t]] >= 0) {
+      sliding_.push_back(t);
+      coeff_.push_back(-cf_[t]);
+    }
+  useBody_ = body_->factor(freeRows_, position_, sliding_, coeff_, findex_, rho, minDiagonal_);
+  bodyFactorizations_ += useBody_;
+  return useBody_;
+}
+
+// y <- K^-1 y with the last factor; in body space with two steps of iterative refinement on K's
+// rows (Woodbury's error grows as 1 / min(cfm + rho)).
+bool NewtonSystem::solveFactored(Vector& y) {
+  if (!useBody_) return lu_.solve(y);
+  refine_ = y;
+  body_->solve(y);
+  for (int pass = 0; pass < kBodyRefinements; ++pass) {
+    reducedTimes(y, product_);
+    product_ = refine_ - product_;
+    body_->solve(product_);
+    y += product_;
+  }
+  return y.allFinite();
+}
+
+// out = K y on the free rows: row i's A_ij at free j, A_it c_t at the free normal of a coupled t.
+void NewtonSystem::reducedTimes(const Vector& y, Vector& out) const {
+  const int m = static_cast<int>(freeRows_.size());
+  out.resize(m);
+  for (int c = 0; c < m; ++c) {
+    double sum = rho_ * y[c];
+    for (SparseMatrix::InnerIterator it(*a_, freeRows_[c]); it; ++it) {
+      const int j = static_cast<int>(it.col());
+      if (position_[j] >= 0)
+        sum += it.value() * y[position_[j]];
+      else if (cf_[j] != 0 && findex_[j] >= 0 && position_[findex_[j]] >= 0)
+        sum -= cf_[j] * it.value() * y[position_[findex_[j]]];
+    }
+    out[c] = sum;
+  }
 }
 
 bool NewtonSystem::solve(Vector& rhs) {

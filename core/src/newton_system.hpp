@@ -2,13 +2,17 @@
 // "Jacobian" and "Linear algebra" in mlcp/newton.hpp). Internal to the library.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "linalg/sparse_lu.hpp"
 #include "mlcp/problem.hpp"
+#include "mlcp/rows.hpp"
 
 namespace mlcp::detail {
+
+class BodySpaceSystem;
 
 // Whether A equals A^T (to 1e-14 of its largest entry) without forming A^T: O(nnz log) for
 // sparse A with sorted rows, O(n^2) dense.
@@ -20,6 +24,13 @@ double naturalMap(const Problem& problem, const Vector& x, const Vector& w, Vect
 
 class NewtonSystem {
  public:
+  NewtonSystem();
+  ~NewtonSystem();
+  // The rows the next prepared problem was assembled from (A = J W J^T + diag(cfm)), or null.
+  // With them the sparse path solves the reduced system in body space when that applies.
+  void useRows(const RowSystem* rows) { rows_ = rows; }
+  // Of the last solve: factorizations done in body space.
+  int bodyFactorizations() const { return bodyFactorizations_; }
   // Per solve, before the steps: the problem (kept by reference until the next prepare); whole
   // problems of at most denseMaxRows rows take the dense path.
   void prepare(const Problem& problem, int denseMaxRows);
@@ -47,8 +58,21 @@ class NewtonSystem {
   bool factorDense(double rho);
   bool factorSparse(double rho);
   bool solveReduced(Vector& rhs);
+  void prepareBody(const Problem& problem);
+  bool factorBody(double rho);
+  bool solveFactored(Vector& y);
+  void reducedTimes(const Vector& y, Vector& out) const;
 
   linalg::SparseLu lu_;
+  // Body space (linalg/body_space.hpp): ready when the rows are A's; used for the last factor.
+  const RowSystem* rows_ = nullptr;
+  std::unique_ptr<BodySpaceSystem> body_;
+  bool bodyReady_ = false, useBody_ = false;
+  int bodyFactorizations_ = 0;
+  double rho_ = 0, minDiagonal_ = 0;
+  std::vector<int> sliding_, findex_;
+  std::vector<double> coeff_;
+  Vector refine_, product_;
   const Problem* problem_ = nullptr;
   const SparseMatrix* a_ = nullptr;  // CSR A: the problem's, or own_ for dense or uncompressed
   SparseMatrix own_;

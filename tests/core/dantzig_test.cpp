@@ -7,9 +7,9 @@
 
 #include <random>
 
-#include "../core/src/dantzig_block.hpp"  // SymmetricPatternLu (internal)
-#include "../core/src/dantzig_body.hpp"   // BodySpaceSystem (internal)
-#include "../core/src/dantzig_small.hpp"  // the tiny dense path (internal)
+#include "../core/src/dantzig_block.hpp"      // SymmetricPatternLu (internal)
+#include "../core/src/dantzig_small.hpp"      // the tiny dense path (internal)
+#include "../core/src/linalg/body_space.hpp"  // BodySpaceSystem (internal)
 #include "common/contact_scenes.hpp"
 #include "common/generators.hpp"
 #include "mlcp/io.hpp"

@@ -93,6 +93,51 @@ TEST(Newton, WarmSequenceTakesFewSteps) {
   }
 }
 
+// With the problem's rows (Solver::useRows, as RowSolver passes them) the reduced systems are
+// factored in body space and the iterates are those of the sparse LU without them, warm steps
+// of a friction pyramid from dantzig's answer (sliding rows couple to their normals). With
+// cfm = 0 the last steps' tiny proximal weight leaves body space to the sparse LU.
+TEST(Newton, RowsFactorInBodySpaceWithTheSparseLusIterates) {
+  for (const double cfm : {1e-5 * 60, 0.0}) {
+    test::PyramidSpec spec = pyramidSpec(6, 0.6);
+    spec.cfm = cfm;
+    test::BoxPyramid pyramid(spec);
+    DantzigSolver dantzig;
+    dantzig.options().tolerance = 1e-10;
+    Vector x;
+    ASSERT_TRUE(dantzig.solve(pyramid.rows().assemble(true), x).converged());
+    Vector y = x;
+    NewtonSolver with, without;
+    with.options().tolerance = without.options().tolerance = 1e-9;
+    int inBodySpace = 0, factorizations = 0;
+    for (int step = 0; step < 4; ++step) {
+      pyramid.nextStep(1e-3);
+      const Problem p = pyramid.rows().assemble(true);
+      ASSERT_GT(p.size(), with.params().denseMaxRows);
+      const Vector gx = x, gy = y;
+      with.useRows(&pyramid.rows());
+      const Result r = with.solveWithGuess(p, gx, x);
+      with.useRows(nullptr);
+      const Result ref = without.solveWithGuess(p, gy, y);
+      ASSERT_TRUE(ref.converged()) << cfm << " step " << step << ": " << ref.message;
+      ASSERT_TRUE(r.converged()) << cfm << " step " << step << ": " << r.message;
+      EXPECT_LE(accuracy(p, x).residual, 1e-9) << step;
+      if (cfm > 0) {
+        EXPECT_EQ(r.iterations, ref.iterations) << step;
+        EXPECT_LE((x - y).lpNorm<Eigen::Infinity>(), 1e-8 * (1 + y.lpNorm<Eigen::Infinity>()))
+            << step;
+      }
+      EXPECT_EQ(without.bodyFactorizations(), 0);
+      inBodySpace += with.bodyFactorizations();
+      factorizations += with.factorizations();
+    }
+    EXPECT_GT(inBodySpace, 0) << cfm;
+    if (cfm > 0) {
+      EXPECT_EQ(inBodySpace, factorizations);
+    }
+  }
+}
+
 // A step limit and a time budget return the best iterate (never worse than the start) with an
 // honest status.
 TEST(Newton, LimitsReturnTheBestIterate) {

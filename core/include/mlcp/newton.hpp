@@ -73,6 +73,14 @@
 // assembly of K (O(nnz A)), its factorization, one solve, one product with J^T, and one
 // product with A per trial step length.
 //
+// Body space. A problem that comes with its rows (Solver::useRows: RowSolver, hence both
+// adapters; A = J W J^T + diag(cfm)) factors the same K + rho I in body space instead
+// (linalg/body_space.hpp: Woodbury on the bodies, S = I + V^T D^-1 U with D = diag(cfm + rho)),
+// followed by two steps of iterative refinement on K's rows, as long as every cfm_c + rho is at
+// least 1e-11 max |A_ii| (else the sparse LU above). S has 6 rows per body whatever the number
+// of contact rows, so a step costs a fraction of KLU's: the same iterates, 8-20x less time per
+// step on 55- and 210-box pyramids (docs/benchmarks.md).
+//
 // Why these choices. An LU of the nonsymmetric K keeps the coupling exact. The reduced K is
 // far sparser than the whole-pattern J (429 free rows with 11k entries against 1140 rows with
 // 81k at the captured 55-box Bullet island's answer): a solve of that island is 2.7x faster
@@ -150,6 +158,10 @@ class NewtonSolver : public Solver {
   int factorizations() const { return factorizations_; }
   // Symbolic analyses this object has done (one per reduced pattern seen in a row).
   int analyses() const;
+  // Of the last solve: the factorizations done in body space (a problem with its rows).
+  int bodyFactorizations() const;
+
+  void useRows(const RowSystem* rows) override;
 
  protected:
   void run(const Problem& problem, Vector& x, Result& result) override;

@@ -1,4 +1,4 @@
-#include "dantzig_body.hpp"
+#include "body_space.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/OrderingMethods>

@@ -1,8 +1,9 @@
-// Block steps of DantzigSolver's block stage solved in body space (see "Body space" in
-// mlcp/dantzig.hpp). Internal to the library.
+// The reduced systems of an MLCP assembled from rows, solved in body space: the block steps of
+// DantzigSolver's block stage (see "Body space" in mlcp/dantzig.hpp) and NewtonSolver's steps
+// (newton.hpp, "Linear algebra"). Internal to the library.
 //
-// For a problem assembled from rows (rows.hpp: A = J W J^T + diag(cfm), W = M^-1), a block step's
-// matrix on its clamped set C, with sliding rows t (x_t = c_t x_n(t)) substituted, is
+// For a problem assembled from rows (rows.hpp: A = J W J^T + diag(cfm), W = M^-1), the matrix on
+// a set C of clamped (free) rows, with sliding rows t (x_t = c_t x_n(t)) substituted, is
 //
 //     K = D + J_C W G_C^T,   D = diag(cfm_c + rho),   G_c = J_c + sum_{t: n(t) = c} c_t J_t.
 //
@@ -14,6 +15,11 @@
 //
 // S of size 6 x (dynamic bodies), 6 x 6 blocks on the body graph (symmetric pattern; symmetric
 // positive definite, eigenvalues >= 1, without sliding rows). Valid when every d_c is not tiny.
+//
+// Cost. S's factor is a block LU on the body graph in an AMD order: O(bodies (fill blocks)^2 216)
+// per factorization, independent of how many rows each contact has; on a 210-box pyramid (4.7k
+// rows, 1260 body coordinates) that is about a tenth of a sparse LU of K on the rows. The block
+// table holds bodies^2 slots, hence kMaxBodies.
 #pragma once
 
 #include <Eigen/Dense>
