@@ -108,10 +108,16 @@ bool NewtonSolver::fallbackStep(const Problem& pb, bool sweeps) {
   return lineSearch(pb, -2 * gg * gg / jgjg) >= 0;
 }
 
-// The start: x as given (warm) or, from zero with sweeps applicable, coldSweeps sweeps.
+// The start (newton.hpp "Starts"), where sweeps apply: from zero coldSweeps sweeps; a warm start
+// whose scaled residual exceeds warmSweepsResidual warmSweeps sweeps; otherwise x as given.
 void NewtonSolver::start(const Problem& pb, Vector& x, bool sweeps) {
-  if (x.isZero(0.0) && sweeps)
-    for (int k = 0; k < params_.coldSweeps; ++k) detail::pgsSweep(pb, work_->invDiag, 1.0, x);
+  if (!sweeps) return;
+  const bool cold = x.isZero(0.0);
+  const double guess = work_->best.inf / (1.0 + pb.b.lpNorm<Eigen::Infinity>());
+  const int count = cold                                 ? params_.coldSweeps
+                    : guess > params_.warmSweepsResidual ? params_.warmSweeps
+                                                         : 0;
+  for (int k = 0; k < count; ++k) detail::pgsSweep(pb, work_->invDiag, 1.0, x);
 }
 
 void NewtonSolver::run(const Problem& pb, Vector& x, Result& result) {

@@ -105,6 +105,8 @@ int StepStats::maxIterations() const {
 
 std::string Stepper::knownSolvers() { return solverNames() + ", ode-step, ode-quickstep, ode-lcp"; }
 
+Stepper::Stepper(const std::string& solver) : Stepper(withSolver(Settings{}, solver)) {}
+
 Stepper::Stepper(const std::string& solver, Settings settings)
     : Stepper(withSolver(std::move(settings), solver)) {}
 

@@ -94,9 +94,13 @@
 // steps also take singular J (the circuit MLCPs' equality blocks, up to 61 rows in the Siconos
 // corpus), which the sparse LU refuses.
 //
-// Starts. A warm start (Options::warmStart, solveWithGuess) is used as given. A cold start (x =
-// 0), where sweeps apply, first takes NewtonParams::coldSweeps projected Gauss-Seidel sweeps;
-// pivoting from zero never runs here. Newton is fast from a start whose active pieces are
+// Starts. A warm start (Options::warmStart, solveWithGuess) within
+// NewtonParams::warmSweepsResidual of an answer is used as given; a farther one (ODE's impulses
+// of the last step on this step's contacts: scaled residuals 1-10 on the pyramids), where
+// sweeps apply, first takes NewtonParams::warmSweeps projected Gauss-Seidel sweeps, which place
+// most rows on their pieces (on ODE's 210-box pyramid 8-22 Newton steps a step instead of
+// 20-50). A cold start (x = 0), where sweeps apply, first takes NewtonParams::coldSweeps
+// sweeps; pivoting from zero never runs here. Newton is fast from a start whose active pieces are
 // nearly the answer's: warm-started from the previous step's exact answer, synthetic pyramids
 // of 192-768 rows converge in 1-9 steps (10 of 12 cases), small captured islands in 1-6 steps
 // even cold. On large islands from a cold or an engine's start the pieces of thousands of rows
@@ -121,6 +125,11 @@ namespace mlcp {
 struct NewtonParams {
   // Projected Gauss-Seidel sweeps over a cold start (x = 0) before the first step. Default 10.
   int coldSweeps = 10;
+  // Projected Gauss-Seidel sweeps over a warm start whose scaled residual exceeds
+  // warmSweepsResidual (an engine's start from the last step's impulses on new contacts, not a
+  // near answer). Defaults 20 and 0.2.
+  int warmSweeps = 20;
+  double warmSweepsResidual = 0.2;
   // Problems of at most this many rows take the dense path (Eigen's LU of J); larger ones the
   // sparse LU (KLU). Default 100.
   int denseMaxRows = 100;

@@ -21,14 +21,16 @@
 //   contacts, rows >  smallIslandRows:
 //     the step's time budget spent             -> "pgs"      (improves any start in any share)
 //     tolerance >= looseTolerance              -> "pgs"      (fallback "dantzig")
-//     otherwise                                -> largeIslandSolver ("dantzig" today; set
-//                                                 kLargeIslandSolver to "newton" once that
-//                                                 solver is registered)
+//     otherwise                                -> largeIslandSolver ("newton")
 // ("contacts": StandardLcp, Boxed and Findex islands.) Why: one LDL^T solve is exact and cheaper
 // than any iteration on joint chains; pivoting is exact and fastest on small contact islands,
-// but its pivot count grows with the rows, so above ~1000 rows an exact answer takes seconds a
+// but its pivot count grows with the rows, so above ~1000 rows a cold answer takes seconds a
 // step, where pgs reaches a loose tolerance in a bounded number of sweeps; a tight tolerance on
-// a large island still asks for an exact method, which the time budget bounds (row_solver.hpp).
+// a large island still asks for an exact method: newton, whose steps on engine rows cost a
+// body-space factorization (newton.hpp) and whose cold starts never pivot from zero (Bullet's
+// 55-box pyramid under the 0.05 s budget: 18 of 30 steps converged, against none for dantzig,
+// whose cut first step demotes the island to pgs), all bounded by the time budget
+// (row_solver.hpp).
 // The measurements: docs/benchmarks.md, "auto's choices and the time budget".
 //
 // The fallback rule (the same for a registry chain "a>b>c" and for RowSolver's primary and
@@ -57,9 +59,8 @@
 
 namespace mlcp {
 
-// The solver for contact islands above Policy::smallIslandRows rows at a tight tolerance: one
-// line to change when a better large-island method is registered ("newton").
-inline constexpr const char* kLargeIslandSolver = "dantzig";
+// The solver for contact islands above Policy::smallIslandRows rows at a tight tolerance.
+inline constexpr const char* kLargeIslandSolver = "newton";
 
 // What the policy picked, and why in words (for Result::message). Static strings, or (solver)
 // the Policy's largeIslandSolver: choosing allocates nothing (it runs for every island).
@@ -75,7 +76,7 @@ struct Policy {
   // Largest contact island handed to dantzig whatever the tolerance, in rows. Default 600.
   int smallIslandRows = 600;
   // Solver of larger contact islands at tolerances below looseTolerance. Default
-  // kLargeIslandSolver ("dantzig").
+  // kLargeIslandSolver ("newton").
   std::string largeIslandSolver = kLargeIslandSolver;
   // Requested tolerance (scaled residual) at or above which large contact islands go to pgs.
   // Default 1e-4.

@@ -160,8 +160,9 @@ class Stepper {
   // Throws std::invalid_argument naming the known solvers when settings.solver (or fallback,
   // reference) is not a name the stepper knows, or for a negative or NaN acceptResidual.
   explicit Stepper(const Settings& settings);
-  // The same with settings.solver replaced by `solver`.
-  explicit Stepper(const std::string& solver = "auto", Settings settings = {});
+  // The same with settings.solver replaced by `solver` (default settings without them).
+  explicit Stepper(const std::string& solver = "auto");
+  Stepper(const std::string& solver, Settings settings);
   ~Stepper();
   Stepper(const Stepper&) = delete;
   Stepper& operator=(const Stepper&) = delete;
