@@ -19,7 +19,7 @@ bool BodySpaceSystem::prepare(const RowSystem& rows, int n) {
     const BodyInverseMass& body = rows.bodies[k];
     linear[k] = std::sqrt(std::max(0.0, body.invMass));
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-    eig.computeDirect(body.invInertia);
+    eig.compute(body.invInertia);
     angular[k] = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
     if (linear[k] > 0 || !angular[k].isZero(0.0)) compact[k] = dynamic++;
   }
