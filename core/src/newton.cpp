@@ -22,8 +22,8 @@ struct NewtonSolver::Work {
   struct Point {
     Vector x, w, h;
     double theta = kInf, inf = kInf;  // ||h||_2^2 and ||h||_inf
-    void evaluate(const Problem& pb) {
-      w = pb.slack(x);
+    void evaluate(const Problem& pb, const detail::NewtonSystem& system) {
+      system.slack(x, w);
       theta = detail::naturalMap(pb, x, w, h, inf);
     }
   };
@@ -51,7 +51,7 @@ int NewtonSolver::lineSearch(const Problem& pb, double slope) {
   for (int k = 0; k <= halvings; ++k) {
     const double t = std::ldexp(1.0, -k);
     wk.trial.x = wk.at.x + t * wk.dx;
-    wk.trial.evaluate(pb);
+    wk.trial.evaluate(pb, wk.system);
     if (wk.trial.theta <= wk.at.theta + kArmijo * t * slope) return k;
   }
   return -1;
@@ -97,7 +97,7 @@ bool NewtonSolver::fallbackStep(const Problem& pb, bool sweeps) {
   if (sweeps) {
     wk.trial.x = wk.at.x;
     for (int k = 0; k < params_.stepSweeps; ++k) detail::pgsSweep(pb, wk.invDiag, 1.0, wk.trial.x);
-    wk.trial.evaluate(pb);
+    wk.trial.evaluate(pb, wk.system);
     return true;
   }
   wk.system.transposeTimes(wk.at.h, wk.g);
@@ -135,14 +135,14 @@ void NewtonSolver::run(const Problem& pb, Vector& x, Result& result) {
   // Sweeps (the cold start, the fallback) need A_ii > 0 and descend for symmetric A.
   const bool sweeps = detail::inverseDiagonal(pb, wk.invDiag) < 0 && detail::symmetricMatrix(pb);
   wk.best.x = x;  // the start as given counts as an iterate: never return worse
-  wk.best.evaluate(pb);
+  wk.best.evaluate(pb, wk.system);
   start(pb, x, sweeps);
   double dMax = 0;
   for (int i = 0; i < n; ++i) dMax = std::max(dMax, std::abs(pb.diagonal(i)));
   const double rhoScale = dMax > 0 ? dMax : 1.0;
   const double scale = 1.0 + pb.b.lpNorm<Eigen::Infinity>();
   wk.at.x.swap(x);
-  wk.at.evaluate(pb);
+  wk.at.evaluate(pb, wk.system);
   double mu = params_.proximal;
   int stalls = 0, sinceBest = 0;
   std::ostringstream os;

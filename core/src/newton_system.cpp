@@ -108,6 +108,18 @@ void NewtonSystem::prepareBody(const Problem& pb) {
   for (int i = 0; bodyReady_ && i < n; ++i)
     bodyReady_ = std::abs(body_->diagonal(i) - pb.diagonal(i)) <= 1e-10 * std::max(dMax, 1e-300);
   findex_ = pb.hasFindex() ? pb.findex : std::vector<int>(n, -1);
+  // Products in body space only with every cfm > 0 (as dantzig's block stage: on a singular A
+  // their round-off differences from A's rows are not damped).
+  bodyProducts_ = bodyReady_ && rows_->cfm.minCoeff() > 0;
+}
+
+void NewtonSystem::slack(const Vector& x, Vector& w) const {
+  if (!bodyProducts_) {
+    w = problem_->slack(x);
+    return;
+  }
+  body_->multiply(x, w);
+  w += problem_->b;
 }
 
 int NewtonSystem::linearize(const Vector& x, const Vector& w) {
@@ -273,8 +285,18 @@ bool NewtonSystem::solveFactored(Vector& y) {
 }
 
 // out = K y on the free rows: row i's A_ij at free j, A_it c_t at the free normal of a coupled t.
+// In body space: (A z)_C + rho y with z = y on the free rows, c_t y_n(t) on the coupled ones.
 void NewtonSystem::reducedTimes(const Vector& y, Vector& out) const {
   const int m = static_cast<int>(freeRows_.size());
+  if (bodyProducts_ && useBody_) {  // sliding_ and coeff_ are the last body factor's
+    spread_.setZero(problem_->size());
+    for (int c = 0; c < m; ++c) spread_[freeRows_[c]] = y[c];
+    for (size_t k = 0; k < sliding_.size(); ++k)
+      spread_[sliding_[k]] = coeff_[k] * y[position_[findex_[sliding_[k]]]];
+    body_->multiply(spread_, freeRows_, out);
+    out += rho_ * y;
+    return;
+  }
   out.resize(m);
   for (int c = 0; c < m; ++c) {
     double sum = rho_ * y[c];
@@ -319,16 +341,28 @@ bool NewtonSystem::solveRegularized(double lambda, Vector& rhs) {
 void NewtonSystem::times(const Vector& v, Vector& out) const {
   const Problem& pb = *problem_;
   const int n = pb.size();
+  if (bodyProducts_) body_->multiply(v, scratch_);
   out.resize(n);
   for (int i = 0; i < n; ++i) {
-    out[i] = da_[i] * v[i] + (db_[i] != 0 ? db_[i] * pb.rowDot(i, v) : 0.0);
+    const double av = db_[i] == 0 ? 0.0 : bodyProducts_ ? scratch_[i] : pb.rowDot(i, v);
+    out[i] = da_[i] * v[i] + db_[i] * av;
     if (cf_[i] != 0) out[i] += cf_[i] * v[pb.findex[i]];
   }
 }
 
+// out = J^T v. In body space A^T (db v) = A (db v): A from rows is symmetric.
 void NewtonSystem::transposeTimes(const Vector& v, Vector& out) const {
   const Problem& pb = *problem_;
   const int n = pb.size();
+  if (bodyProducts_) {
+    spread_ = db_.cwiseProduct(v);
+    body_->multiply(spread_, out);
+    for (int i = 0; i < n; ++i) {
+      out[i] += da_[i] * v[i];
+      if (cf_[i] != 0) out[pb.findex[i]] += cf_[i] * v[i];
+    }
+    return;
+  }
   out.setZero(n);
   for (int i = 0; i < n; ++i) {
     const double vi = db_[i] * v[i];

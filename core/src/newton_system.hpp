@@ -46,6 +46,9 @@ class NewtonSystem {
   // Dense path: rhs <- (J^T J + lambda I)^-1 J^T rhs (Levenberg-Marquardt; J of the last
   // factor, without rho). False on the sparse path or when the result is not finite.
   bool solveRegularized(double lambda, Vector& rhs);
+  // w = A x + b of the prepared problem: in body space when its products apply there (rows
+  // given, every cfm > 0: 12 multiply-adds a row instead of A's row), else from A.
+  void slack(const Vector& x, Vector& w) const;
   // out = J^T v (without rho).
   void transposeTimes(const Vector& v, Vector& out) const;
   // out = J v (without rho).
@@ -67,12 +70,13 @@ class NewtonSystem {
   // Body space (linalg/body_space.hpp): ready when the rows are A's; used for the last factor.
   const RowSystem* rows_ = nullptr;
   std::unique_ptr<BodySpaceSystem> body_;
-  bool bodyReady_ = false, useBody_ = false;
+  bool bodyReady_ = false, useBody_ = false, bodyProducts_ = false;
   int bodyFactorizations_ = 0;
   double rho_ = 0, minDiagonal_ = 0;
   std::vector<int> sliding_, findex_;
   std::vector<double> coeff_;
   Vector refine_, product_;
+  mutable Vector scratch_, spread_;  // products in body space
   const Problem* problem_ = nullptr;
   const SparseMatrix* a_ = nullptr;  // CSR A: the problem's, or own_ for dense or uncompressed
   SparseMatrix own_;
