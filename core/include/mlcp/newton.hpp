@@ -78,8 +78,10 @@
 // (linalg/body_space.hpp: Woodbury on the bodies, S = I + V^T D^-1 U with D = diag(cfm + rho)),
 // followed by two steps of iterative refinement on K's rows, as long as every cfm_c + rho is at
 // least 1e-11 max |A_ii| (else the sparse LU above). S has 6 rows per body whatever the number
-// of contact rows, so a step costs a fraction of KLU's: the same iterates, 8-20x less time per
-// step on 55- and 210-box pyramids (docs/benchmarks.md).
+// of contact rows, so a step costs a fraction of KLU's: the same iterates, 7-20x less time per
+// step on 55- and 210-box pyramids (docs/benchmarks.md). With every cfm > 0 the products with A
+// (the line search's slack, J and J^T, the refinement's K) also go through the rows: 12
+// multiply-adds a row instead of A's row (~80 entries on the pyramids).
 //
 // Why these choices. An LU of the nonsymmetric K keeps the coupling exact. The reduced K is
 // far sparser than the whole-pattern J (429 free rows with 11k entries against 1140 rows with
@@ -103,10 +105,12 @@
 // sweeps; pivoting from zero never runs here. Newton is fast from a start whose active pieces are
 // nearly the answer's: warm-started from the previous step's exact answer, synthetic pyramids
 // of 192-768 rows converge in 1-9 steps (10 of 12 cases), small captured islands in 1-6 steps
-// even cold. On large islands from a cold or an engine's start the pieces of thousands of rows
-// change a few per step along the ill-conditioned directions of redundant contacts, and the
-// step limit often ends a solve at residuals 1e-3..1e-5 (docs/benchmarks.md): large islands
-// stay dantzig's or pgs's in `auto` (policy.hpp).
+// even cold; on ODE's engine rows (pyramids of 1170 and 4740 rows, the 120-box wall) every step
+// converges within the scenes' 50 steps. Where many friction rows slide at the answer (Bullet's
+// resting pyramids: 272 of 740 on the 55 boxes) the pieces of hundreds of rows change a few per
+// step, the line search shortens the steps across their kinks, and 50 steps end at residuals
+// 1e-5..1e-3 (docs/benchmarks.md). `auto` runs newton on contact islands above
+// Policy::smallIslandRows (policy.hpp).
 //
 // Limits and invariants. Options::maxIterations bounds the Newton steps (MaxIterations),
 // Options::timeBudget the wall time (checked before each step; TimeLimit). Every non-converged
