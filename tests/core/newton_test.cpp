@@ -31,6 +31,17 @@ Problem pyramidProblem(int levels, double mu, double side) {
   return pyramid.rows().assemble(true);
 }
 
+// The friction pyramid's answer by dantzig (to 1e-10) in `answer`, then the next step's problem,
+// of which that answer is a near warm start.
+Problem nextStepAfterAnswer(Vector& answer) {
+  test::BoxPyramid pyramid(pyramidSpec(6, 0.6));
+  DantzigSolver dantzig;
+  dantzig.options().tolerance = 1e-10;
+  EXPECT_TRUE(dantzig.solve(pyramid.rows().assemble(true), answer).converged());
+  pyramid.nextStep(1e-3);
+  return pyramid.rows().assemble(true);
+}
+
 // Generated problems with known solutions: newton converges and agrees with dantzig where the
 // solution is unique.
 TEST(Newton, AgreesWithDantzigOnGeneratedProblems) {
@@ -138,6 +149,31 @@ TEST(Newton, RowsFactorInBodySpaceWithTheSparseLusIterates) {
   }
 }
 
+// A warm start far from an answer (scaled residual above warmSweepsResidual, as ODE's impulses
+// of the last step on new contacts are) is swept before the first Newton step; a near one is
+// used as given. With no Newton step allowed the answer is the better of the start and the
+// swept point.
+TEST(Newton, FarWarmStartIsSweptNearOneIsKept) {
+  Vector answer;
+  const Problem p = nextStepAfterAnswer(answer);
+  const Vector far = 4.0 * answer;
+  const double farResidual = accuracy(p, far).residual;
+  ASSERT_GT(farResidual, NewtonParams().warmSweepsResidual);
+  ASSERT_LT(accuracy(p, answer).residual, NewtonParams().warmSweepsResidual);
+  auto startOf = [&](const Vector& guess, int sweeps) {
+    NewtonSolver newton;
+    newton.options().maxIterations = 0;
+    newton.params().warmSweeps = sweeps;
+    Vector x;
+    newton.solveWithGuess(p, guess, x);
+    return x;
+  };
+  const Vector swept = startOf(far, NewtonParams().warmSweeps);
+  EXPECT_LT(accuracy(p, swept).residual, 0.5 * farResidual);
+  EXPECT_TRUE((startOf(far, 0).array() == far.array()).all());
+  EXPECT_TRUE((startOf(answer, NewtonParams().warmSweeps).array() == answer.array()).all());
+}
+
 // A step limit and a time budget return the best iterate (never worse than the start) with an
 // honest status.
 TEST(Newton, LimitsReturnTheBestIterate) {
@@ -192,13 +228,8 @@ TEST(Newton, FrictionPyramidStepLimitIsHonest) {
 // (one refresh per step, each step symmetric) ended at 2e-6 after 100 steps: with the friction
 // rows' exact Jacobian it converges to 1e-6 in a few steps, to dantzig's answer.
 TEST(Newton, WarmFrictionPyramidConvergesWhereLaggedBoundsStalled) {
-  test::BoxPyramid pyramid(pyramidSpec(6, 0.6));
-  DantzigSolver dantzig;
-  dantzig.options().tolerance = 1e-10;
   Vector last;
-  ASSERT_TRUE(dantzig.solve(pyramid.rows().assemble(true), last).converged());
-  pyramid.nextStep(1e-3);
-  const Problem p = pyramid.rows().assemble(true);
+  const Problem p = nextStepAfterAnswer(last);
   ASSERT_GT(p.size(), NewtonParams().denseMaxRows);  // the sparse path
   NewtonSolver newton;
   newton.options().tolerance = 1e-6;
@@ -207,6 +238,8 @@ TEST(Newton, WarmFrictionPyramidConvergesWhereLaggedBoundsStalled) {
   const Result r = newton.solveWithGuess(p, last, x);
   ASSERT_TRUE(r.converged()) << r.message;
   EXPECT_LE(accuracy(p, x).residual, 1e-6);
+  DantzigSolver dantzig;
+  dantzig.options().tolerance = 1e-10;
   Vector xd;
   ASSERT_TRUE(dantzig.solve(p, xd).converged());
   EXPECT_LE((x - xd).lpNorm<Eigen::Infinity>(), 1e-3 * (1 + xd.lpNorm<Eigen::Infinity>()));
