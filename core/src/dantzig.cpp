@@ -598,8 +598,9 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
   // none: synthetic pyramids from cold), so it costs at most autoColdSteps factorizations.
   // A guess within kTrustedGuess (an engine's own last answers at rest) skips it: its sets are
   // right up to a few rows, where the cold sets are not (Bullet's resting pyramid).
-  // A warm solve also skips it while the last trial of this solver missed (an engine whose
-  // cold sets are never right: Bullet's moving pyramid), re-trying every autoColdRetry solves.
+  // A warm solve with a ColdTrialMemory also skips it while the last trial it records missed (an
+  // engine whose cold sets are never right: Bullet's moving pyramid), re-trying every
+  // autoColdRetry solves.
   const bool autoStage = params_.blockStage == DantzigParams::BlockStage::Auto;
   const double guessResidual = warm ? residual(problem, x) : kInf;
   const bool trusted = autoStage && guessResidual <= kTrustedGuess;
@@ -607,9 +608,10 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
       params_.blockTrustedSets && warm && guessResidual <= params_.blockSetsAtGuessResidual;
   bool coldTrial = autoStage && !trusted;
   bool continued = false;  // the cold trial's iterate is the block stage's start
-  if (coldTrial && warm && coldMissed_ > 0 && coldMissedRows_ == problem.size()) {
-    coldTrial = coldMissed_ % std::max(1, params_.autoColdRetry) == 0;
-    ++coldMissed_;
+  ColdTrialMemory* memory = coldMemory_;
+  if (coldTrial && warm && memory && memory->missed > 0 && memory->rows == problem.size()) {
+    coldTrial = memory->missed % std::max(1, params_.autoColdRetry) == 0;
+    ++memory->missed;
   }
   if (coldTrial) {
     Vector trial = Vector::Zero(problem.size());
@@ -619,8 +621,7 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
     blockSteps_ += rep.steps;
     blockFactorizations_ += rep.factorizations;
     blockBodyFactorizations_ += rep.bodyFactorizations;
-    coldMissed_ = rep.settled ? 0 : 1;
-    coldMissedRows_ = problem.size();
+    if (memory) *memory = {rep.settled ? 0 : 1, problem.size()};
     if (rep.settled) {
       x = trial;
       settle(rep);

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "mlcp/dantzig.hpp"
 #include "mlcp/io.hpp"
 #include "mlcp/registry.hpp"
 #include "mlcp/residual.hpp"
@@ -60,6 +61,8 @@ struct RowSolver::Slot {
   std::vector<std::pair<std::string, std::unique_ptr<Solver>>> solvers;
   std::uint64_t lastUse = 0;
   int pgsFirst = 0;
+  // dantzig's cold-trial memory over this island's solves (DantzigSolver::useColdTrialMemory).
+  DantzigSolver::ColdTrialMemory coldTrial;
 };
 
 namespace {
@@ -220,13 +223,20 @@ Result RowSolver::run(const RowSystem& rows, const std::string& name, const Opti
   }
   Solver* solver = assembledSolver(island, name);
   solver->setOptions(o);
-  // The rows for this solve only, cleared on every way out (a throw included): the solver is
-  // kept per island and must not hold them past this call.
+  // The rows (and dantzig's cold-trial memory, the island slot's) for this solve only, cleared
+  // on every way out (a throw included): the solver is kept per island and must not hold them
+  // past this call.
+  auto* dantzig = dynamic_cast<DantzigSolver*>(solver);
   struct Rows {
     Solver* solver;
-    ~Rows() { solver->useRows(nullptr); }
-  } scope{solver};
+    DantzigSolver* dantzig;
+    ~Rows() {
+      solver->useRows(nullptr);
+      if (dantzig) dantzig->useColdTrialMemory(nullptr);
+    }
+  } scope{solver, dantzig};
   solver->useRows(&rows);
+  if (dantzig) dantzig->useColdTrialMemory(&island.coldTrial);
   return solver->solveWithGuess(assembled_, start, x);
 }
 

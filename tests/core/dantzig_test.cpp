@@ -635,27 +635,36 @@ TEST(DantzigBlock, AutoTrustedGuessSkipsTheColdTrial) {
   EXPECT_EQ(r.message.find("cold trial"), std::string::npos) << r.message;
 }
 
-// Auto's cold trial after a miss: warm solves of the same solver skip it until autoColdRetry
-// solves have passed (Bullet's moving pyramid never settles from the cold sets), then try again.
+// Auto's cold trial after a miss: warm solves lent the same ColdTrialMemory skip it until
+// autoColdRetry solves have passed (Bullet's moving pyramid never settles from the cold sets),
+// then try again. Without a memory every solve tries it and answers alike: no state carries.
 TEST(DantzigBlock, AutoColdTrialAfterAMissIsRetriedEveryAutoColdRetrySolves) {
   test::BoxPyramid pyramid(slidingPyramid(4));
   pyramid.nextStep(1e-4);
   const Problem p = pyramid.rows().assemble(true);
   DantzigSolver autoStage = withStage(DantzigParams::BlockStage::Auto);
   autoStage.params().autoColdRetry = 3;
-  Vector exact, x;
+  Vector exact, x, first;
   ASSERT_TRUE(withStage(DantzigParams::BlockStage::Never).solve(p, exact).converged());
   const Vector guess = 0.5 * exact;  // a poor guess (residual above 1e-2)
   ASSERT_GT(residual(p, guess), 1e-2);
-  for (int solve = 0; solve < 7; ++solve) {
-    const Result r = autoStage.solveWithGuess(p, guess, x);
-    ASSERT_TRUE(r.converged()) << r.message;
-    EXPECT_LE(accuracy(p, x).residual, autoStage.options().tolerance);
-    const bool tried = r.message.find("cold trial") != std::string::npos;
-    if (solve == 0) {
-      ASSERT_TRUE(tried) << "the cold trial settled: pick a scene where it misses";
+  DantzigSolver::ColdTrialMemory memory;
+  for (const bool lent : {true, false}) {
+    autoStage.useColdTrialMemory(lent ? &memory : nullptr);
+    for (int solve = 0; solve < 7; ++solve) {
+      const Result r = autoStage.solveWithGuess(p, guess, x);
+      ASSERT_TRUE(r.converged()) << r.message;
+      EXPECT_LE(accuracy(p, x).residual, autoStage.options().tolerance);
+      const bool tried = r.message.find("cold trial") != std::string::npos;
+      if (solve == 0) {
+        ASSERT_TRUE(tried) << "the cold trial settled: pick a scene where it misses";
+        first = x;
+      }
+      EXPECT_EQ(tried, !lent || solve % 3 == 0) << lent << " solve " << solve << ": " << r.message;
+      if (!lent) {
+        EXPECT_TRUE((x.array() == first.array()).all()) << "solve " << solve;
+      }
     }
-    EXPECT_EQ(tried, solve % 3 == 0) << "solve " << solve << ": " << r.message;
   }
 }
 

@@ -44,7 +44,9 @@
 // (O(nnz) of those rows when A is sparse); O(n^3) overall in the worst case, like a dense
 // factorization. Memory: A permuted into processing order (dense n^2, or CSR/CSC when
 // Problem::isSparse()), L (and U when A is not symmetric) at n^2 each. The workspace lives in
-// the solver object and is reused: no reallocation when n does not grow. No global state.
+// the solver object and is reused: no reallocation when n does not grow. No global state; the
+// block stage's cold-trial memory is the caller's (useColdTrialMemory; RowSolver keeps one per
+// island slot): without it the same problem and start give the same answer.
 //
 // Order of rows. Equality rows (-inf, inf) first, then the rows the start point guesses as
 // clamped, then the other rows, friction rows last (so that normals are settled first).
@@ -197,9 +199,10 @@ struct DantzigParams {
   // Auto: most block steps of the trial from the cold guess (it ends at its first full step
   // that brings no new lowest merit). Default 3.
   int autoColdSteps = 3;
-  // Auto: after a cold trial that did not settle, warm solves of this solver on problems of the
-  // same size skip the trial except every autoColdRetry-th one (a trial that settles, or a
-  // problem of another size, resets this). Default 8.
+  // Auto: after a cold trial that did not settle, warm solves that share its ColdTrialMemory
+  // (DantzigSolver::useColdTrialMemory) on problems of the same size skip the trial except every
+  // autoColdRetry-th one (a trial that settles, or a problem of another size, resets this).
+  // Default 8.
   int autoColdRetry = 8;
   // Auto: a cold solve of at least autoWarmMinRows rows whose cold trial did not settle but came
   // within 1e-2 (residual) continues the block stage from the trial's best iterate (else the
@@ -281,6 +284,16 @@ class DantzigSolver : public Solver {
  public:
   void useRows(const RowSystem* rows) override { rows_ = rows; }
 
+  // Auto's cold-trial memory over the solves of one island (DantzigParams::autoColdRetry). The
+  // caller holds it (RowSolver keeps one in each island's slot) and lends it for a solve; without
+  // one (the default, nullptr) every warm solve tries the cold sets, and the same problem and
+  // start give the same answer.
+  struct ColdTrialMemory {
+    int missed = 0;  // solves since the last cold trial, which did not settle (0: it settled)
+    int rows = 0;    // that trial's problem size: another size tries again
+  };
+  void useColdTrialMemory(ColdTrialMemory* memory) { coldMemory_ = memory; }
+
  protected:
  private:
   struct Workspace;
@@ -295,8 +308,7 @@ class DantzigSolver : public Solver {
   int blockBodyFactorizations_ = 0;
   const RowSystem* rows_ = nullptr;
   bool blockSettled_ = false;
-  int coldMissed_ = 0;      // solves since the last cold trial, which did not settle (0: it did)
-  int coldMissedRows_ = 0;  // that trial's problem size: another size tries again
+  ColdTrialMemory* coldMemory_ = nullptr;  // lent per solve (useColdTrialMemory)
 };
 
 }  // namespace mlcp
