@@ -86,6 +86,9 @@ void NewtonSystem::prepare(const Problem& pb, int denseMaxRows) {
   cf_.setZero(n);
   sparse_ = n > denseMaxRows;
   a_ = nullptr;
+  // Nothing of the last problem's body space carries over (the dense path has none).
+  bodyReady_ = bodyProducts_ = useBody_ = false;
+  bodyFactorizations_ = 0;
   if (!sparse_) return;
   if (pb.isSparse() && pb.sparseA().isCompressed()) {
     a_ = &pb.sparseA();
@@ -100,7 +103,6 @@ void NewtonSystem::prepare(const Problem& pb, int denseMaxRows) {
 // Body space applies when the rows handed over are A's: checked on the diagonal.
 void NewtonSystem::prepareBody(const Problem& pb) {
   const int n = pb.size();
-  bodyFactorizations_ = 0;
   double dMax = 0;
   for (int i = 0; i < n; ++i) dMax = std::max(dMax, std::abs(pb.diagonal(i)));
   minDiagonal_ = kBodyMinDiagonal * dMax;

@@ -149,6 +149,29 @@ TEST(Newton, RowsFactorInBodySpaceWithTheSparseLusIterates) {
   }
 }
 
+// A solver that took a problem with its rows (body space) and then one without them, or a small
+// one on the dense path, uses A's own products there: the body-space state of the last problem
+// was left set for the dense path, whose slack then came from the old rows (read past x's end).
+TEST(Newton, BodySpaceStateDoesNotOutliveItsProblem) {
+  test::BoxPyramid large(pyramidSpec(6, 0));
+  NewtonSolver newton;
+  Vector last, x;
+  const Problem p = nextStepAfterAnswer(last);
+  newton.useRows(&large.rows());
+  newton.solve(large.rows().assemble(true), x);
+  newton.useRows(nullptr);
+  EXPECT_GT(newton.bodyFactorizations(), 0);
+  test::BoxPyramid small(pyramidSpec(2, 0.6));
+  const Problem q = small.rows().assemble(true);
+  ASSERT_LE(q.size(), newton.params().denseMaxRows);
+  const Result r = newton.solve(q, x);
+  ASSERT_TRUE(r.converged()) << r.message;
+  EXPECT_LE(accuracy(q, x).residual, newton.options().tolerance);
+  const Result again = newton.solveWithGuess(p, last, x);  // sparse, without rows
+  ASSERT_TRUE(again.converged()) << again.message;
+  EXPECT_EQ(newton.bodyFactorizations(), 0);
+}
+
 // A warm start far from an answer (scaled residual above warmSweepsResidual, as ODE's impulses
 // of the last step on new contacts are) is swept before the first Newton step; a near one is
 // used as given. With no Newton step allowed the answer is the better of the start and the
