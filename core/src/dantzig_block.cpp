@@ -701,14 +701,8 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
   dMax_ = dMax;
   if (!rowsPrepared_) {
     rowsPrepared_ = true;
-    bodyReady_ = rows_ != nullptr && body_->prepare(*rows_, n);
-    // The rows must be A's (A = J W J^T + diag(cfm)): checked on the diagonal.
-    for (int i = 0; bodyReady_ && i < n; ++i)
-      bodyReady_ = std::abs(body_->diagonal(i) - pb.diagonal(i)) <= 1e-10 * std::max(dMax, 1e-300);
-    // Factored products only with every cfm > 0: on a singular A (cfm = 0, coplanar contacts)
-    // their round-off differences sent a test's sliding pyramid from settling to 120 unsettled
-    // steps.
-    factoredProducts_ = bodyReady_ && rows_->cfm.size() > 0 && rows_->cfm.minCoeff() > 0;
+    bodyReady_ = rows_ != nullptr && body_->prepareFor(*rows_, pb, dMax);
+    factoredProducts_ = bodyReady_ && body_->productsStandForA();
   }
   bodyFactorizations_ = 0;
   pivTolRelative_ = opt.pivotTolerance;

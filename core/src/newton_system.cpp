@@ -106,13 +106,9 @@ void NewtonSystem::prepareBody(const Problem& pb) {
   double dMax = 0;
   for (int i = 0; i < n; ++i) dMax = std::max(dMax, std::abs(pb.diagonal(i)));
   minDiagonal_ = kBodyMinDiagonal * dMax;
-  bodyReady_ = rows_ != nullptr && body_->prepare(*rows_, n);
-  for (int i = 0; bodyReady_ && i < n; ++i)
-    bodyReady_ = std::abs(body_->diagonal(i) - pb.diagonal(i)) <= 1e-10 * std::max(dMax, 1e-300);
+  bodyReady_ = rows_ != nullptr && body_->prepareFor(*rows_, pb, dMax);
   findex_ = pb.hasFindex() ? pb.findex : std::vector<int>(n, -1);
-  // Products in body space only with every cfm > 0 (as dantzig's block stage: on a singular A
-  // their round-off differences from A's rows are not damped).
-  bodyProducts_ = bodyReady_ && rows_->cfm.minCoeff() > 0;
+  bodyProducts_ = bodyReady_ && body_->productsStandForA();
 }
 
 void NewtonSystem::slack(const Vector& x, Vector& w) const {

@@ -7,6 +7,15 @@
 
 namespace mlcp::detail {
 
+bool BodySpaceSystem::prepareFor(const RowSystem& rows, const Problem& problem, double dMax) {
+  const int n = problem.size();
+  if (!prepare(rows, n)) return false;
+  for (int i = 0; i < n; ++i)
+    if (!(std::abs(diagonal(i) - problem.diagonal(i)) <= 1e-10 * std::max(dMax, 1e-300)))
+      return false;
+  return true;
+}
+
 bool BodySpaceSystem::prepare(const RowSystem& rows, int n) {
   if (rows.size() != n || rows.cfm.size() != n) return false;
   const int nb = static_cast<int>(rows.bodies.size());
