@@ -1,9 +1,11 @@
 #include "body_space.hpp"
 
 #include <Eigen/Eigenvalues>
-#include <Eigen/OrderingMethods>
+#include <Eigen/SparseCore>
 #include <algorithm>
 #include <cmath>
+
+#include "linalg/ordering.hpp"
 
 namespace mlcp::detail {
 
@@ -45,11 +47,9 @@ bool BodySpaceSystem::prepare(const RowSystem& rows, int n) {
   if (dynamic > kMaxBodies) return false;
   Eigen::SparseMatrix<double, Eigen::ColMajor, int> graph(dynamic, dynamic);
   graph.setFromTriplets(pairs.begin(), pairs.end());
-  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> perm;
-  Eigen::AMDOrdering<int>()(graph, perm);
-  // perm.indices()[k]: the body at rank k (as BlockPivoting's byRank_).
+  const std::vector<int>& byRank = orderOf(graph);
   std::vector<int> rank(dynamic);
-  for (int k = 0; k < dynamic; ++k) rank[perm.indices()[k]] = k;
+  for (int k = 0; k < dynamic; ++k) rank[byRank[k]] = k;
   for (int k = 0; k < nb; ++k)
     if (compact[k] >= 0) compact[k] = rank[compact[k]];
   bodies_ = dynamic;
@@ -97,6 +97,25 @@ bool BodySpaceSystem::prepare(const RowSystem& rows, int n) {
   }
   cfm_.assign(rows.cfm.data(), rows.cfm.data() + n);
   return true;
+}
+
+const std::vector<int>& BodySpaceSystem::orderOf(
+    const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& graph) {
+  const int n = static_cast<int>(graph.rows());
+  const int* start = graph.outerIndexPtr();
+  const int* index = graph.innerIndexPtr();
+  const bool same = static_cast<int>(graphStart_.size()) == n + 1 &&
+                    std::equal(graphStart_.begin(), graphStart_.end(), start) &&
+                    std::equal(graphIndex_.begin(), graphIndex_.end(), index);
+  if (same) return byRank_;
+  graphStart_.assign(start, start + n + 1);
+  graphIndex_.assign(index, index + graph.nonZeros());
+  byRank_ = linalg::fillReducingOrder(n, graphStart_, graphIndex_);
+  if (static_cast<int>(byRank_.size()) != n) {  // refused: the bodies' own order
+    byRank_.resize(n);
+    for (int k = 0; k < n; ++k) byRank_[k] = k;
+  }
+  return byRank_;
 }
 
 bool BodySpaceSystem::factor(const std::vector<int>& order, const std::vector<int>& pos,

@@ -18,13 +18,19 @@
 // S of size 6 x (dynamic bodies), 6 x 6 blocks on the body graph (symmetric pattern; symmetric
 // positive definite, eigenvalues >= 1, without sliding rows). Valid when every d_c is not tiny.
 //
-// Cost. S's factor is a block LU on the body graph in an AMD order: O(bodies (fill blocks)^2 216)
-// per factorization, independent of how many rows each contact has; on a 210-box pyramid (4.7k
-// rows, 1260 body coordinates) that is about a tenth of a sparse LU of K on the rows. The block
-// table holds bodies^2 slots, hence kMaxBodies.
+// Cost. S's factor is a block LU on the body graph in CHOLMOD's fill-reducing order (the lower
+// fill of AMD and nested dissection, linalg/ordering.hpp; kept while the graph is the last
+// problem's): O(sum over bodies of (fill blocks below it)^2 216) per factorization, independent
+// of how many rows each contact has; on a 210-box pyramid (4.7k rows, 1260 body coordinates) that
+// is about a tenth of a sparse LU of K on the rows. Why a block LU of our own and not a library's
+// factorization of S: on the pyramids' S (330 to 6090 coordinates) it is faster than CHOLMOD's
+// supernodal Cholesky (which would serve only S without sliding rows), KLU and UMFPACK, with
+// reference BLAS or OpenBLAS (docs/benchmarks.md, "Body space: the factorization of S"). The
+// block table holds bodies^2 slots, hence kMaxBodies.
 #pragma once
 
 #include <Eigen/Dense>
+#include <Eigen/SparseCore>
 #include <algorithm>
 #include <vector>
 
@@ -98,6 +104,10 @@ class BodySpaceSystem {
   std::vector<double> d_, gr_, cfm_;
   Vector z_, v_;
   std::vector<int> rowOf_;  // per clamped index c: its row
+  // The body graph's elimination order (byRank_[r]: the body at rank r), kept with the graph it
+  // was computed for, so that next steps of an unchanged island skip the ordering.
+  const std::vector<int>& orderOf(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& graph);
+  std::vector<int> graphStart_, graphIndex_, byRank_;
 };
 
 }  // namespace mlcp::detail
