@@ -121,6 +121,31 @@ const std::vector<int>& BodySpaceSystem::orderOf(
 bool BodySpaceSystem::factor(const std::vector<int>& order, const std::vector<int>& pos,
                              const std::vector<int>& sliding, const std::vector<double>& coeff,
                              const std::vector<int>& findex, double rho, double minDiagonal) {
+  return assemble(order, pos, sliding, coeff, findex, rho, minDiagonal) && eliminate();
+}
+
+void BodySpaceSystem::assembled(std::vector<int>& start, std::vector<int>& index,
+                                std::vector<double>& values) const {
+  start.assign(1, 0);
+  index.clear();
+  values.clear();
+  for (int q = 0; q < bodies_; ++q)
+    for (int j = 0; j < 6; ++j) {
+      for (int p = 0; p < bodies_; ++p) {
+        const int slot = slot_[static_cast<size_t>(p) * bodies_ + q];
+        if (slot < 0 || (p != q && blocks_[slot].isZero(0.0))) continue;
+        for (int i = 0; i < 6; ++i) {
+          index.push_back(6 * p + i);
+          values.push_back(blocks_[slot](i, j));
+        }
+      }
+      start.push_back(static_cast<int>(index.size()));
+    }
+}
+
+bool BodySpaceSystem::assemble(const std::vector<int>& order, const std::vector<int>& pos,
+                               const std::vector<int>& sliding, const std::vector<double>& coeff,
+                               const std::vector<int>& findex, double rho, double minDiagonal) {
   const int m = static_cast<int>(order.size());
   d_.resize(m);
   gr_.resize(12 * static_cast<size_t>(m));
@@ -154,6 +179,10 @@ bool BodySpaceSystem::factor(const std::vector<int>& order, const std::vector<in
     }
   }
   rowOf_.assign(order.begin(), order.end());
+  return true;
+}
+
+bool BodySpaceSystem::eliminate() {
   // Right-looking block LU in the elimination order (no pivoting between blocks: S = I + V^T D^-1
   // U is symmetric positive definite without sliding rows, near it with them).
   constexpr double kPivot = 1e-12;

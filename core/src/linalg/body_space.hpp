@@ -59,6 +59,16 @@ class BodySpaceSystem {
   bool factor(const std::vector<int>& order, const std::vector<int>& pos,
               const std::vector<int>& sliding, const std::vector<double>& coeff,
               const std::vector<int>& findex, double rho, double minDiagonal);
+  // factor()'s two stages: S assembled (false where factor() does not apply), then its block LU
+  // (false when S is singular).
+  bool assemble(const std::vector<int>& order, const std::vector<int>& pos,
+                const std::vector<int>& sliding, const std::vector<double>& coeff,
+                const std::vector<int>& findex, double rho, double minDiagonal);
+  bool eliminate();
+  // S as assemble() left it, by compressed columns (6 p + i: coordinate i of the body at rank
+  // p), its blocks that are not zero: for comparisons with library factorizations.
+  void assembled(std::vector<int>& start, std::vector<int>& index,
+                 std::vector<double>& values) const;
   // y <- K^-1 y (y indexed as order).
   void solve(Vector& y);
   // Products with A = (J R)(J R)^T + diag(cfm) in factored form: 12 multiply-adds a row into the

@@ -1,0 +1,260 @@
+// body_space_bench: the factorization of body-space S (linalg/body_space.hpp) on friction
+// pyramids, the library's 6x6-block LU against SuiteSparse's CHOLMOD, KLU and UMFPACK on the same
+// matrices in one run.
+//
+//   build/bench/body_space_bench [levels...]      (default 10 20 44: 55, 210 and 990 boxes)
+//
+// Per pyramid (tests/common/contact_scenes.hpp BoxPyramid, sliding bodies, cfm 1e-5/dt) the
+// clamped and sliding rows are those of newton's answer (tolerance 1e-6, at most 60 steps), S is
+// assembled as newton's steps assemble it (rho = 0), and each method factors it: the block LU
+// (assembly and elimination, in the library's CHOLMOD order) and, on the S it exports, CHOLMOD
+// (analysis once, then supernodal or simplicial as CHOLMOD decides), KLU and UMFPACK (analysis
+// once). S with its sliding rows is not symmetric, so CHOLMOD is timed on the S of the same
+// clamped rows without them (what a Cholesky step plus a correction for the sliding rows would
+// factor); the block LU is timed on both. Each time is the median of repeats (at least 5, until
+// 0.5 s); each factor is checked by a solve (relative residual of S z = r). The BLAS is whichever
+// libblas.so.3 the process loaded (printed).
+#include <suitesparse/cholmod.h>
+#include <suitesparse/klu.h>
+#include <suitesparse/umfpack.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "../core/src/linalg/body_space.hpp"  // BodySpaceSystem (internal)
+#include "common/contact_scenes.hpp"
+#include "mlcp/newton.hpp"
+
+namespace {
+
+using mlcp::Vector;
+
+struct Csc {
+  int n = 0;
+  std::vector<int> start, index;
+  std::vector<double> values;
+  Vector times(const Vector& z) const {
+    Vector out = Vector::Zero(n);
+    for (int j = 0; j < n; ++j)
+      for (int e = start[j]; e < start[j + 1]; ++e) out[index[e]] += values[e] * z[j];
+    return out;
+  }
+};
+
+double medianMs(const std::function<void()>& run) {
+  std::vector<double> t;
+  double total = 0;
+  while (t.size() < 5 || (total < 500 && t.size() < 200)) {
+    const auto t0 = std::chrono::steady_clock::now();
+    run();
+    t.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                    .count());
+    total += t.back();
+  }
+  std::nth_element(t.begin(), t.begin() + t.size() / 2, t.end());
+  return t[t.size() / 2];
+}
+
+double relResidual(const Csc& s, const Vector& r, const Vector& z) {
+  return (s.times(z) - r).norm() / r.norm();
+}
+
+std::string loadedBlas() {
+  std::ifstream maps("/proc/self/maps");
+  std::string line;
+  while (std::getline(maps, line))
+    if (line.find("libblas") != std::string::npos || line.find("libopenblas") != std::string::npos)
+      return line.substr(line.find('/'));
+  return "none";
+}
+
+// The library factorizations of one S: median ms of a numeric factorization and the solve check.
+struct Timing {
+  double ms = -1, residual = -1;
+};
+
+Timing cholmod(const Csc& s, const Vector& r) {
+  cholmod_common c;
+  cholmod_start(&c);
+  c.print = 0;
+  cholmod_sparse a{};
+  a.nrow = a.ncol = s.n;
+  a.nzmax = s.index.size();
+  a.p = const_cast<int*>(s.start.data());
+  a.i = const_cast<int*>(s.index.data());
+  a.x = const_cast<double*>(s.values.data());
+  a.stype = 1;
+  a.itype = CHOLMOD_INT;
+  a.xtype = CHOLMOD_REAL;
+  a.dtype = CHOLMOD_DOUBLE;
+  a.sorted = a.packed = 1;
+  cholmod_factor* l = cholmod_analyze(&a, &c);
+  Timing t;
+  bool ok = true;
+  t.ms = medianMs([&] { ok = cholmod_factorize(&a, l, &c) && c.status == CHOLMOD_OK && ok; });
+  cholmod_dense b{};
+  b.nrow = b.nzmax = b.d = s.n;
+  b.ncol = 1;
+  Vector rhs = r;
+  b.x = rhs.data();
+  b.xtype = CHOLMOD_REAL;
+  b.dtype = CHOLMOD_DOUBLE;
+  cholmod_dense* x = ok ? cholmod_solve(CHOLMOD_A, l, &b, &c) : nullptr;
+  if (x) {
+    t.residual = relResidual(s, r, Eigen::Map<Vector>(static_cast<double*>(x->x), s.n));
+    cholmod_free_dense(&x, &c);
+  }
+  cholmod_free_factor(&l, &c);
+  cholmod_finish(&c);
+  return t;
+}
+
+Timing klu(const Csc& s, const Vector& r) {
+  klu_common c;
+  klu_defaults(&c);
+  std::vector<int> start = s.start, index = s.index;
+  std::vector<double> values = s.values;
+  klu_symbolic* sym = klu_analyze(s.n, start.data(), index.data(), &c);
+  klu_numeric* num = nullptr;
+  Timing t;
+  t.ms = medianMs([&] {
+    if (num) klu_free_numeric(&num, &c);
+    num = klu_factor(start.data(), index.data(), values.data(), sym, &c);
+  });
+  Vector z = r;
+  if (num && klu_solve(sym, num, s.n, 1, z.data(), &c)) t.residual = relResidual(s, r, z);
+  if (num) klu_free_numeric(&num, &c);
+  klu_free_symbolic(&sym, &c);
+  return t;
+}
+
+Timing umfpack(const Csc& s, const Vector& r) {
+  void* sym = nullptr;
+  void* num = nullptr;
+  umfpack_di_symbolic(s.n, s.n, s.start.data(), s.index.data(), s.values.data(), &sym, nullptr,
+                      nullptr);
+  Timing t;
+  t.ms = medianMs([&] {
+    if (num) umfpack_di_free_numeric(&num);
+    umfpack_di_numeric(s.start.data(), s.index.data(), s.values.data(), sym, &num, nullptr,
+                       nullptr);
+  });
+  Vector z(s.n);
+  if (num && umfpack_di_solve(UMFPACK_A, s.start.data(), s.index.data(), s.values.data(),
+                              z.data(), r.data(), num, nullptr, nullptr) == UMFPACK_OK)
+    t.residual = relResidual(s, r, z);
+  if (num) umfpack_di_free_numeric(&num);
+  umfpack_di_free_symbolic(&sym);
+  return t;
+}
+
+// The clamped rows of x (strictly inside their effective bounds) and the sliding friction rows
+// (at a bound, their normal clamped) with x_t = c_t x_n.
+struct Sets {
+  std::vector<int> order, pos, sliding;
+  std::vector<double> coeff;
+};
+
+Sets setsOf(const mlcp::Problem& p, const Vector& x) {
+  Sets s;
+  const int n = p.size();
+  s.pos.assign(n, -1);
+  for (int i = 0; i < n; ++i) {
+    const double lo = p.effectiveLo(i, x), hi = p.effectiveHi(i, x);
+    if (x[i] > lo && x[i] < hi) {
+      s.pos[i] = static_cast<int>(s.order.size());
+      s.order.push_back(i);
+    }
+  }
+  for (int t = 0; t < n; ++t) {
+    const int f = p.findex.empty() ? -1 : p.findex[t];
+    if (f < 0 || s.pos[t] >= 0 || s.pos[f] < 0 || x[f] <= 0) continue;
+    s.sliding.push_back(t);
+    s.coeff.push_back(x[t] / x[f]);
+  }
+  return s;
+}
+
+void row(int boxes, int coords, const Sets& sets, bool withSliding, const Csc& s, double blockMs,
+         double blockResidual, const Vector& r) {
+  const Timing ch = withSliding ? Timing{} : cholmod(s, r);
+  const Timing k = klu(s, r), u = umfpack(s, r);
+  auto cell = [](const Timing& t) {
+    char buf[64];
+    if (t.ms < 0) return std::string("-");
+    std::snprintf(buf, sizeof buf, "%.3g ms (%.0e)", t.ms, t.residual);
+    return std::string(buf);
+  };
+  std::printf("| %d | %d | %zu | %zu | %s | %zu | %.3g ms (%.0e) | %s | %s | %s |\n", boxes, coords,
+              sets.order.size(), withSliding ? sets.sliding.size() : 0,
+              withSliding ? "with sliding rows" : "without", s.index.size(), blockMs,
+              blockResidual, cell(ch).c_str(), cell(k).c_str(), cell(u).c_str());
+}
+
+void bench(int levels) {
+  mlcp::test::PyramidSpec spec;
+  spec.levels = levels;
+  spec.sideVelocity = 0.5;
+  mlcp::test::BoxPyramid pyramid(spec);
+  const mlcp::RowSystem& rows = pyramid.rows();
+  const mlcp::Problem p = rows.assemble(true);
+  mlcp::NewtonSolver newton;
+  newton.options().tolerance = 1e-6;
+  newton.options().maxIterations = 60;
+  newton.useRows(&rows);
+  Vector x;
+  newton.solve(p, x);
+  const Sets sets = setsOf(p, x);
+  double dMax = 0;
+  for (int i = 0; i < p.size(); ++i) dMax = std::max(dMax, p.diagonal(i));
+  mlcp::detail::BodySpaceSystem body;
+  if (!body.prepareFor(rows, p, dMax)) {
+    std::printf("| %d | - | body space does not apply |\n", pyramid.boxes());
+    return;
+  }
+  const double minDiagonal = 1e-11 * dMax;
+  for (const bool withSliding : {true, false}) {
+    const std::vector<int> sliding = withSliding ? sets.sliding : std::vector<int>{};
+    const std::vector<double> coeff = withSliding ? sets.coeff : std::vector<double>{};
+    Csc s;
+    s.n = body.size();
+    body.assemble(sets.order, sets.pos, sliding, coeff, p.findex, 0, minDiagonal);
+    body.assembled(s.start, s.index, s.values);
+    const double blockMs = medianMs(
+        [&] { body.factor(sets.order, sets.pos, sliding, coeff, p.findex, 0, minDiagonal); });
+    // The block LU solves K y = r on the clamped rows; its S solve is checked through K: S z = r
+    // is what the other methods solve, so the block LU's residual is of K y = r.
+    Vector r = Vector::Ones(s.n);
+    Vector y = Vector::Ones(static_cast<int>(sets.order.size())), ky;
+    const Vector y0 = y;
+    body.solve(y);
+    // K y = D y + J_C W G_C^T y: through the rows (multiply is A = J W J^T + cfm on all rows).
+    Vector full = Vector::Zero(p.size());
+    for (size_t c = 0; c < sets.order.size(); ++c) full[sets.order[c]] = y[c];
+    for (size_t k = 0; k < sliding.size(); ++k)
+      full[sliding[k]] = coeff[k] * full[p.findex[sliding[k]]];
+    body.multiply(full, sets.order, ky);
+    const double blockResidual = (ky - y0).norm() / y0.norm();
+    row(pyramid.boxes(), s.n, sets, withSliding, s, blockMs, blockResidual, r);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<int> levels;
+  for (int a = 1; a < argc; ++a) levels.push_back(std::atoi(argv[a]));
+  if (levels.empty()) levels = {10, 20, 44};
+  std::printf("BLAS: %s\n\n", loadedBlas().c_str());
+  std::printf(
+      "| boxes | S size | clamped rows | sliding rows | S | nnz(S) | block LU | CHOLMOD | KLU | "
+      "UMFPACK |\n|---|---|---|---|---|---|---|---|---|---|\n");
+  for (int l : levels) bench(l);
+  return 0;
+}
