@@ -53,8 +53,8 @@ double medianMs(const std::function<void()>& run) {
   while (t.size() < 5 || (total < 500 && t.size() < 200)) {
     const auto t0 = std::chrono::steady_clock::now();
     run();
-    t.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                    .count());
+    t.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     total += t.back();
   }
   std::nth_element(t.begin(), t.begin() + t.size() / 2, t.end());
@@ -146,8 +146,8 @@ Timing umfpack(const Csc& s, const Vector& r) {
                        nullptr);
   });
   Vector z(s.n);
-  if (num && umfpack_di_solve(UMFPACK_A, s.start.data(), s.index.data(), s.values.data(),
-                              z.data(), r.data(), num, nullptr, nullptr) == UMFPACK_OK)
+  if (num && umfpack_di_solve(UMFPACK_A, s.start.data(), s.index.data(), s.values.data(), z.data(),
+                              r.data(), num, nullptr, nullptr) == UMFPACK_OK)
     t.residual = relResidual(s, r, z);
   if (num) umfpack_di_free_numeric(&num);
   umfpack_di_free_symbolic(&sym);
@@ -193,8 +193,8 @@ void row(int boxes, int coords, const Sets& sets, bool withSliding, const Csc& s
   };
   std::printf("| %d | %d | %zu | %zu | %s | %zu | %.3g ms (%.0e) | %s | %s | %s |\n", boxes, coords,
               sets.order.size(), withSliding ? sets.sliding.size() : 0,
-              withSliding ? "with sliding rows" : "without", s.index.size(), blockMs,
-              blockResidual, cell(ch).c_str(), cell(k).c_str(), cell(u).c_str());
+              withSliding ? "with sliding rows" : "without", s.index.size(), blockMs, blockResidual,
+              cell(ch).c_str(), cell(k).c_str(), cell(u).c_str());
 }
 
 void bench(int levels) {

@@ -142,9 +142,10 @@
 // G_C^T D^-1 r, S = I + R^T G_C^T D^-1 J_C R (W = R R^T per body, R from the eigen decomposition
 // of invInertia: singular inertia allowed; static bodies left out). S has 6 x (dynamic bodies)
 // unknowns, fewer than the clamped rows of a contact island, and is factored as a right-looking LU
-// on 6 x 6 blocks in an AMD order of the body graph (core/src/linalg/body_space.hpp). Every step
-// whose every d_c is at least blockBodyMinDiagonal max |A_ii| takes it, with two steps of
-// refinement against the true K (its conditioning is ~ 1 / d); the others factor A_CC as above.
+// on 6 x 6 blocks in CHOLMOD's fill-reducing order of the body graph (linalg/body_space.hpp,
+// linalg/ordering.hpp). Every step whose every d_c is at least blockBodyMinDiagonal max |A_ii|
+// takes it, with two steps of refinement against the true K (its conditioning is ~ 1 / d); the
+// others factor A_CC as above.
 // Because these steps are cheap, maxBodyBlockSteps allows more of them than maxBlockSteps before
 // the hand-over to the incremental pivoting. With rows and every cfm > 0 the stage's products with
 // A are formed as (J R)((J R)^T x) + cfm x, 24 multiply-adds a row (the rows are checked against
