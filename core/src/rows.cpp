@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <limits>
 #include <sstream>
 #include <type_traits>
 
@@ -204,28 +205,30 @@ void RowSystem::assemble(bool sparse, Problem& p, AssembleScratch& scratch) cons
                       held.innerIndexPtr());
   }();
   SparseMatrix& A = scratch.sparse;
-  p.swapA(A);  // A now holds the problem's previous sparse matrix
+  p.swapA(A);  // A now holds the problem's previous sparse matrix (its storage is reused)
   if (samePattern) {
+    // The second assembly on a pattern finds where each product lands (row-major: a search of
+    // the row's sorted columns), the next ones only write values.
+    auto& slots = scratch.valueSlot;
+    if (slots.empty())
+      forEachProduct([&](int i, int j, double) {
+        const int* first = A.innerIndexPtr() + A.outerIndexPtr()[i];
+        const int* last = A.innerIndexPtr() + A.outerIndexPtr()[i + 1];
+        slots.push_back(static_cast<int>(std::lower_bound(first, last, j) - A.innerIndexPtr()));
+      });
     double* values = A.valuePtr();
     std::fill_n(values, A.nonZeros(), 0.0);
-    const int* slot = scratch.valueSlot.data();
+    const int* slot = slots.data();
     forEachProduct([&](int, int, double v) { values[*slot++] += v; });
   } else {
-    auto& triplets = scratch.triplets;
-    triplets.clear();
-    forEachProduct([&](int i, int j, double v) { triplets.emplace_back(i, j, v); });
+    // A new pattern: each row written in place, its columns the merge of its bodies' row lists.
     A.resize(n, n);
-    A.setFromTriplets(triplets.begin(), triplets.end());
-    A.makeCompressed();
-    // Where each product landed (row-major: search the row's sorted column indices).
-    scratch.valueSlot.resize(triplets.size());
-    for (std::size_t t = 0; t < triplets.size(); ++t) {
-      const int row = triplets[t].row();
-      const int* first = A.innerIndexPtr() + A.outerIndexPtr()[row];
-      const int* last = A.innerIndexPtr() + A.outerIndexPtr()[row + 1];
-      scratch.valueSlot[t] =
-          static_cast<int>(std::lower_bound(first, last, triplets[t].col()) - A.innerIndexPtr());
-    }
+    int* outer = A.outerIndexPtr();
+    outer[0] = 0;
+    for (int i = 0; i < n; ++i) outer[i + 1] = outer[i] + mergeRow<false>(i, touching, nullptr);
+    A.resizeNonZeros(outer[n]);
+    for (int i = 0; i < n; ++i) mergeRow<true>(i, touching, &A);
+    scratch.valueSlot.clear();
     scratch.patternOuter.assign(A.outerIndexPtr(), A.outerIndexPtr() + n + 1);
     scratch.patternInner.assign(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros());
     key.resize(1 + 2 * static_cast<std::size_t>(n));
@@ -236,6 +239,64 @@ void RowSystem::assemble(bool sparse, Problem& p, AssembleScratch& scratch) cons
     }
   }
   p.swapA(A);
+}
+
+// Row i of the sparse A (RowSystem::assemble): every row j sharing a body with i, in increasing
+// j, A_ij = [i == j] cfm_i + sum over the bodies k of i (increasing k) of
+// J_jk . (M_k^-1 J_ik), summed in the dense path's order (cfm, then body by body, and within a
+// body i's sides in the order A, B and j's in touching order), so that both storages hold the
+// same bits. Count only (Fill false): returns the entries; Fill: writes them at the row's start.
+template <bool Fill>
+int RowSystem::mergeRow(int i, const Touching& touching, SparseMatrix* A) const {
+  const ConstraintRow& r = rows[i];
+  // i's sides in increasing body order (A before B on one body).
+  struct Side {
+    const std::vector<std::pair<int, const Vector6*>>* list = nullptr;
+    Vector6 m = Vector6::Zero();  // M_k^-1 J_ik
+    std::size_t at = 0;
+  } side[2];
+  int sides = 0;
+  auto addSide = [&](int body, const Vector6& j) {
+    if (body < 0) return;
+    side[sides].list = &touching[body];
+    if (Fill) side[sides].m = applyInverseMass(bodies[body], j);
+    ++sides;
+  };
+  const bool swap = r.bodyA >= 0 && r.bodyB >= 0 && r.bodyB < r.bodyA;
+  addSide(swap ? r.bodyB : r.bodyA, swap ? r.jB : r.jA);
+  addSide(swap ? r.bodyA : r.bodyB, swap ? r.jA : r.jB);
+  int* inner = Fill ? A->innerIndexPtr() + A->outerIndexPtr()[i] : nullptr;
+  double* value = Fill ? A->valuePtr() + A->outerIndexPtr()[i] : nullptr;
+  int count = 0;
+  bool diagonal = false;
+  constexpr int kNone = std::numeric_limits<int>::max();
+  for (;;) {
+    int j = diagonal ? kNone : i;
+    for (int s = 0; s < sides; ++s)
+      if (side[s].at < side[s].list->size()) j = std::min(j, (*side[s].list)[side[s].at].first);
+    if (j == kNone) break;
+    double v = 0;
+    bool started = false;
+    if (j == i) {
+      v = cfm[i];
+      started = diagonal = true;
+    }
+    for (int s = 0; s < sides; ++s) {
+      const auto& list = *side[s].list;
+      for (; side[s].at < list.size() && list[side[s].at].first == j; ++side[s].at) {
+        if (!Fill) continue;
+        const double c = list[side[s].at].second->dot(side[s].m);
+        v = started ? v + c : c;
+        started = true;
+      }
+    }
+    if (Fill) {
+      inner[count] = j;
+      value[count] = v;
+    }
+    ++count;
+  }
+  return count;
 }
 
 Result RowPgs::solve(const RowSystem& s, Vector& x) {

@@ -85,8 +85,9 @@ TEST(RowSystem, AssemblyMatchesDenseProduct) {
 }
 
 // The per-step assembly into a kept problem (RowSolver's): values written into the kept sparse
-// pattern equal a fresh assembly bit for bit, a changed body graph or a replaced matrix gets a
-// new pattern, and dense storage is reused.
+// pattern (its second assembly finds the slots, later ones use them) equal a fresh assembly bit
+// for bit, and the dense assembly's bits; a changed body graph or a replaced matrix gets a new
+// pattern, and dense storage is reused.
 TEST(RowSystem, ReusedAssemblyEqualsAFreshOne) {
   Problem kept;
   RowSystem::AssembleScratch scratch;
@@ -97,6 +98,7 @@ TEST(RowSystem, ReusedAssemblyEqualsAFreshOne) {
     const Problem fresh = s.assemble(sparse);
     ASSERT_EQ(kept.isSparse(), sparse);
     EXPECT_EQ(kept.toDense(), fresh.toDense());  // exactly equal
+    EXPECT_EQ(fresh.toDense(), s.assemble(!sparse).toDense());
     EXPECT_EQ(kept.b, fresh.b);
     EXPECT_EQ(kept.findex, fresh.findex);
     EXPECT_LE((kept.toDense() - denseByHand(s)).lpNorm<Eigen::Infinity>(), 1e-12);
@@ -106,6 +108,9 @@ TEST(RowSystem, ReusedAssemblyEqualsAFreshOne) {
   const double* values = kept.sparseA().valuePtr();
   // New Jacobian values on the same bodies: the same storage is refilled.
   s = stackRows(5, 3);
+  expectFresh(s, true);
+  EXPECT_EQ(kept.sparseA().valuePtr(), values);
+  s = stackRows(5, 6);
   expectFresh(s, true);
   EXPECT_EQ(kept.sparseA().valuePtr(), values);
   // A row moved to another body pair: a new pattern.

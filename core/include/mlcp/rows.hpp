@@ -56,13 +56,15 @@ class RowSystem {
   Problem assemble(bool sparse) const;
   // The same into `into`, reusing its vectors, A's storage (Problem::swapA) and the scratch's
   // buffers: a per-step caller (RowSolver) allocates nothing once the sizes have been seen.
-  // Sparse A: when the rows join the same bodies as in the last sparse assembly with this
-  // scratch and `into` still holds that pattern (index arrays compared), only the values are
-  // written, in the order setFromTriplets sums them (bitwise the same A); otherwise the pattern
-  // is built from triplets and remembered.
+  // Sparse A: a new pattern is written row by row in place (each row the merge of its bodies'
+  // row lists, O(nnz A), no sort) and remembered; when the rows join the same bodies as in the
+  // last sparse assembly with this scratch and `into` still holds that pattern (index arrays
+  // compared), only the values are written, through each product's slot (found once per
+  // pattern, at its second assembly: islands whose contacts change every step never pay for
+  // it). Both sum in the dense path's order: the same bits in every storage.
+  using Touching = std::vector<std::vector<std::pair<int, const Vector6*>>>;  // per body
   struct AssembleScratch {
-    std::vector<std::vector<std::pair<int, const Vector6*>>> touching;
-    std::vector<Eigen::Triplet<double>> triplets;
+    Touching touching;  // per body, the rows touching it (row order) and their Jacobian there
     std::vector<int> patternBodies;               // bodies.size(), then bodyA, bodyB per row
     std::vector<int> patternOuter, patternInner;  // the pattern's compressed index arrays
     std::vector<int> valueSlot;  // per product, in assembly order: its index in A's values
@@ -74,6 +76,10 @@ class RowSystem {
   Vector slack(const Vector& x) const;
   // Body velocity changes M^-1 J^T x, 6 per body ([linear; angular]).
   std::vector<Vector6> bodyVelocities(const Vector& x) const;
+
+ private:
+  template <bool Fill>
+  int mergeRow(int i, const Touching& touching, SparseMatrix* A) const;
 };
 
 // Projected Gauss-Seidel on the rows themselves (what engines' sequential impulse does), with
