@@ -96,7 +96,7 @@ bool NewtonSolver::fallbackStep(const Problem& pb, bool sweeps) {
   Work& wk = *work_;
   if (sweeps) {
     wk.trial.x = wk.at.x;
-    for (int k = 0; k < params_.stepSweeps; ++k) detail::pgsSweep(pb, wk.invDiag, 1.0, wk.trial.x);
+    for (int k = 0; k < params_.stepSweeps; ++k) wk.system.sweep(wk.invDiag, wk.trial.x);
     wk.trial.evaluate(pb, wk.system);
     return true;
   }
@@ -117,7 +117,7 @@ void NewtonSolver::start(const Problem& pb, Vector& x, bool sweeps) {
   const int count = cold                                 ? params_.coldSweeps
                     : guess > params_.warmSweepsResidual ? params_.warmSweeps
                                                          : 0;
-  for (int k = 0; k < count; ++k) detail::pgsSweep(pb, work_->invDiag, 1.0, x);
+  for (int k = 0; k < count; ++k) work_->system.sweep(work_->invDiag, x);
 }
 
 void NewtonSolver::run(const Problem& pb, Vector& x, Result& result) {
@@ -133,7 +133,7 @@ void NewtonSolver::run(const Problem& pb, Vector& x, Result& result) {
   Work& wk = *work_;
   wk.system.prepare(pb, params_.denseMaxRows);
   // Sweeps (the cold start, the fallback) need A_ii > 0 and descend for symmetric A.
-  const bool sweeps = detail::inverseDiagonal(pb, wk.invDiag) < 0 && detail::symmetricMatrix(pb);
+  const bool sweeps = detail::inverseDiagonal(pb, wk.invDiag) < 0 && wk.system.symmetric();
   wk.best.x = x;  // the start as given counts as an iterate: never return worse
   wk.best.evaluate(pb, wk.system);
   start(pb, x, sweeps);

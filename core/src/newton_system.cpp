@@ -5,6 +5,7 @@
 #include <numeric>
 
 #include "linalg/body_space.hpp"
+#include "mlcp/pgs.hpp"
 
 namespace mlcp::detail {
 
@@ -110,6 +111,15 @@ void NewtonSystem::prepareBody(const Problem& pb) {
   findex_ = pb.hasFindex() ? pb.findex : std::vector<int>(n, -1);
   bodyProducts_ = bodyReady_ && body_->productsStandForA();
 }
+
+void NewtonSystem::sweep(const Vector& invDiag, Vector& x) {
+  if (bodyProducts_)
+    body_->sweep(*problem_, invDiag, x);
+  else
+    detail::pgsSweep(*problem_, invDiag, 1.0, x);
+}
+
+bool NewtonSystem::symmetric() const { return bodyReady_ || symmetricMatrix(*problem_); }
 
 void NewtonSystem::slack(const Vector& x, Vector& w) const {
   if (!bodyProducts_) {

@@ -49,6 +49,12 @@ class NewtonSystem {
   // w = A x + b of the prepared problem: in body space when its products apply there (rows
   // given, every cfm > 0: 12 multiply-adds a row instead of A's row), else from A.
   void slack(const Vector& x, Vector& w) const;
+  // One projected Gauss-Seidel sweep (omega 1) on the prepared problem: in body space when its
+  // products apply there (as slack()), else detail::pgsSweep on A.
+  void sweep(const Vector& invDiag, Vector& x);
+  // Whether the prepared problem's A is symmetric: by construction when body space holds its
+  // rows (A = J W J^T + diag(cfm)), else symmetricMatrix().
+  bool symmetric() const;
   // out = J^T v (without rho).
   void transposeTimes(const Vector& v, Vector& out) const;
   // out = J v (without rho).

@@ -12,8 +12,7 @@ namespace mlcp {
 void detail::pgsSweep(const Problem& problem, const Vector& invDiag, double omega, Vector& x) {
   for (int i = 0; i < problem.size(); ++i) {
     const double wi = problem.rowDot(i, x) + problem.b[i];
-    const double xi = x[i] - omega * wi * invDiag[i];
-    x[i] = std::clamp(xi, problem.effectiveLo(i, x), problem.effectiveHi(i, x));
+    x[i] = pgsUpdate(problem, i, wi, invDiag[i], omega, x);
   }
 }
 

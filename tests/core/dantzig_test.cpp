@@ -14,6 +14,7 @@
 #include "common/generators.hpp"
 #include "mlcp/io.hpp"
 #include "mlcp/ldlt.hpp"
+#include "mlcp/pgs.hpp"
 #include "mlcp/registry.hpp"
 #include "mlcp/residual.hpp"
 #include "mlcp/rows.hpp"
@@ -1116,6 +1117,29 @@ TEST(DantzigBody, BodyFactorsOfRotatedInertiasMatchTheAssembledDiagonal) {
     }
   }
   EXPECT_LE(worst, 1e-13 * dMax);
+}
+
+// A projected Gauss-Seidel sweep in body space (slacks from the bodies' R^T J^T x) gives the
+// sweep on the assembled A, friction bounds from the current normals included, sweep after sweep
+// from zero on a sliding pyramid.
+TEST(DantzigBody, SweepInBodySpaceIsTheSweepOnA) {
+  test::BoxPyramid pyramid(slidingPyramid(5));
+  const Problem p = pyramid.rows().assemble(true);
+  detail::BodySpaceSystem body;
+  ASSERT_TRUE(body.prepare(pyramid.rows(), p.size()));
+  Vector invDiag;
+  ASSERT_LT(detail::inverseDiagonal(p, invDiag), 0);
+  Vector x = Vector::Zero(p.size()), y = x;
+  int atBound = 0;
+  for (int sweep = 0; sweep < 10; ++sweep) {
+    body.sweep(p, invDiag, x);
+    detail::pgsSweep(p, invDiag, 1.0, y);
+    ASSERT_LE((x - y).lpNorm<Eigen::Infinity>(), 1e-10 * (1 + y.lpNorm<Eigen::Infinity>()))
+        << sweep;
+  }
+  for (int i = 0; i < p.size(); ++i)
+    if (p.findex[i] >= 0 && x[i] != 0 && std::abs(x[i]) == p.effectiveHi(i, x)) ++atBound;
+  EXPECT_GT(atBound, 0) << "the sweeps should meet friction bounds";
 }
 
 // K = D + J_C W G_C^T solved in body space equals K built from the assembled A and solved densely:

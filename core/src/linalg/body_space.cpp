@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "linalg/ordering.hpp"
+#include "mlcp/pgs.hpp"
 
 namespace mlcp::detail {
 
@@ -249,6 +250,23 @@ void BodySpaceSystem::bodyForces(const Vector& x) {
       for (int l = 0; l < 6; ++l) v_[6 * rd.a + l] += rd.jr[l] * xi;
     if (rd.b >= 0)
       for (int l = 0; l < 6; ++l) v_[6 * rd.b + l] += rd.jr[6 + l] * xi;
+  }
+}
+
+void BodySpaceSystem::sweep(const Problem& problem, const Vector& invDiag, Vector& x) {
+  bodyForces(x);
+  const int n = static_cast<int>(rows_.size());
+  for (int i = 0; i < n; ++i) {
+    const double wi = rowTimes(i, x[i]) + problem.b[i];
+    const double xi = pgsUpdate(problem, i, wi, invDiag[i], 1.0, x);
+    const double dx = xi - x[i];
+    if (dx == 0) continue;
+    x[i] = xi;
+    const RowData& rd = rows_[i];
+    if (rd.a >= 0)
+      for (int l = 0; l < 6; ++l) v_[6 * rd.a + l] += rd.jr[l] * dx;
+    if (rd.b >= 0)
+      for (int l = 0; l < 6; ++l) v_[6 * rd.b + l] += rd.jr[6 + l] * dx;
   }
 }
 
