@@ -246,11 +246,16 @@ bool NewtonSystem::solveReduced(Vector& rhs) {
   }
   const int m = static_cast<int>(freeRows_.size());
   reduced_.resize(m);
-  for (int c = 0; c < m; ++c) {
-    const int i = freeRows_[c];
-    double sum = rhs[i];
-    for (SparseMatrix::InnerIterator it(*a_, i); it; ++it) sum -= it.value() * known_[it.col()];
-    reduced_[c] = sum;
+  if (bodyProducts_) {  // (A known)_C through the rows (known is 0 on the free rows)
+    body_->multiply(known_, freeRows_, product_);
+    for (int c = 0; c < m; ++c) reduced_[c] = rhs[freeRows_[c]] - product_[c];
+  } else {
+    for (int c = 0; c < m; ++c) {
+      const int i = freeRows_[c];
+      double sum = rhs[i];
+      for (SparseMatrix::InnerIterator it(*a_, i); it; ++it) sum -= it.value() * known_[it.col()];
+      reduced_[c] = sum;
+    }
   }
   if (m > 0 && !solveFactored(reduced_)) return false;
   for (int c = 0; c < m; ++c) rhs[freeRows_[c]] = reduced_[c];
