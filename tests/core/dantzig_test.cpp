@@ -1119,6 +1119,32 @@ TEST(DantzigBody, BodyFactorsOfRotatedInertiasMatchTheAssembledDiagonal) {
   EXPECT_LE(worst, 1e-13 * dMax);
 }
 
+// Body space has no limit on the bodies (its memory is O(fill), not bodies^2): a pyramid of 1081
+// boxes, every contact row clamped, solves K y = r to round-off (K's product through the rows).
+TEST(DantzigBody, IslandsOfMoreThanAThousandBodiesFactor) {
+  test::BoxPyramid pyramid(slidingPyramid(46));
+  const RowSystem& rows = pyramid.rows();
+  ASSERT_GT(pyramid.boxes(), 1024);
+  detail::BodySpaceSystem body;
+  ASSERT_TRUE(body.prepare(rows, rows.size()));
+  std::vector<int> order, pos(rows.size(), -1);
+  for (int i = 0; i < rows.size(); ++i)
+    if (rows.findex[i] < 0) {
+      pos[i] = static_cast<int>(order.size());
+      order.push_back(i);
+    }
+  const double rho = 1e-3;
+  ASSERT_TRUE(body.factor(order, pos, {}, {}, rows.findex, rho, 1e-12));
+  const int m = static_cast<int>(order.size());
+  const Vector r = Vector::LinSpaced(m, -1, 1);
+  Vector y = r, full = Vector::Zero(rows.size()), ky;
+  body.solve(y);
+  for (int c = 0; c < m; ++c) full[order[c]] = y[c];
+  body.multiply(full, order, ky);
+  ky += rho * y;
+  EXPECT_LE((ky - r).norm(), 1e-9 * r.norm());
+}
+
 // A projected Gauss-Seidel sweep in body space (slacks from the bodies' R^T J^T x) gives the
 // sweep on the assembled A, friction bounds from the current normals included, sweep after sweep
 // from zero on a sliding pyramid.

@@ -45,7 +45,6 @@ bool BodySpaceSystem::prepare(const RowSystem& rows, int n) {
       pairs.emplace_back(b, a, 1.0);
     }
   }
-  if (dynamic > kMaxBodies) return false;
   Eigen::SparseMatrix<double, Eigen::ColMajor, int> graph(dynamic, dynamic);
   graph.setFromTriplets(pairs.begin(), pairs.end());
   const std::vector<int>& byRank = orderOf(graph);
@@ -55,29 +54,12 @@ bool BodySpaceSystem::prepare(const RowSystem& rows, int n) {
     if (compact[k] >= 0) compact[k] = rank[compact[k]];
   bodies_ = dynamic;
   // The block pattern with its fill: eliminating body k joins every pair of its later neighbours.
-  const size_t nb2 = static_cast<size_t>(dynamic) * dynamic;
-  slot_.assign(nb2, -1);
-  for (int k = 0; k < dynamic; ++k) slot_[static_cast<size_t>(k) * dynamic + k] = 0;
+  std::vector<std::vector<int>> later(dynamic);  // per rank, the graph's neighbours of higher rank
   for (int col = 0; col < graph.outerSize(); ++col)
     for (Eigen::SparseMatrix<double, Eigen::ColMajor, int>::InnerIterator it(graph, col); it; ++it)
-      slot_[static_cast<size_t>(rank[it.index()]) * dynamic + rank[col]] = 0;
-  belowStart_.assign(1, 0);
-  below_.clear();
-  for (int k = 0; k < dynamic; ++k) {
-    const int first = static_cast<int>(below_.size());
-    for (int i = k + 1; i < dynamic; ++i)
-      if (slot_[static_cast<size_t>(i) * dynamic + k] >= 0) below_.push_back(i);
-    const int last = static_cast<int>(below_.size());
-    for (int a = first; a < last; ++a)
-      for (int b = first; b < last; ++b)
-        slot_[static_cast<size_t>(below_[a]) * dynamic + below_[b]] = 0;
-    belowStart_.push_back(last);
-  }
-  int count = 0;
-  for (int& e : slot_)
-    if (e >= 0) e = count++;
-  blocks_.resize(count);
-  inverse_.resize(dynamic);
+      if (rank[it.index()] > rank[col]) later[rank[col]].push_back(rank[it.index()]);
+  symbolic(later);
+  rows_.resize(n);
   rows_.resize(n);
   for (int i = 0; i < n; ++i) {
     const ConstraintRow& r = rows.rows[i];
@@ -95,9 +77,51 @@ bool BodySpaceSystem::prepare(const RowSystem& rows, int n) {
     };
     side(rd.a >= 0 ? r.bodyA : -1, r.jA, rd.jr);
     side(rd.b >= 0 ? r.bodyB : -1, r.jB, rd.jr + 6);
+    const int sides[2] = {rd.a, rd.b};
+    for (int sp = 0; sp < 2; ++sp)
+      for (int sq = 0; sq < 2; ++sq)
+        rd.block[sp][sq] = sides[sp] >= 0 && sides[sq] >= 0 ? slotOf(sides[sp], sides[sq]) : -1;
   }
   cfm_.assign(rows.cfm.data(), rows.cfm.data() + n);
   return true;
+}
+
+// below(k) = k's later neighbours and, for each child c of k in the elimination tree (k the
+// lowest of below(c)), below(c) without k: the pattern of L's block column k after the fill.
+void BodySpaceSystem::symbolic(std::vector<std::vector<int>>& later) {
+  std::vector<std::vector<int>> children(bodies_);
+  belowStart_.assign(1, 0);
+  below_.clear();
+  for (int k = 0; k < bodies_; ++k) {
+    std::vector<int>& set = later[k];
+    for (int c : children[k])
+      for (int a = belowStart_[c]; a < belowStart_[c + 1]; ++a)
+        if (below_[a] != k) set.push_back(below_[a]);
+    std::sort(set.begin(), set.end());
+    set.erase(std::unique(set.begin(), set.end()), set.end());
+    below_.insert(below_.end(), set.begin(), set.end());
+    belowStart_.push_back(static_cast<int>(below_.size()));
+    if (!set.empty()) children[set.front()].push_back(k);
+  }
+  blocks_.resize(bodies_ + 2 * below_.size());
+  inverse_.resize(bodies_);
+  // Per pivot k and pair (a, b) of below(k), the block that the update L_ak U_kb lands in.
+  updates_.clear();
+  for (int k = 0; k < bodies_; ++k)
+    for (int a = belowStart_[k]; a < belowStart_[k + 1]; ++a)
+      for (int b = belowStart_[k]; b < belowStart_[k + 1]; ++b)
+        updates_.push_back(slotOf(below_[a], below_[b]));
+}
+
+// Block (p, q) of the pattern: p's diagonal, L's (p, q) for p > q at q's column, U's (p, q) for
+// p < q at p's row (slots: bodies_ diagonal blocks, then L and U of each below_ entry in turn).
+int BodySpaceSystem::slotOf(int p, int q) const {
+  if (p == q) return p;
+  const int column = std::min(p, q), other = std::max(p, q);
+  const auto first = below_.begin() + belowStart_[column];
+  const auto last = below_.begin() + belowStart_[column + 1];
+  const int at = static_cast<int>(std::lower_bound(first, last, other) - below_.begin());
+  return bodies_ + 2 * at + (p < q ? 1 : 0);
 }
 
 const std::vector<int>& BodySpaceSystem::orderOf(
@@ -127,14 +151,23 @@ bool BodySpaceSystem::factor(const std::vector<int>& order, const std::vector<in
 
 void BodySpaceSystem::assembled(std::vector<int>& start, std::vector<int>& index,
                                 std::vector<double>& values) const {
+  // Per block column q, its blocks (p, slot) in increasing p.
+  std::vector<std::vector<std::pair<int, int>>> columns(bodies_);
+  for (int k = 0; k < bodies_; ++k) {
+    columns[k].emplace_back(k, k);
+    for (int a = belowStart_[k]; a < belowStart_[k + 1]; ++a) {
+      columns[k].emplace_back(below_[a], bodies_ + 2 * a);
+      columns[below_[a]].emplace_back(k, bodies_ + 2 * a + 1);
+    }
+  }
   start.assign(1, 0);
   index.clear();
   values.clear();
-  for (int q = 0; q < bodies_; ++q)
+  for (int q = 0; q < bodies_; ++q) {
+    std::sort(columns[q].begin(), columns[q].end());
     for (int j = 0; j < 6; ++j) {
-      for (int p = 0; p < bodies_; ++p) {
-        const int slot = slot_[static_cast<size_t>(p) * bodies_ + q];
-        if (slot < 0 || (p != q && blocks_[slot].isZero(0.0))) continue;
+      for (const auto& [p, slot] : columns[q]) {
+        if (p != q && blocks_[slot].isZero(0.0)) continue;
         for (int i = 0; i < 6; ++i) {
           index.push_back(6 * p + i);
           values.push_back(blocks_[slot](i, j));
@@ -142,6 +175,7 @@ void BodySpaceSystem::assembled(std::vector<int>& start, std::vector<int>& index
       }
       start.push_back(static_cast<int>(index.size()));
     }
+  }
 }
 
 bool BodySpaceSystem::assemble(const std::vector<int>& order, const std::vector<int>& pos,
@@ -163,7 +197,7 @@ bool BodySpaceSystem::assemble(const std::vector<int>& order, const std::vector<
     for (int l = 0; l < 12; ++l) gr_[12 * c + l] += coeff[k] * t.jr[l];
   }
   for (Block& blk : blocks_) blk.setZero();
-  for (int q = 0; q < bodies_; ++q) at(q, q).setIdentity();
+  for (int q = 0; q < bodies_; ++q) blocks_[q].setIdentity();
   // S(p, q) += (G_c R_p)^T (J_c R_q) / d_c for the sides p, q of each clamped row c.
   using Vec6 = Eigen::Matrix<double, 6, 1>;
   for (int c = 0; c < m; ++c) {
@@ -175,7 +209,7 @@ bool BodySpaceSystem::assemble(const std::vector<int>& order, const std::vector<
       const Vec6 gp = Eigen::Map<const Vec6>(&gr_[12 * c + 6 * sp]) * inv;
       for (int sq = 0; sq < 2; ++sq)
         if (side[sq] >= 0)
-          at(side[sp], side[sq]).noalias() +=
+          blocks_[rd.block[sp][sq]].noalias() +=
               gp * Eigen::Map<const Vec6>(rd.jr + 6 * sq).transpose();
     }
   }
@@ -187,17 +221,17 @@ bool BodySpaceSystem::eliminate() {
   // Right-looking block LU in the elimination order (no pivoting between blocks: S = I + V^T D^-1
   // U is symmetric positive definite without sliding rows, near it with them).
   constexpr double kPivot = 1e-12;
+  const int* update = updates_.data();
   for (int k = 0; k < bodies_; ++k) {
-    const Eigen::PartialPivLU<Block> lu(at(k, k));
-    const double scale = std::max(1.0, at(k, k).cwiseAbs().maxCoeff());
+    const Eigen::PartialPivLU<Block> lu(blocks_[k]);
+    const double scale = std::max(1.0, blocks_[k].cwiseAbs().maxCoeff());
     if (!(lu.matrixLU().diagonal().cwiseAbs().minCoeff() > kPivot * scale)) return false;
     inverse_[k] = lu.inverse();
     const int first = belowStart_[k], last = belowStart_[k + 1];
-    for (int a = first; a < last; ++a) at(below_[a], k) = at(below_[a], k) * inverse_[k];
+    for (int a = first; a < last; ++a) lower(a) = lower(a) * inverse_[k];
     for (int a = first; a < last; ++a) {
-      const Block& lik = at(below_[a], k);
-      for (int b = first; b < last; ++b)
-        at(below_[a], below_[b]).noalias() -= lik * at(k, below_[b]);
+      const Block& lak = lower(a);
+      for (int b = first; b < last; ++b) blocks_[*update++].noalias() -= lak * upper(b);
     }
   }
   return inverse_.empty() || inverse_.back().allFinite();
@@ -220,12 +254,12 @@ void BodySpaceSystem::solve(Vector& y) {
   for (int k = 0; k < bodies_; ++k) {
     const Vec6 zk = z.segment<6>(6 * k);
     for (int a = belowStart_[k]; a < belowStart_[k + 1]; ++a)
-      z.segment<6>(6 * below_[a]).noalias() -= at(below_[a], k) * zk;
+      z.segment<6>(6 * below_[a]).noalias() -= lower(a) * zk;
   }
   for (int k = bodies_ - 1; k >= 0; --k) {
     Vec6 t = z.segment<6>(6 * k);
     for (int a = belowStart_[k]; a < belowStart_[k + 1]; ++a)
-      t.noalias() -= at(k, below_[a]) * z.segment<6>(6 * below_[a]);
+      t.noalias() -= upper(a) * z.segment<6>(6 * below_[a]);
     z.segment<6>(6 * k) = inverse_[k] * t;
   }
   for (int c = 0; c < m; ++c) {

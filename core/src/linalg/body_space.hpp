@@ -25,8 +25,8 @@
 // is about a tenth of a sparse LU of K on the rows. Why a block LU of our own and not a library's
 // factorization of S: on the pyramids' S (330 to 6090 coordinates) it is faster than CHOLMOD's
 // supernodal Cholesky (which would serve only S without sliding rows), KLU and UMFPACK, with
-// reference BLAS or OpenBLAS (docs/benchmarks.md, "Body space: the factorization of S"). The
-// block table holds bodies^2 slots, hence kMaxBodies.
+// reference BLAS or OpenBLAS (docs/benchmarks.md, "Body space: the factorization of S"). Memory
+// is O(fill blocks + elimination updates); no limit on the bodies.
 #pragma once
 
 #include <Eigen/Dense>
@@ -87,14 +87,13 @@ class BodySpaceSystem {
     for (int l = 0; l < 12; ++l) d += rd.jr[l] * rd.jr[l];
     return d;
   }
-  // The most dynamic bodies handled (the block table is bodies^2 entries).
-  static constexpr int kMaxBodies = 1024;
 
  private:
   using Block = Eigen::Matrix<double, 6, 6>;
   struct RowData {
     int a = -1, b = -1;  // dynamic bodies in elimination order, -1: none
     double jr[12];       // [J_A R_A, J_B R_B]
+    int block[2][2];     // S's blocks (side p, side q) of this row, -1 without both sides
   };
   void bodyForces(const Vector& x);  // v_ = R^T J^T x
   double rowTimes(int i, double xi) const {
@@ -106,14 +105,20 @@ class BodySpaceSystem {
       for (int l = 0; l < 6; ++l) u += rd.jr[6 + l] * v_[6 * rd.b + l];
     return u;
   }
-  Block& at(int p, int q) { return blocks_[slot_[static_cast<size_t>(p) * bodies_ + q]]; }
+  // Of below_ entry a (body i below pivot k): L's block (i, k) and U's (k, i).
+  Block& lower(int a) { return blocks_[bodies_ + 2 * a]; }
+  Block& upper(int a) { return blocks_[bodies_ + 2 * a + 1]; }
+  void symbolic(std::vector<std::vector<int>>& later);
+  int slotOf(int p, int q) const;
   std::vector<RowData> rows_;
   int bodies_ = 0;
   // S and its factor S = L U on 6 x 6 blocks (L unit block-lower, U block-upper whose
   // diagonal blocks are kept inverted, from a 6 x 6 LU with partial pivoting), on the block pattern
-  // of the body graph with its fill in the elimination order: below_[belowStart_[k] ..] the blocks
-  // (i, k), i > k, of L (and (k, i) of U); slot_ per block pair its index in blocks_, -1 outside.
-  std::vector<int> belowStart_, below_, slot_;
+  // of the body graph with its fill in the elimination order: below_[belowStart_[k] ..] the bodies
+  // i > k of L's blocks (i, k) (and U's (k, i)). blocks_ holds the diagonal blocks, then L's and
+  // U's block of each below_ entry; updates_ per elimination update its target block, in the
+  // order the elimination makes them (memory O(fill), read in sequence).
+  std::vector<int> belowStart_, below_, updates_;
   std::vector<Block, Eigen::aligned_allocator<Block>> blocks_, inverse_;  // inverse_: U's diagonal
   std::vector<double> d_, gr_, cfm_;
   Vector z_, v_;
