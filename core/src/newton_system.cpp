@@ -14,6 +14,9 @@ namespace {
 constexpr double kBodyMinDiagonal = 1e-11;
 // Steps of iterative refinement after a body-space solve.
 constexpr int kBodyRefinements = 2;
+// A refinement whose correction is below this fraction of the solution ends them: the next one
+// would change y by less than round-off of the refined y.
+constexpr double kRefinedEnough = 1e-13;
 
 double largestEntry(const Problem& pb) {
   return pb.isSparse() ? (pb.sparseA().nonZeros() ? pb.sparseA().coeffs().cwiseAbs().maxCoeff() : 0)
@@ -293,6 +296,7 @@ bool NewtonSystem::solveFactored(Vector& y) {
     product_ = refine_ - product_;
     body_->solve(product_);
     y += product_;
+    if (product_.squaredNorm() <= kRefinedEnough * kRefinedEnough * y.squaredNorm()) break;
   }
   return y.allFinite();
 }
