@@ -57,8 +57,8 @@ if [ ${#missing[@]} -gt 0 ] || [ $need_update -eq 1 ]; then
 fi
 
 # Siconos pulls in OpenBLAS, whose libblas.so.3 / liblapack.so.3 outrank the reference ones in
-# Debian's alternatives: that would change, for every program, the BLAS under CHOLMOD (newton,
-# ldlt) and start its threads. When this set-up is what brought OpenBLAS, the reference libraries
+# Debian's alternatives: that would change, for every program, the BLAS that SuiteSparse and
+# LAPACK users load, and start its threads. When this set-up is what brought OpenBLAS, the reference libraries
 # stay the system's (as without Siconos; Siconos links OpenBLAS directly); a machine that had
 # OpenBLAS before keeps its owner's choice.
 if [ $had_openblas -eq 0 ]; then
