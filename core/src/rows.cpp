@@ -276,19 +276,14 @@ int RowSystem::mergeRow(int i, const Touching& touching, SparseMatrix* A) const 
       if (side[s].at < side[s].list->size()) j = std::min(j, (*side[s].list)[side[s].at].first);
     if (j == kNone) break;
     double v = 0;
-    bool started = false;
     if (j == i) {
       v = cfm[i];
-      started = diagonal = true;
+      diagonal = true;
     }
     for (int s = 0; s < sides; ++s) {
       const auto& list = *side[s].list;
-      for (; side[s].at < list.size() && list[side[s].at].first == j; ++side[s].at) {
-        if (!Fill) continue;
-        const double c = list[side[s].at].second->dot(side[s].m);
-        v = started ? v + c : c;
-        started = true;
-      }
+      for (; side[s].at < list.size() && list[side[s].at].first == j; ++side[s].at)
+        if (Fill) v += list[side[s].at].second->dot(side[s].m);
     }
     if (Fill) {
       inner[count] = j;

@@ -60,7 +60,6 @@ bool BodySpaceSystem::prepare(const RowSystem& rows, int n) {
       if (rank[it.index()] > rank[col]) later[rank[col]].push_back(rank[it.index()]);
   symbolic(later);
   rows_.resize(n);
-  rows_.resize(n);
   for (int i = 0; i < n; ++i) {
     const ConstraintRow& r = rows.rows[i];
     RowData& rd = rows_[i];
@@ -242,13 +241,7 @@ void BodySpaceSystem::solve(Vector& y) {
   Vector& z = z_;
   z.setZero(6 * bodies_);
   for (int c = 0; c < m; ++c) {
-    const RowData& rd = rows_[rowOf_[c]];
-    const double q = y[c] / d_[c];
-    const double* g = &gr_[12 * c];
-    if (rd.a >= 0)
-      for (int l = 0; l < 6; ++l) z[6 * rd.a + l] += g[l] * q;
-    if (rd.b >= 0)
-      for (int l = 0; l < 6; ++l) z[6 * rd.b + l] += g[6 + l] * q;
+    spread(rows_[rowOf_[c]], &gr_[12 * c], y[c] / d_[c], z);
   }
   using Vec6 = Eigen::Matrix<double, 6, 1>;
   for (int k = 0; k < bodies_; ++k) {
@@ -264,12 +257,7 @@ void BodySpaceSystem::solve(Vector& y) {
   }
   for (int c = 0; c < m; ++c) {
     const RowData& rd = rows_[rowOf_[c]];
-    double u = 0;
-    if (rd.a >= 0)
-      for (int l = 0; l < 6; ++l) u += rd.jr[l] * z[6 * rd.a + l];
-    if (rd.b >= 0)
-      for (int l = 0; l < 6; ++l) u += rd.jr[6 + l] * z[6 * rd.b + l];
-    y[c] = (y[c] - u) / d_[c];
+    y[c] = (y[c] - gather(rd, rd.jr, z, 0.0)) / d_[c];
   }
 }
 
@@ -277,13 +265,7 @@ void BodySpaceSystem::bodyForces(const Vector& x) {
   v_.setZero(6 * bodies_);
   const int n = static_cast<int>(rows_.size());
   for (int i = 0; i < n; ++i) {
-    const double xi = x[i];
-    if (xi == 0) continue;
-    const RowData& rd = rows_[i];
-    if (rd.a >= 0)
-      for (int l = 0; l < 6; ++l) v_[6 * rd.a + l] += rd.jr[l] * xi;
-    if (rd.b >= 0)
-      for (int l = 0; l < 6; ++l) v_[6 * rd.b + l] += rd.jr[6 + l] * xi;
+    if (x[i] != 0) spread(rows_[i], rows_[i].jr, x[i], v_);
   }
 }
 
@@ -296,11 +278,7 @@ void BodySpaceSystem::sweep(const Problem& problem, const Vector& invDiag, Vecto
     const double dx = xi - x[i];
     if (dx == 0) continue;
     x[i] = xi;
-    const RowData& rd = rows_[i];
-    if (rd.a >= 0)
-      for (int l = 0; l < 6; ++l) v_[6 * rd.a + l] += rd.jr[l] * dx;
-    if (rd.b >= 0)
-      for (int l = 0; l < 6; ++l) v_[6 * rd.b + l] += rd.jr[6 + l] * dx;
+    spread(rows_[i], rows_[i].jr, dx, v_);
   }
 }
 

@@ -96,14 +96,24 @@ class BodySpaceSystem {
     int block[2][2];     // S's blocks (side p, side q) of this row, -1 without both sides
   };
   void bodyForces(const Vector& x);  // v_ = R^T J^T x
-  double rowTimes(int i, double xi) const {
-    const RowData& rd = rows_[i];
-    double u = cfm_[i] * xi;
+  // v's entries of rd's bodies += amount j, and init + j . v over them (j: 12 entries, the
+  // sides A and B as jr).
+  static void spread(const RowData& rd, const double* j, double amount, Vector& v) {
     if (rd.a >= 0)
-      for (int l = 0; l < 6; ++l) u += rd.jr[l] * v_[6 * rd.a + l];
+      for (int l = 0; l < 6; ++l) v[6 * rd.a + l] += j[l] * amount;
     if (rd.b >= 0)
-      for (int l = 0; l < 6; ++l) u += rd.jr[6 + l] * v_[6 * rd.b + l];
+      for (int l = 0; l < 6; ++l) v[6 * rd.b + l] += j[6 + l] * amount;
+  }
+  static double gather(const RowData& rd, const double* j, const Vector& v, double init) {
+    double u = init;
+    if (rd.a >= 0)
+      for (int l = 0; l < 6; ++l) u += j[l] * v[6 * rd.a + l];
+    if (rd.b >= 0)
+      for (int l = 0; l < 6; ++l) u += j[6 + l] * v[6 * rd.b + l];
     return u;
+  }
+  double rowTimes(int i, double xi) const {
+    return gather(rows_[i], rows_[i].jr, v_, cfm_[i] * xi);
   }
   // Of below_ entry a (body i below pivot k): L's block (i, k) and U's (k, i).
   Block& lower(int a) { return blocks_[bodies_ + 2 * a]; }
