@@ -112,6 +112,7 @@ class Scene {
 
   // Collide, step, drop the contacts: one frame of an ODE program.
   void step(const StepFn& stepFn, dReal h) {
+    ++frame_;
     lastContacts_ = 0;
     contactRecords_.clear();
     dSpaceCollide(space, this, &Scene::nearCallback);
@@ -130,6 +131,9 @@ class Scene {
     dJointFeedback* feedback;  // null unless contactFeedback
   };
   bool recordContacts = false, contactFeedback = false;
+  // Each frame, a pair's contacts are created in dCollide's order rotated by the frame number:
+  // the same points, in another order every step (as colliders that cull or sort points give).
+  bool rotateContacts = false;
   const std::vector<ContactRecord>& contactRecords() const { return contactRecords_; }
   int bodyIndex(dBodyID b) const {
     const auto it = std::find(bodies.begin(), bodies.end(), b);
@@ -172,6 +176,8 @@ class Scene {
     if (ba && bb && dAreConnectedExcluding(ba, bb, dJointTypeContact)) return;
     std::vector<dContact> c(s->surface.maxContacts);
     const int n = dCollide(a, b, s->surface.maxContacts, &c[0].geom, sizeof(dContact));
+    if (s->rotateContacts && n > 1)
+      std::rotate(c.begin(), c.begin() + s->frame_ % n, c.begin() + n);
     for (int i = 0; i < n; ++i) {
       c[i].surface.mode = s->surface.mode;
       c[i].surface.mu = s->surface.mu;
@@ -186,6 +192,7 @@ class Scene {
     }
     s->lastContacts_ += n;
   }
+  int frame_ = 0;
   void record(dJointID j, const dContactGeom& geom) {
     dJointFeedback* fb = nullptr;
     if (contactFeedback) {

@@ -332,15 +332,11 @@ bool WarmStartCache::lookup(dxJoint* joint, int m, double* lambda, double matchD
   int i = find(key);
   if (i < 0) return false;
   if (key.contact) {
-    for (int rank = entries_[i].lookups++; rank > 0 && i >= 0; --rank) i = entries_[i].next;
-    if (i < 0) return false;
-    const Entry& e = entries_[i];
     const dReal* pos = static_cast<dxJointContact*>(joint)->contact.geom.pos;
-    const double d2 = (pos[0] - e.pos[0]) * (pos[0] - e.pos[0]) +
-                      (pos[1] - e.pos[1]) * (pos[1] - e.pos[1]) +
-                      (pos[2] - e.pos[2]) * (pos[2] - e.pos[2]);
-    if (e.m != m || d2 > matchDistance * matchDistance) return false;
-    std::copy(e.lambda.begin(), e.lambda.begin() + m, lambda);
+    double d2 = 0;
+    i = nearestContact(i, pos, m, d2);
+    if (i < 0 || d2 > matchDistance * matchDistance) return false;
+    std::copy(entries_[i].lambda.begin(), entries_[i].lambda.begin() + m, lambda);
     return true;
   }
   const Entry& e = entries_[i];
@@ -349,6 +345,19 @@ bool WarmStartCache::lookup(dxJoint* joint, int m, double* lambda, double matchD
     return false;
   std::copy(e.lambda.begin(), e.lambda.begin() + m, lambda);
   return true;
+}
+
+int WarmStartCache::nearestContact(int first, const dReal* pos, int m, double& d2) const {
+  int best = -1;
+  for (int i = first; i >= 0; i = entries_[i].next) {
+    const Entry& e = entries_[i];
+    if (e.m != m) continue;
+    const double d = (pos[0] - e.pos[0]) * (pos[0] - e.pos[0]) +
+                     (pos[1] - e.pos[1]) * (pos[1] - e.pos[1]) +
+                     (pos[2] - e.pos[2]) * (pos[2] - e.pos[2]);
+    if (best < 0 || d < d2) best = i, d2 = d;
+  }
+  return best;
 }
 
 void WarmStartCache::store(dxJoint* joint, int m, const double* lambda) {

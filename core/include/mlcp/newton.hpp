@@ -97,11 +97,11 @@
 // corpus), which the sparse LU refuses.
 //
 // Starts. A warm start (Options::warmStart, solveWithGuess) within
-// NewtonParams::warmSweepsResidual of an answer is used as given; a farther one (ODE's impulses
-// of the last step on this step's contacts: scaled residuals 1-10 on the pyramids), where
-// sweeps apply, first takes NewtonParams::warmSweeps projected Gauss-Seidel sweeps, which place
-// most rows on their pieces (on ODE's 210-box pyramid 8-22 Newton steps a step instead of
-// 20-50). A cold start (x = 0), where sweeps apply, first takes NewtonParams::coldSweeps
+// NewtonParams::warmSweepsResidual of an answer is used as given (a resting pyramid's start
+// from the last step's answers: scaled residuals ~1e-5); a farther one (the islands of a
+// settling pile, whose contacts come and go: scaled residuals 1-10), where sweeps apply, first
+// takes NewtonParams::warmSweeps projected Gauss-Seidel sweeps, which place most rows on their
+// pieces. A cold start (x = 0), where sweeps apply, first takes NewtonParams::coldSweeps
 // sweeps; pivoting from zero never runs here. Newton is fast from a start whose active pieces are
 // nearly the answer's: warm-started from the previous step's exact answer, synthetic pyramids
 // of 192-768 rows converge in 1-9 steps (10 of 12 cases), small captured islands in 1-6 steps

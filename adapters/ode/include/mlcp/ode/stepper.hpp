@@ -28,8 +28,9 @@
 //          rhs = c / h - J (M^-1 f_ext + v / h),
 //      where c and cfm are getInfo2's (ODE scales both by 1/h) and lambda is a force. Ours is
 //      w = A x + b, so b = -rhs; lo, hi and findex (made island-global) are copied;
-//   4. warm start: lambda of the last step per joint (per contact: matched by body pair,
-//      order and position), when the solver can use it;
+//   4. warm start: lambda of the last step per joint (per contact: the nearest last-step
+//      contact of the same body pair, within Settings::contactMatchDistance), when the solver can
+//      use it;
 //   5. solve: mlcp::RowSolver (mlcp/row_solver.hpp), shared with the Bullet adapter: it
 //      classifies the island, runs the named solver or `auto`'s choice ("pgs" on the rows,
 //      others on an assembled A, dense up to denseMaxRows rows), accepts the answer only when it
@@ -72,9 +73,9 @@ namespace mlcp::ode {
 struct Settings : RowSolverSettings {
   // Start each island's solve from the last step's lambda of the same joints. Default true.
   bool warmStart = true;
-  // A contact of the last step warm-starts a contact of this step when both join the same two
-  // bodies, have the same rank among that pair's contacts, and their positions are closer
-  // than this distance (in ODE's length unit, m). Default 0.05.
+  // A contact of this step is warm-started by the nearest contact of the last step between the
+  // same two bodies when their positions are closer than this distance (in ODE's length unit, m).
+  // Default 0.05.
   double contactMatchDistance = 0.05;
   // Diagnostics: a second solver (any name the stepper accepts except the forwarding ones) run
   // on the same island problem after the primary; its residual and time go to IslandStats,
