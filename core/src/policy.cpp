@@ -20,8 +20,10 @@ Choice Policy::choose(ProblemClass c, int rows, double tolerance, bool positiveD
   return {largeIslandSolver.c_str(), "pgs", "large contact island"};
 }
 
-bool Policy::demotes(const Result& rejected, double acceptResidual) const {
+bool Policy::demotes(const Result& rejected, double acceptResidual, int cutsInRow) const {
   if (rejected.status == Status::Failed || rejected.status == Status::NumericalIssue) return true;
+  if (!std::isfinite(rejected.residual)) return true;
+  if (rejected.status == Status::TimeLimit && cutsInRow < cutsBeforeDemotion) return false;
   return !(rejected.residual <= nearMiss * acceptResidual);
 }
 

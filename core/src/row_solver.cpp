@@ -55,12 +55,14 @@ std::string ChoiceCounts::toString() const {
 
 // --- the row solver -------------------------------------------------------------------------
 
-// What is kept per island: its assembled-problem solvers by name, when it was last solved, and
-// how many more `auto` solves run pgs first after a pivoting answer broke down.
+// What is kept per island: its assembled-problem solvers by name, when it was last solved, how
+// many more `auto` solves run pgs first after a pivoting answer broke down, and how many of its
+// last `auto` solves in a row the time budget cut.
 struct RowSolver::Slot {
   std::vector<std::pair<std::string, std::unique_ptr<Solver>>> solvers;
   std::uint64_t lastUse = 0;
   int pgsFirst = 0;
+  int cutsInRow = 0;
   // dantzig's cold-trial memory over this island's solves (DantzigSolver::useColdTrialMemory).
   DantzigSolver::ColdTrialMemory coldTrial;
 };
@@ -418,9 +420,11 @@ IslandSolve RowSolver::solveScreened(const RowSystem& rows, const Vector& start,
     r = run(rows, out.requested, withBudget(settings_.options, share, t0), start, x, island, out);
   if (r.status == Status::InvalidInput || r.status == Status::Unsupported) x = start;
   out.choice = out.requested;
+  if (autoChoice && !cone)
+    island.cutsInRow = r.status == Status::TimeLimit ? island.cutsInRow + 1 : 0;
   if (!acceptable(r, settings_.acceptResidual)) {
     if (autoChoice && !cone && !equals(out.requested, "pgs") && !equals(out.requested, "ldlt") &&
-        policy.demotes(r, settings_.acceptResidual))
+        policy.demotes(r, settings_.acceptResidual, island.cutsInRow))
       island.pgsFirst = policy.pgsAfterBreakdown;
     r = fallBack(rows, start, x, island, out, std::move(r), share, t0);
   }

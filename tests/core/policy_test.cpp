@@ -67,6 +67,19 @@ TEST(Policy, BreakdownsAndFarMissesDemoteNearMissesDoNot) {
   EXPECT_TRUE(p.demotes(r, 1e-3));
 }
 
+// A cold first step cut by the budget leaves the next, warm solve a start it converges from; a
+// second cut in a row is a method that does not finish in the budget.
+TEST(Policy, OneCutSolveDoesNotDemoteTwoInARowDo) {
+  const Policy p;
+  Result r;
+  r.status = Status::TimeLimit;
+  r.residual = 0.1;  // a far miss of 1e-3
+  EXPECT_FALSE(p.demotes(r, 1e-3, 1));
+  EXPECT_TRUE(p.demotes(r, 1e-3, 2));
+  r.status = Status::MaxIterations;  // not a cut: the first far miss demotes
+  EXPECT_TRUE(p.demotes(r, 1e-3, 0));
+}
+
 TEST(FallbackRule, BetterIsTheLowerFiniteResidual) {
   Result a, b;
   a.residual = 1e-3;

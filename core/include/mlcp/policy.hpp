@@ -29,7 +29,7 @@
 // a large island still asks for an exact method: newton, whose steps on engine rows cost a
 // body-space factorization (newton.hpp) and whose cold starts never pivot from zero (Bullet's
 // 55-box pyramid under the 0.05 s budget: 18 of 30 steps converged, against none for dantzig,
-// whose cut first step demotes the island to pgs), all bounded by the time budget
+// whose cut first steps demote the island to pgs), all bounded by the time budget
 // (row_solver.hpp).
 // The measurements: docs/benchmarks.md, "auto's choices and the time budget".
 //
@@ -93,11 +93,19 @@ struct Policy {
   // budget is spent and this solve has only its minimal share.
   Choice choose(ProblemClass c, int rows, double tolerance, bool positiveDiagonal = true,
                 bool budgetSpent = false) const;
-  // Whether a rejected answer of a pivoting primary sends its island to pgs for the next
-  // pgsAfterBreakdown solves: a breakdown (Failed, NumericalIssue, a non-finite residual) or a
-  // miss by more than nearMiss times acceptResidual (as a solve cut by the time budget usually
-  // is: the island then stops spending its budget on a method that does not finish in it).
-  bool demotes(const Result& rejected, double acceptResidual) const;
+  // Solves in a row of one island cut by the time budget before a far miss of the last demotes
+  // it. Default 2: one cut solve is often a cold first step (newton's 11-20 steps on the 210-box
+  // pyramid when the contacts appear) that leaves a start from which the next, warm solve
+  // converges; a second cut in a row says the method does not finish in the budget.
+  int cutsBeforeDemotion = 2;
+
+  // Whether a rejected answer of a pivoting or Newton primary sends its island to pgs for the
+  // next pgsAfterBreakdown solves: a breakdown (Failed, NumericalIssue, a non-finite residual),
+  // or a miss by more than nearMiss times acceptResidual that is not a TimeLimit answer of the
+  // island's first cutsBeforeDemotion - 1 cut solves in a row (cutsInRow counts them, this
+  // one included): the island then stops spending its budget on a method that does not finish
+  // in it.
+  bool demotes(const Result& rejected, double acceptResidual, int cutsInRow = 1) const;
 };
 
 // Rule 1 above: the status is not Failed, NumericalIssue, InvalidInput or Unsupported and the

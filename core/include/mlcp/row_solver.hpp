@@ -21,8 +21,10 @@
 //     contacts), Boxed (limits, motors), Findex (contacts with friction).
 //  2. choose: the requested name, or for "auto" Policy::choose (policy.hpp) from the class, the
 //     row count, Options::tolerance and whether the step's time budget is spent; plus one rule
-//     with memory per island: after a pivoting answer broke down (Policy::demotes) the island
-//     runs pgs first for its next Policy::pgsAfterBreakdown solves, then pivoting is tried again.
+//     with memory per island: after a pivoting or Newton answer broke down (Policy::demotes; a
+//     solve cut by the time budget counts only when the island's previous solve was cut too)
+//     the island runs pgs first for its next Policy::pgsAfterBreakdown solves, then the
+//     policy's choice is tried again.
 //     Engine rows with cfm = 0 on redundant friction rows (Bullet's CfmModel::Engine) are the
 //     islands that defeat pivoting; the memory keeps them from paying a failed pivoting solve
 //     every step.
