@@ -44,8 +44,8 @@ Method makeMethod(const std::string& name, RowSolverSettings settings);
 // contact nearest to it (a chain through the pair's entries, a few per pair), within the match
 // distance. Why not the rank among the pair's contacts: ODE's box-box collider culls and orders
 // a face's points differently from step to step on a resting pyramid, so the rank pairs points
-// of different corners and leaves most contacts cold (scaled start residuals 1-10; newton then
-// took 5-23 steps a step on ODE's resting 210-box pyramid, 1-4 with the nearest point).
+// of different corners and leaves most contacts cold (docs/benchmarks.md, "ODE's contacts
+// warm-started by position").
 class WarmStartCache {
  public:
   // Fills lambda (size m) for the joint and returns true when a matching entry exists.
