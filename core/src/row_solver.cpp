@@ -420,10 +420,10 @@ IslandSolve RowSolver::solveScreened(const RowSystem& rows, const Vector& start,
     r = run(rows, out.requested, withBudget(settings_.options, share, t0), start, x, island, out);
   if (r.status == Status::InvalidInput || r.status == Status::Unsupported) x = start;
   out.choice = out.requested;
-  if (autoChoice && !cone)
-    island.cutsInRow = r.status == Status::TimeLimit ? island.cutsInRow + 1 : 0;
+  const bool islandMemory = autoChoice && !cone;  // pgsFirst and cutsInRow
+  if (islandMemory) island.cutsInRow = r.status == Status::TimeLimit ? island.cutsInRow + 1 : 0;
   if (!acceptable(r, settings_.acceptResidual)) {
-    if (autoChoice && !cone && !equals(out.requested, "pgs") && !equals(out.requested, "ldlt") &&
+    if (islandMemory && !equals(out.requested, "pgs") && !equals(out.requested, "ldlt") &&
         policy.demotes(r, settings_.acceptResidual, island.cutsInRow))
       island.pgsFirst = policy.pgsAfterBreakdown;
     r = fallBack(rows, start, x, island, out, std::move(r), share, t0);

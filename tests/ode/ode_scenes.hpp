@@ -192,7 +192,6 @@ class Scene {
     }
     s->lastContacts_ += n;
   }
-  int frame_ = 0;
   void record(dJointID j, const dContactGeom& geom) {
     dJointFeedback* fb = nullptr;
     if (contactFeedback) {
@@ -206,6 +205,7 @@ class Scene {
         {j, geom, bodyIndex(dJointGetBody(j, 0)), bodyIndex(dJointGetBody(j, 1)), fb});
   }
   int lastContacts_ = 0;
+  int frame_ = 0;  // steps taken, for rotateContacts
   std::vector<ContactRecord> contactRecords_;
   std::vector<std::unique_ptr<dJointFeedback>> contactFeedbacks_;
 };
