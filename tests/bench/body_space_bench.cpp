@@ -4,7 +4,9 @@
 //
 //   build/bench/body_space_bench [levels...]      (default 10 20 44: 55, 210 and 990 boxes)
 //
-// Per pyramid (tests/common/contact_scenes.hpp BoxPyramid, sliding bodies, cfm 1e-5/dt) the
+// A level count with a trailing s (14s) is a square pyramid (1015 boxes for 14), whose body
+// graph is three-dimensional (larger separators, so larger dense blocks in S's factor). Per
+// pyramid (tests/common/contact_scenes.hpp BoxPyramid, sliding bodies, cfm 1e-5/dt) the
 // clamped and sliding rows are those of newton's answer (tolerance 1e-6, at most 60 steps), S is
 // assembled as newton's steps assemble it (rho = 0), and each method factors it: the block LU
 // (assembly and elimination, in the library's CHOLMOD order) and, on the S it exports, CHOLMOD
@@ -197,9 +199,10 @@ void row(int boxes, int coords, const Sets& sets, bool withSliding, const Csc& s
               cell(ch).c_str(), cell(k).c_str(), cell(u).c_str());
 }
 
-void bench(int levels) {
+void bench(int levels, bool square) {
   mlcp::test::PyramidSpec spec;
   spec.levels = levels;
+  spec.square = square;
   spec.sideVelocity = 0.5;
   mlcp::test::BoxPyramid pyramid(spec);
   const mlcp::RowSystem& rows = pyramid.rows();
@@ -248,13 +251,12 @@ void bench(int levels) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<int> levels;
-  for (int a = 1; a < argc; ++a) levels.push_back(std::atoi(argv[a]));
-  if (levels.empty()) levels = {10, 20, 44};
+  std::vector<std::string> levels(argv + 1, argv + argc);
+  if (levels.empty()) levels = {"10", "20", "44"};
   std::printf("BLAS: %s\n\n", loadedBlas().c_str());
   std::printf(
       "| boxes | S size | clamped rows | sliding rows | S | nnz(S) | block LU | CHOLMOD | KLU | "
       "UMFPACK |\n|---|---|---|---|---|---|---|---|---|---|\n");
-  for (int l : levels) bench(l);
+  for (const std::string& l : levels) bench(std::atoi(l.c_str()), l.back() == 's');
   return 0;
 }

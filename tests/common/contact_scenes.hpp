@@ -3,7 +3,8 @@
 //
 // A pyramid of L levels has L boxes at the bottom, L - 1 above, ..., 1 at the top (L (L + 1) / 2
 // boxes: 15 for L = 5, 55 for L = 10), unit cubes of mass 1 standing in a row along x with a
-// small gap, each upper box resting on the two below it. Every touching face pair (a box and
+// small gap, each upper box resting on the two below it; a square pyramid (PyramidSpec::square)
+// has L x L boxes at the bottom, each upper box on four below. Every touching face pair (a box and
 // the ground, or a box and one below) gets 4 contact points at the corners of the overlap
 // rectangle, and every contact gets three rows, as Bullet and ODE make them:
 //
@@ -39,6 +40,9 @@ struct PyramidSpec {
   double maxDepth = 1e-3;     // penetration depths drawn from [0, maxDepth], m
   double sideVelocity = 0.0;  // random horizontal body velocities up to this, m/s (sliding)
   unsigned seed = 1;
+  // Square levels (L x L boxes at the bottom, each upper box on the corners of four below, as
+  // scenes/pyramid_1000.json) instead of rows along x: a body graph in three dimensions.
+  bool square = false;
 };
 
 class BoxPyramid {
@@ -102,32 +106,42 @@ class BoxPyramid {
     const int L = spec_.levels;
     const double pitch = 1.0 + spec_.gap, g = 9.81;
     std::vector<Eigen::Vector3d> centre, vPre;
-    std::vector<std::vector<int>> level(L);
-    for (int l = 0; l < L; ++l)
-      for (int j = 0; j < L - l; ++j) {
-        level[l].push_back(static_cast<int>(centre.size()));
-        centre.emplace_back((j - 0.5 * (L - l - 1)) * pitch, 0.0, 0.5 + l);
-        Eigen::Vector3d v(uniform(-1, 1), uniform(-1, 1), 0.0);
-        vPre.push_back(spec_.sideVelocity * v + Eigen::Vector3d(0, 0, -g * spec_.dt));
-      }
+    // level[l][i][j]: the box at column i, depth j (depth 0 only for rows along x).
+    std::vector<std::vector<std::vector<int>>> level(L);
+    for (int l = 0; l < L; ++l) {
+      const int w = L - l, depth = spec_.square ? w : 1;
+      level[l].assign(w, std::vector<int>(depth));
+      for (int i = 0; i < w; ++i)
+        for (int j = 0; j < depth; ++j) {
+          level[l][i][j] = static_cast<int>(centre.size());
+          centre.emplace_back((i - 0.5 * (w - 1)) * pitch, (j - 0.5 * (depth - 1)) * pitch,
+                              0.5 + l);
+          Eigen::Vector3d v(uniform(-1, 1), uniform(-1, 1), 0.0);
+          vPre.push_back(spec_.sideVelocity * v + Eigen::Vector3d(0, 0, -g * spec_.dt));
+        }
+    }
     BodyInverseMass unit;
     unit.invMass = 1.0;
     unit.invInertia = 6.0 * Eigen::Matrix3d::Identity();  // unit cube, mass 1: I = 1/6
     rows_.bodies.assign(centre.size(), unit);
-    auto face = [&](int a, int b, double x0, double x1, double z) {
+    // The four corners of the overlap of a's bottom face and b's top face (b < 0: the ground).
+    auto face = [&](int a, int b, double z) {
+      const Eigen::Vector3d& ca = centre[a];
+      const Eigen::Vector3d cb = b >= 0 ? centre[b] : ca;
+      const double x0 = std::max(ca.x(), cb.x()) - 0.5, x1 = std::min(ca.x(), cb.x()) + 0.5;
+      const double y0 = std::max(ca.y(), cb.y()) - 0.5, y1 = std::min(ca.y(), cb.y()) + 0.5;
       for (double x : {x0, x1})
-        for (double y : {-0.5, 0.5}) contact(a, b, Eigen::Vector3d(x, y, z), centre, vPre);
+        for (double y : {y0, y1}) contact(a, b, Eigen::Vector3d(x, y, z), centre, vPre);
     };
-    for (int a : level[0]) face(a, -1, centre[a].x() - 0.5, centre[a].x() + 0.5, 0.0);
+    for (const auto& column : level[0])
+      for (int a : column) face(a, -1, 0.0);
+    const int below = spec_.square ? 2 : 1;  // supporting boxes per upper box along y
     for (int l = 1; l < L; ++l)
-      for (int j = 0; j < static_cast<int>(level[l].size()); ++j) {
-        const int a = level[l][j];
-        for (int b : {level[l - 1][j], level[l - 1][j + 1]}) {
-          const double x0 = std::max(centre[a].x(), centre[b].x()) - 0.5;
-          const double x1 = std::min(centre[a].x(), centre[b].x()) + 0.5;
-          face(a, b, x0, x1, static_cast<double>(l));
-        }
-      }
+      for (size_t i = 0; i < level[l].size(); ++i)
+        for (size_t j = 0; j < level[l][i].size(); ++j)
+          for (int di = 0; di < 2; ++di)
+            for (int dj = 0; dj < below; ++dj)
+              face(level[l][i][j], level[l - 1][i + di][j + dj], static_cast<double>(l));
     const int n = static_cast<int>(rows_.rows.size());
     rows_.b = Eigen::Map<Vector>(base_.data(), n);
     rows_.lo = Eigen::Map<Vector>(lo_.data(), n);

@@ -1170,9 +1170,10 @@ TEST(DantzigBody, SweepInBodySpaceIsTheSweepOnA) {
 
 // K = D + J_C W G_C^T solved in body space equals K built from the assembled A and solved densely:
 // random clamped sets with sliding rows, a body with a singular (locked-axis) inertia, a static
-// body; no sliding rows gives the symmetric case. cfm_c + rho below the limit declines.
-TEST(DantzigBody, SolvesTheClampedSystemOfTheAssembledProblem) {
-  test::BoxPyramid pyramid(slidingPyramid(4));
+// body; no sliding rows gives the symmetric case. cfm_c + rho below the limit declines. A row
+// pyramid's body graph is a path of short cycles; a square pyramid's fills in three dimensions.
+void expectClampedSystemSolved(const test::PyramidSpec& spec) {
+  test::BoxPyramid pyramid(spec);
   RowSystem rows = pyramid.rows();
   // Box 0: rotation about a tilted axis locked (rank-2 inverse inertia); box 1: static.
   const Eigen::Vector3d axis = Eigen::Vector3d(1, 2, 3).normalized();
@@ -1227,6 +1228,13 @@ TEST(DantzigBody, SolvesTheClampedSystemOfTheAssembledProblem) {
     EXPECT_LE((K * y - r).norm(), 1e-14 * K.norm() * y.norm()) << trial;
     EXPECT_FALSE(body.factor(order, pos, sliding, coeff, p.findex, rho, 1.0)) << trial;
   }
+}
+
+TEST(DantzigBody, SolvesTheClampedSystemOfTheAssembledProblem) {
+  expectClampedSystemSolved(slidingPyramid(4));
+  test::PyramidSpec square = slidingPyramid(3);
+  square.square = true;
+  expectClampedSystemSolved(square);
 }
 
 // The block stage with the problem's rows (Solver::useRows, as RowSolver passes them) factors in
