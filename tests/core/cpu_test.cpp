@@ -1,6 +1,7 @@
 // mlcp/cpu.hpp: the CPU path can be read and set, and RowPgs' baseline and AVX2 variants of the
 // packing, sweeps and check give the same answers bit for bit, through the RowSystem entry point
-// and through the engine entry point (rows read in place).
+// and through the engine entry point (rows read in place), as do those of newton's body-space
+// elimination.
 #include "mlcp/cpu.hpp"
 
 #include <gtest/gtest.h>
@@ -17,6 +18,7 @@
 #include "common/contact_scenes.hpp"
 #include "common/cpu_path_guard.hpp"
 #include "common/row_source.hpp"
+#include "mlcp/newton.hpp"
 #include "mlcp/rows.hpp"
 
 namespace mlcp {
@@ -148,6 +150,36 @@ TEST(CpuPath, BaselineAndAvx2GiveTheSameBits) {
       for (int j = 0; j < 6; ++j)
         EXPECT_TRUE(sameBits(a.velocityChanges[k][j], b.velocityChanges[k][j])) << k << "/" << j;
   }
+}
+
+// newton's body-space factorizations (the block LU's updates, linalg/block_update.hpp) on a
+// square pyramid, whose factor fills: the same iterates on both paths.
+TEST(CpuPath, BodySpaceEliminationGivesTheSameBits) {
+  if (!cpuPathAvailable(CpuPath::Avx2)) GTEST_SKIP() << "no AVX2 variant on this build or CPU";
+  CpuPathGuard guard;
+  test::PyramidSpec spec;
+  spec.levels = 5;
+  spec.square = true;
+  spec.sideVelocity = 0.3;
+  test::BoxPyramid pyramid(spec);
+  const Problem p = pyramid.rows().assemble(true);
+  Vector x[2];
+  Result r[2];
+  for (int path = 0; path < 2; ++path) {
+    ASSERT_TRUE(setCpuPath(path == 0 ? CpuPath::Baseline : CpuPath::Avx2));
+    NewtonSolver newton;
+    newton.options().tolerance = 1e-9;
+    newton.useRows(&pyramid.rows());
+    r[path] = newton.solve(p, x[path]);
+    EXPECT_GT(newton.bodyFactorizations(), 0);
+  }
+  EXPECT_EQ(r[0].iterations, r[1].iterations);
+  EXPECT_TRUE(sameBits(r[0].residual, r[1].residual)) << r[0].residual << " " << r[1].residual;
+  ASSERT_EQ(x[0].size(), p.size());
+  ASSERT_EQ(x[1].size(), p.size());
+  int differ = 0;
+  for (int i = 0; i < p.size(); ++i) differ += !sameBits(x[0][i], x[1][i]);
+  EXPECT_EQ(differ, 0);
 }
 
 }  // namespace

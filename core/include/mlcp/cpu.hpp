@@ -1,7 +1,9 @@
-// mlcp/cpu.hpp: which machine code RowPgs' hot loops run.
+// mlcp/cpu.hpp: which machine code the hot loops run.
 //
 // RowPgs (rows.hpp) spends a fixed-sweep solve in three loops: the packing of the engine's rows,
-// the sweeps and the residual check. On x86-64 with GCC each of them is compiled twice, for the
+// the sweeps and the residual check; newton on a large island spends most of its steps in one
+// loop, the block updates of its body-space factorization (core/src/linalg/block_update.hpp).
+// On x86-64 with GCC each of them is compiled twice, for the
 // baseline x86-64 (SSE2, what a distribution's packages target) and with AVX2, and the AVX2 code
 // runs where the CPU has it. Both are the same source: the same operations in the same order,
 // and no fused multiply-adds (the AVX2 variant does not enable FMA, and every target of this
@@ -9,8 +11,9 @@
 // they give the same answers bit for bit (tests/core/cpu_test.cpp, and a Bullet pyramid stepped
 // under both in tests/bullet/plumbing_test.cpp); only the time differs. The AVX2 code uses the
 // VEX encodings throughout and 4-wide vectors for the sweep's and the check's 12-wide row
-// products and velocity updates (core/src/rows/row_simd.hpp). AVX2 is chosen for these loops alone
-// because they are where fixed-sweep pgs spends its time; building the whole library for
+// products and velocity updates (core/src/rows/row_simd.hpp), and for the 6 x 6 block products of
+// the factorization. AVX2 is chosen for these loops alone because they are where fixed-sweep pgs
+// and newton's large steps spend their time; building the whole library for
 // x86-64-v3 gains about what this dispatch gains (docs/decisions.md). docs/benchmarks.md has
 // the times of both paths (bullet_bench --pgs-vs-si, MLCP_CPU_PATH=baseline).
 //

@@ -4,7 +4,9 @@
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
+#include "linalg/block_update.hpp"
 #include "linalg/ordering.hpp"
 #include "mlcp/pgs.hpp"
 
@@ -221,6 +223,7 @@ bool BodySpaceSystem::eliminate() {
   // U is symmetric positive definite without sliding rows, near it with them).
   constexpr double kPivot = 1e-12;
   const int* update = updates_.data();
+  static_assert(std::is_same_v<Block, Block6>);
   for (int k = 0; k < bodies_; ++k) {
     const Eigen::PartialPivLU<Block> lu(blocks_[k]);
     const double scale = std::max(1.0, blocks_[k].cwiseAbs().maxCoeff());
@@ -228,10 +231,8 @@ bool BodySpaceSystem::eliminate() {
     inverse_[k] = lu.inverse();
     const int first = belowStart_[k], last = belowStart_[k + 1];
     for (int a = first; a < last; ++a) lower(a) = lower(a) * inverse_[k];
-    for (int a = first; a < last; ++a) {
-      const Block& lak = lower(a);
-      for (int b = first; b < last; ++b) blocks_[*update++].noalias() -= lak * upper(b);
-    }
+    subtractPivotProducts(blocks_.data(), bodies_ + 2 * first, last - first, update);
+    update += (last - first) * (last - first);
   }
   return inverse_.empty() || inverse_.back().allFinite();
 }

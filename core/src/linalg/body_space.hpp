@@ -25,8 +25,11 @@
 // is about a tenth of a sparse LU of K on the rows. Why a block LU of our own and not a library's
 // factorization of S: on the pyramids' S (330 to 6090 coordinates) it is faster than CHOLMOD's
 // supernodal Cholesky (which would serve only S without sliding rows), KLU and UMFPACK, with
-// reference BLAS or OpenBLAS (docs/benchmarks.md, "Body space: the factorization of S"). Memory
-// is O(fill blocks + elimination updates); no limit on the bodies.
+// reference BLAS or OpenBLAS (docs/benchmarks.md, "Body space: the factorization of S"), also on
+// a square pyramid's three-dimensional body graph, whose top separators make dense blocks of
+// hundreds of coordinates. Its block updates run in AVX2 where the CPU has it (mlcp/cpu.hpp,
+// linalg/block_update.hpp). Memory is O(fill blocks + elimination updates); no limit on the
+// bodies.
 #pragma once
 
 #include <Eigen/Dense>
