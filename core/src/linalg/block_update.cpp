@@ -7,17 +7,6 @@ namespace mlcp::detail {
 
 namespace {
 
-// c - m s, entry by entry (m in registers).
-template <bool Wide>
-[[gnu::always_inline]] inline Six<Wide> subScaled(const Six<Wide>& c, const Six<Wide>& m,
-                                                  double s) {
-  const D2 s2 = {s, s};
-  if constexpr (Wide)
-    return {c.head - m.head * D4{s, s, s, s}, c.tail - m.tail * s2};
-  else
-    return {c.p0 - m.p0 * s2, c.p1 - m.p1 * s2, c.p2 - m.p2 * s2};
-}
-
 // c -= l u on column-major 6 x 6 blocks (block_update.hpp has the order of operations).
 template <bool Wide>
 [[gnu::always_inline]] inline void subtractProduct(double* c, const double* l, const double* u) {

@@ -2,8 +2,8 @@
 // C_ab -= L_ak U_kb of every pair (a, b) of the bodies below it, on 6 x 6 column-major blocks.
 // Internal to the library.
 //
-// The elimination spends most of its time here: on a square pyramid of 1015 boxes (scenes/
-// pyramid_1000.json) about 900k updates of 216 multiply-adds per factorization. Each column j
+// The elimination spends most of its time here: 216 multiply-adds per update, and the updates
+// number the sum over pivots of the squared count of blocks below them. Each column j
 // of C is one 6-vector (rows/row_simd.hpp's Six) and takes c_j = c_j - L_k u_kj for k = 0..5 in
 // that order, L's six columns held in registers across the six columns of U: three 2-wide SSE2
 // multiplies and subtractions a term on the baseline, a 4-wide and a 2-wide AVX pair in the AVX2

@@ -4,9 +4,7 @@
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <cmath>
-#include <type_traits>
 
-#include "linalg/block_update.hpp"
 #include "linalg/ordering.hpp"
 #include "mlcp/pgs.hpp"
 
@@ -223,7 +221,6 @@ bool BodySpaceSystem::eliminate() {
   // U is symmetric positive definite without sliding rows, near it with them).
   constexpr double kPivot = 1e-12;
   const int* update = updates_.data();
-  static_assert(std::is_same_v<Block, Block6>);
   for (int k = 0; k < bodies_; ++k) {
     const Eigen::PartialPivLU<Block> lu(blocks_[k]);
     const double scale = std::max(1.0, blocks_[k].cwiseAbs().maxCoeff());

@@ -37,6 +37,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "block_update.hpp"
 #include "mlcp/problem.hpp"
 #include "mlcp/rows.hpp"
 
@@ -92,7 +93,7 @@ class BodySpaceSystem {
   }
 
  private:
-  using Block = Eigen::Matrix<double, 6, 6>;
+  using Block = Block6;  // linalg/block_update.hpp's, whose kernel updates blocks_
   struct RowData {
     int a = -1, b = -1;  // dynamic bodies in elimination order, -1: none
     double jr[12];       // [J_A R_A, J_B R_B]

@@ -72,6 +72,16 @@ template <bool Wide>
   else
     return {a.p0 + load2(m) * s2, a.p1 + load2(m + 2) * s2, a.p2 + load2(m + 4) * s2};
 }
+// c - m s, entry by entry (m in registers).
+template <bool Wide>
+[[gnu::always_inline]] inline Six<Wide> subScaled(const Six<Wide>& c, const Six<Wide>& m,
+                                                  double s) {
+  const D2 s2 = {s, s};
+  if constexpr (Wide)
+    return {c.head - m.head * D4{s, s, s, s}, c.tail - m.tail * s2};
+  else
+    return {c.p0 - m.p0 * s2, c.p1 - m.p1 * s2, c.p2 - m.p2 * s2};
+}
 template <bool Wide>
 [[gnu::always_inline]] inline Six<Wide> add(const Six<Wide>& a, const Six<Wide>& b) {
   if constexpr (Wide)
