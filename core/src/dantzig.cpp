@@ -662,9 +662,17 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
     result.message = "block stage: " + blockMessage + "; time budget spent before pivoting";
     return;
   }
+  if (blockIterate) blockBest_ = x;
   runPivoting(problem, x, result, blockIterate);
   result.iterations += blockSteps_;
   result.message = "block stage: " + blockMessage + "; pivoting: " + result.message;
+  // Pivoting cut short (time, pivot limit, a breakdown) can end worse than the block stage's
+  // best iterate, which is then the answer: never worse than what the solve had found.
+  if (blockIterate && result.status != Status::Converged &&
+      residual(problem, blockBest_) < residual(problem, x)) {
+    x = blockBest_;
+    result.message += "; the block stage's iterate is lower: returned";
+  }
 }
 
 void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& result, bool fromBlock) {

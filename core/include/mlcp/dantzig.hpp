@@ -129,7 +129,8 @@
 // The stage ends when the residual (residual.hpp) is within Options::tolerance (then it is the
 // answer, projected onto the bounds when that keeps it within tolerance: Result::iterations counts
 // its steps), or after DantzigParams::maxBlockSteps, no descent, a singular damped block or the
-// time budget: then the best iterate is handed to the incremental pivoting below as its warm start.
+// time budget: then the best iterate is handed to the incremental pivoting below as its warm start,
+// and stays the answer when the pivoting ends unconverged at a larger residual.
 // Starts of the block stage. A warm start takes a few projected sweeps first
 // (DantzigParams::blockPgsSweeps, up to blockPgsResidual) when its residual is large, so that the
 // first sets come from an iterate that already places most rows; a guess within
@@ -309,6 +310,7 @@ class DantzigSolver : public Solver {
   int blockBodyFactorizations_ = 0;
   const RowSystem* rows_ = nullptr;
   bool blockSettled_ = false;
+  Vector blockBest_;  // the block stage's best iterate while pivoting continues from it
   ColdTrialMemory* coldMemory_ = nullptr;  // lent per solve (useColdTrialMemory)
 };
 
