@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <vector>
 
 #include "mlcp/pgs.hpp"
 #include "newton_system.hpp"
@@ -30,6 +31,10 @@ struct NewtonSolver::Work {
   detail::NewtonSystem system;
   Point at, trial, best;
   Vector dx, g, jg, invDiag;
+  // The merits of the iterates so far, and the line search's reference: the largest of the
+  // current one and the NewtonParams::nonmonotoneMemory before it.
+  std::vector<double> merits;
+  double reference = kInf;
 };
 
 NewtonSolver::NewtonSolver() : work_(std::make_unique<Work>()) {}
@@ -42,8 +47,9 @@ int NewtonSolver::bodyFactorizations() const { return work_->system.bodyFactoriz
 void NewtonSolver::useRows(const RowSystem* rows) { work_->system.useRows(rows); }
 
 // Backtracking from t = 1 along wk.dx from wk.at: the first t = 2^-k (k <= the halvings) with
-// ||H(x + t dx)||^2 <= ||H(x)||^2 + sigma t slope (slope < 0, the directional derivative). On
-// success wk.trial holds the point; returns the halvings taken, or -1.
+// ||H(x + t dx)||^2 <= reference + sigma t slope (slope < 0, the directional derivative;
+// reference: Work::reference). On success wk.trial holds the point; returns the halvings taken,
+// or -1.
 int NewtonSolver::lineSearch(const Problem& pb, double slope) {
   Work& wk = *work_;
   if (!(slope < 0)) return -1;
@@ -52,9 +58,19 @@ int NewtonSolver::lineSearch(const Problem& pb, double slope) {
     const double t = std::ldexp(1.0, -k);
     wk.trial.x = wk.at.x + t * wk.dx;
     wk.trial.evaluate(pb, wk.system);
-    if (wk.trial.theta <= wk.at.theta + kArmijo * t * slope) return k;
+    if (wk.trial.theta <= wk.reference + kArmijo * t * slope) return k;
   }
   return -1;
+}
+
+// Records the current merit and sets the line search's reference to the largest of it and the
+// last NewtonParams::nonmonotoneMemory merits before it (newton.hpp "Step").
+void NewtonSolver::setReference() {
+  Work& wk = *work_;
+  wk.merits.push_back(wk.at.theta);
+  const std::size_t count =
+      std::min(wk.merits.size(), std::size_t(1) + std::max(0, params_.nonmonotoneMemory));
+  wk.reference = *std::max_element(wk.merits.end() - count, wk.merits.end());
 }
 
 // The directional derivative of ||H||^2 at wk.at along wk.dx: 2 (J^T H) . dx.
@@ -145,6 +161,7 @@ void NewtonSolver::run(const Problem& pb, Vector& x, Result& result) {
   wk.at.evaluate(pb, wk.system);
   double mu = params_.proximal;
   int stalls = 0, sinceBest = 0;
+  wk.merits.clear();
   std::ostringstream os;
   for (int step = 0;; ++step) {
     if (wk.at.inf < wk.best.inf) {
@@ -174,6 +191,7 @@ void NewtonSolver::run(const Problem& pb, Vector& x, Result& result) {
       break;
     }
     result.iterations = step + 1;
+    setReference();
     wk.system.linearize(wk.at.x, wk.at.w);
     if (newtonStep(pb, res, rhoScale, mu)) {
       stalls = 0;

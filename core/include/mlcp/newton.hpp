@@ -29,9 +29,18 @@
 //
 // and the step is x + t dx with t = 1, 1/2, ... (NewtonParams::maxHalvings halvings at most,
 // sparseMaxHalvings on the sparse path),
-// the first t with Armijo's rule on the merit theta = ||H||_2^2,
+// the first t with the non-monotone Armijo rule (Grippo, Lampariello and Lucidi) on the merit
+// theta = ||H||_2^2,
 //
-//     theta(x + t dx) <= theta(x) + sigma t theta'(x; dx),   theta' = 2 (J^T H) . dx, sigma 1e-4.
+//     theta(x + t dx) <= max(theta(x_k), ..., theta(x_k-m)) + sigma t theta'(x; dx),
+//     theta' = 2 (J^T H) . dx,   sigma 1e-4,   m = NewtonParams::nonmonotoneMemory (1).
+//
+// Why non-monotone: where many friction rows slide (Bullet's resting pyramids) the full step
+// crosses kinks of H and raises theta a little before the next step lowers it far; the monotone
+// rule halves such steps and raises the proximal weight, and the iterates then crawl (1% a step
+// over tens of steps at residuals ~1e-4). A memory of one merit lets the full step through
+// (docs/benchmarks.md, "newton's non-monotone line search"); longer memories let bad steps
+// through too. The best iterate is kept either way.
 //
 // rho is a proximal (Levenberg-Marquardt) weight on the sparse path,
 //
@@ -153,6 +162,9 @@ struct NewtonParams {
   int maxStalls = 3;
   // Steps in a row without a new best iterate before the solve stops (Failed). Default 50.
   int maxStagnation = 50;
+  // Merits before the current one that the line search's reference takes the largest of (the
+  // non-monotone rule of "Step" above); 0: monotone Armijo. Default 1.
+  int nonmonotoneMemory = 1;
 };
 
 class NewtonSolver : public Solver {
@@ -182,6 +194,7 @@ class NewtonSolver : public Solver {
  private:
   struct Work;
   int lineSearch(const Problem& problem, double slope);
+  void setReference();
   double slope();
   bool newtonStep(const Problem& problem, double res, double rhoScale, double& mu);
   bool fallbackStep(const Problem& problem, bool sweeps);
