@@ -27,10 +27,17 @@ struct NewtonSolver::Work {
       system.slack(x, w);
       theta = detail::naturalMap(pb, x, w, h, inf);
     }
+    // The point from + t dx, its slack from + t A dx (adx): O(n), no product with A.
+    void evaluateAlong(const Problem& pb, const Point& from, double t, const Vector& dx,
+                       const Vector& adx) {
+      x = from.x + t * dx;
+      w = from.w + t * adx;
+      theta = detail::naturalMap(pb, x, w, h, inf);
+    }
   };
   detail::NewtonSystem system;
   Point at, trial, best;
-  Vector dx, g, jg, invDiag;
+  Vector dx, adx, g, jg, invDiag;  // adx = A dx
   // The merits of the iterates so far, and the line search's reference: the largest of the
   // current one and the NewtonParams::nonmonotoneMemory before it.
   std::vector<double> merits;
@@ -54,10 +61,10 @@ int NewtonSolver::lineSearch(const Problem& pb, double slope) {
   Work& wk = *work_;
   if (!(slope < 0)) return -1;
   const int halvings = wk.system.isSparse() ? params_.sparseMaxHalvings : params_.maxHalvings;
+  wk.system.product(wk.dx, wk.adx);
   for (int k = 0; k <= halvings; ++k) {
     const double t = std::ldexp(1.0, -k);
-    wk.trial.x = wk.at.x + t * wk.dx;
-    wk.trial.evaluate(pb, wk.system);
+    wk.trial.evaluateAlong(pb, wk.at, t, wk.dx, wk.adx);
     if (wk.trial.theta <= wk.reference + kArmijo * t * slope) return k;
   }
   return -1;

@@ -125,12 +125,18 @@ void NewtonSystem::sweep(const Vector& invDiag, Vector& x) {
 bool NewtonSystem::symmetric() const { return bodyReady_ || symmetricMatrix(*problem_); }
 
 void NewtonSystem::slack(const Vector& x, Vector& w) const {
-  if (!bodyProducts_) {
-    w = problem_->slack(x);
-    return;
-  }
-  body_->multiply(x, w);
+  product(x, w);
   w += problem_->b;
+}
+
+void NewtonSystem::product(const Vector& v, Vector& out) const {
+  if (bodyProducts_) {
+    body_->multiply(v, out);
+  } else if (problem_->isSparse()) {
+    out.noalias() = problem_->sparseA() * v;
+  } else {
+    out.noalias() = problem_->denseA() * v;
+  }
 }
 
 int NewtonSystem::linearize(const Vector& x, const Vector& w) {

@@ -49,6 +49,8 @@ class NewtonSystem {
   // w = A x + b of the prepared problem: in body space when its products apply there (rows
   // given, every cfm > 0: 12 multiply-adds a row instead of A's row), else from A.
   void slack(const Vector& x, Vector& w) const;
+  // out = A v (slack() without b).
+  void product(const Vector& v, Vector& out) const;
   // One projected Gauss-Seidel sweep (omega 1) on the prepared problem: in body space when its
   // products apply there (as slack()), else detail::pgsSweep on A.
   void sweep(const Vector& invDiag, Vector& x);

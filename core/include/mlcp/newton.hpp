@@ -79,8 +79,8 @@
 // normals) holds from one factorization to the next: the retries of one step with a larger rho
 // and the last steps of a converging solve reuse it. The LU is taken on K's rows as the
 // columns of K^T and solved transposed, so no transposed copy is made. A step costs one
-// assembly of K (O(nnz A)), its factorization, one solve, one product with J^T, and one
-// product with A per trial step length.
+// assembly of K (O(nnz A)), its factorization, one solve, one product with J^T and one with A
+// (A dx); each trial step length then costs O(n), its slack being w + t A dx.
 //
 // Body space. A problem that comes with its rows (Solver::useRows: RowSolver, hence both
 // adapters; A = J W J^T + diag(cfm)) factors the same K + rho I in body space instead
