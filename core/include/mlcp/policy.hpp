@@ -64,7 +64,7 @@ namespace mlcp {
 
 // The solver for contact islands above Policy::smallIslandRows rows at a tight tolerance.
 inline constexpr const char* kLargeIslandSolver = "newton";
-// The solver that continues its answers when they end short of the tolerance.
+// The solver that continues kLargeIslandSolver's answers when they end short of the tolerance.
 inline constexpr const char* kPolishSolver = "dantzig";
 
 // What the policy picked, and why in words (for Result::message). Static strings, or (solver)
@@ -93,10 +93,11 @@ struct Policy {
   // falls back for that solve only, without the pgsAfterBreakdown memory. Default 10.
   double nearMiss = 10;
   // Solver that continues a largeIslandSolver answer that did not converge, warm-started from
-  // it, for at most the time that answer took (RowSolver, row_solver.hpp, stage 3); "" for
-  // none. Default kPolishSolver ("dantzig"): from newton's last iterate, whose pieces are nearly
-  // the answer's, pivoting exchanges the few rows newton's line search keeps crossing (Bullet's
-  // resting pyramids, where hundreds of friction rows slide) and ends exact.
+  // it, in what is left of the island's time budget (RowSolver, row_solver.hpp, stage 3; not
+  // without a budget); "" for none. Default kPolishSolver ("dantzig"): from newton's last iterate,
+  // whose pieces are nearly the answer's, pivoting exchanges the few rows newton's line search
+  // keeps crossing (Bullet's resting pyramids, where hundreds of friction rows slide) and ends
+  // exact.
   std::string polishSolver = kPolishSolver;
 
   // The choice for a problem of this class and size. positiveDiagonal: every A_ii > 0 (always
