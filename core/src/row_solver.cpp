@@ -55,6 +55,14 @@ std::string ChoiceCounts::toString() const {
 
 // --- the row solver -------------------------------------------------------------------------
 
+namespace {
+// The largest residual of a start that stage 3 returns unsolved: rounding's level, not the
+// tolerance's, so that an exact method's answers stay exact (a last answer within the tolerance
+// is still solved again: returned as it is, each step's answer would lag its problem by up to
+// the tolerance).
+constexpr double kExactStart = 1e-13;
+}  // namespace
+
 // What is kept per island: its assembled-problem solvers by name, when it was last solved, how
 // many more `auto` solves run pgs first after a pivoting answer broke down, and how many of its
 // last `auto` solves in a row the time budget cut.
@@ -215,6 +223,8 @@ Result RowSolver::run(const RowSystem& rows, const std::string& name, const Opti
     if (r.status == Status::TimeLimit) keepStartIfBetter(rows, start, x, r, o.tolerance);
     return r;
   }
+  Result done;
+  if (startSolves(rows, start, o.tolerance, x, done)) return done;
   // Every assembled-problem solver follows the storage (ldlt: dense or sparse LDL^T).
   const bool sparse = rows.size() > settings_.denseMaxRows;
   if (!haveAssembled_ || assembled_.isSparse() != sparse) {
@@ -243,6 +253,21 @@ Result RowSolver::run(const RowSystem& rows, const std::string& name, const Opti
   solver->useRows(&rows);
   if (dantzig) dantzig->useColdTrialMemory(&island.coldTrial);
   return solver->solveWithGuess(assembled_, start, x);
+}
+
+bool RowSolver::startSolves(const RowSystem& rows, const Vector& start, double tolerance, Vector& x,
+                            Result& r) {
+  if (start.size() != rows.size()) return false;  // the solver reports the wrong size
+  const Accuracy a = accuracy(start, rows.slack(start), rows.lo, rows.hi, rows.findex,
+                              rows.b.lpNorm<Eigen::Infinity>());
+  if (!a.finite || !(a.residual <= std::min(tolerance, kExactStart))) return false;
+  x = start;
+  r = Result{};
+  r.status = Status::Converged;
+  r.iterations = 0;
+  applyAccuracy(r, a, tolerance);
+  r.message = "the start is within the tolerance";
+  return true;
 }
 
 void RowSolver::keepStartIfBetter(const RowSystem& rows, const Vector& start, Vector& x, Result& r,

@@ -274,6 +274,39 @@ TEST(RowSolver, AssemblyTimingIsOptional) {
   EXPECT_GT(sb.result.seconds, 0.0);  // the island is still timed as a whole
 }
 
+// Regression (Bullet's BasicDemo: a block of touching boxes in free fall, every contact's answer
+// 0, cost 17 ms a step in assembly and solver set-up for answers the start already had).
+TEST(RowSolver, AStartThatSolvesTheRowsIsTheAnswerWithoutAssembly) {
+  for (const char* name : {"auto", "dantzig", "newton", "lemke"}) {
+    RowSolverSettings settings;
+    settings.solver = name;
+    settings.options.tolerance = 1e-6;
+    RowSolver solver(settings);
+    RowSystem rows = boxOnGround(true);
+    for (int i = 0; i < 4; ++i) rows.b[i] = 0.2;  // the contacts separate: x = 0 is the answer
+    Vector x;
+    const Vector zero = Vector::Zero(rows.size());
+    const IslandSolve free = solver.solve(rows, zero, x);
+    EXPECT_EQ(free.result.status, Status::Converged) << name;
+    EXPECT_EQ(free.result.message, "the start is within the tolerance") << name;
+    EXPECT_EQ(free.result.iterations, 0) << name;
+    EXPECT_EQ(free.assembleSeconds, 0.0) << name;
+    EXPECT_TRUE(free.accepted);
+    EXPECT_TRUE((x.array() == 0).all()) << name;
+    EXPECT_EQ(free.result.residual, rowResidual(rows, x)) << name;
+    // A start within the tolerance but not exact is solved (exact answers stay exact).
+    for (double push : {1e-9, 0.1}) {
+      Vector near = zero;
+      near[0] = push;
+      ASSERT_GT(rowResidual(rows, near), 1e-13);
+      const IslandSolve solved = solver.solve(rows, near, x);
+      EXPECT_NE(solved.result.message, "the start is within the tolerance") << name << push;
+      EXPECT_GT(solved.assembleSeconds, 0.0) << name << push;
+      EXPECT_LE(rowResidual(rows, x), 1e-6) << name << push;
+    }
+  }
+}
+
 TEST(RowSolver, CaptureWritesEachIslandsProblem) {
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / ("row_solver_capture_" + std::to_string(::getpid()));

@@ -231,6 +231,7 @@ const Expected kScenes[] = {
     {"hull_stack", 9, 8, 0},
     {"slide_diagonal", 2, 1, 0},  // the friction models' anisotropy
     {"wall_120", 121, 120, 0},
+    {"basic_demo", 126, 125, 0},  // Bullet's BasicDemo
 };
 
 TEST(SceneFiles, EveryFileIsListedAndLoadsWithItsCounts) {

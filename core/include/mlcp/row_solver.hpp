@@ -32,7 +32,13 @@
 //     no matrix); every other name gets A assembled once per island, dense up to denseMaxRows
 //     rows and sparse above. Solver objects live per island key and name, so the sparse analyses
 //     of ldlt and dantzig (ordering, elimination tree) are redone only when that island's
-//     pattern changes, and RowPgs' buffers are reused.
+//     pattern changes, and RowPgs' buffers are reused. A start that already solves the rows to
+//     rounding (residual <= min(tolerance, 1e-13)) is the answer of every solver but pgs (whose
+//     own first check finds it): one product through the rows instead of an assembly and a
+//     solver's set-up. Such starts are common in real content: touching bodies that nothing
+//     presses together (Bullet's BasicDemo block in free fall: every contact's answer is 0). A
+//     start that is only within the tolerance is solved again, so that exact methods' answers
+//     stay exact and do not lag their problems.
 //     Polish ("auto" under a time budget): when the policy's largeIslandSolver (newton) ends
 //     short of the tolerance with a finite residual, Policy::polishSolver (dantzig) continues
 //     from newton's answer with what is left of the island's share, and its answer replaces
@@ -315,6 +321,10 @@ class RowSolver {
   bool buildCone(const RowSystem& rows, const Vector& start, IslandSolve& out);
   Result solveCone(const Vector& start, Vector& x, Slot& island, IslandSolve& out, double share,
                    double t0);
+  // Whether the start already solves the rows to rounding (see stage 3); then x and r are that
+  // answer.
+  static bool startSolves(const RowSystem& rows, const Vector& start, double tolerance, Vector& x,
+                          Result& r);
   // A time-limited answer x is replaced by the start when the start's residual is lower.
   static void keepStartIfBetter(const RowSystem& rows, const Vector& start, Vector& x, Result& r,
                                 double tolerance);
