@@ -56,11 +56,13 @@ std::string ChoiceCounts::toString() const {
 // --- the row solver -------------------------------------------------------------------------
 
 namespace {
-// The largest residual of a start that stage 3 returns unsolved: rounding's level, not the
-// tolerance's, so that an exact method's answers stay exact (a last answer within the tolerance
-// is still solved again: returned as it is, each step's answer would lag its problem by up to
-// the tolerance).
-constexpr double kExactStart = 1e-13;
+// The largest residual of a start that stage 3 returns unsolved: kExactStart times the tolerance,
+// at most kExactStartLimit. Exact methods' answers stay exact: the stock pivoting solvers' answers
+// are at 1e-16..1e-13, ours within 1e-12 of theirs (the engine tests), and a last answer merely
+// within the tolerance is solved again (returned as it is, each step's answer would lag its
+// problem by up to the tolerance).
+constexpr double kExactStart = 1e-4;
+constexpr double kExactStartLimit = 1e-12;
 }  // namespace
 
 // What is kept per island: its assembled-problem solvers by name, when it was last solved, how
@@ -260,7 +262,8 @@ bool RowSolver::startSolves(const RowSystem& rows, const Vector& start, double t
   if (start.size() != rows.size()) return false;  // the solver reports the wrong size
   const Accuracy a = accuracy(start, rows.slack(start), rows.lo, rows.hi, rows.findex,
                               rows.b.lpNorm<Eigen::Infinity>());
-  if (!a.finite || !(a.residual <= std::min(tolerance, kExactStart))) return false;
+  if (!a.finite || !(a.residual <= std::min(kExactStart * tolerance, kExactStartLimit)))
+    return false;
   x = start;
   r = Result{};
   r.status = Status::Converged;

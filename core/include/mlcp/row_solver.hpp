@@ -32,10 +32,10 @@
 //     no matrix); every other name gets A assembled once per island, dense up to denseMaxRows
 //     rows and sparse above. Solver objects live per island key and name, so the sparse analyses
 //     of ldlt and dantzig (ordering, elimination tree) are redone only when that island's
-//     pattern changes, and RowPgs' buffers are reused. A start that already solves the rows to
-//     rounding (residual <= min(tolerance, 1e-13)) is the answer of every solver but pgs (whose
-//     own first check finds it): one product through the rows instead of an assembly and a
-//     solver's set-up. Such starts are common in real content: touching bodies that nothing
+//     pattern changes, and RowPgs' buffers are reused. A start that already solves the rows far
+//     within the tolerance (residual <= min(1e-4 tolerance, 1e-12)) is the answer of every solver
+//     but pgs (whose own first check finds it): one product through the rows instead of an assembly
+//     and a solver's set-up. Such starts are common in real content: touching bodies that nothing
 //     presses together (Bullet's BasicDemo block in free fall: every contact's answer is 0). A
 //     start that is only within the tolerance is solved again, so that exact methods' answers
 //     stay exact and do not lag their problems.
@@ -321,8 +321,8 @@ class RowSolver {
   bool buildCone(const RowSystem& rows, const Vector& start, IslandSolve& out);
   Result solveCone(const Vector& start, Vector& x, Slot& island, IslandSolve& out, double share,
                    double t0);
-  // Whether the start already solves the rows to rounding (see stage 3); then x and r are that
-  // answer.
+  // Whether the start already solves the rows far within the tolerance (see stage 3); then x and r
+  // are that answer.
   static bool startSolves(const RowSystem& rows, const Vector& start, double tolerance, Vector& x,
                           Result& r);
   // A time-limited answer x is replaced by the start when the start's residual is lower.
