@@ -63,6 +63,8 @@ namespace {
 // problem by up to the tolerance).
 constexpr double kExactStart = 1e-4;
 constexpr double kExactStartLimit = 1e-12;
+// IslandSolve::choice of an island that the start answered (no solver ran).
+constexpr const char* kStartChoice = "start";
 }  // namespace
 
 // What is kept per island: its assembled-problem solvers by name, when it was last solved, how
@@ -226,7 +228,10 @@ Result RowSolver::run(const RowSystem& rows, const std::string& name, const Opti
     return r;
   }
   Result done;
-  if (startSolves(rows, start, o.tolerance, x, done)) return done;
+  if (startSolves(rows, start, o.tolerance, x, done)) {
+    startAnswered_ = true;
+    return done;
+  }
   // Every assembled-problem solver follows the storage (ldlt: dense or sparse LDL^T).
   const bool sparse = rows.size() > settings_.denseMaxRows;
   if (!haveAssembled_ || assembled_.isSparse() != sparse) {
@@ -269,7 +274,7 @@ bool RowSolver::startSolves(const RowSystem& rows, const Vector& start, double t
   r.status = Status::Converged;
   r.iterations = 0;
   applyAccuracy(r, a, tolerance);
-  r.message = "the start is within the tolerance";
+  r.message = "the start already solves the rows: no solve";
   return true;
 }
 
@@ -441,6 +446,7 @@ IslandSolve RowSolver::solveScreened(const RowSystem& rows, const Vector& start,
   solveStart_ = t0;
   ++calls_;
   haveAssembled_ = false;
+  startAnswered_ = false;
   coneNote_.clear();
   IslandSolve out;
   const int n = rows.size();
@@ -482,7 +488,7 @@ IslandSolve RowSolver::solveScreened(const RowSystem& rows, const Vector& start,
   if (!cone)
     r = run(rows, out.requested, withBudget(settings_.options, share, t0), start, x, island, out);
   if (r.status == Status::InvalidInput || r.status == Status::Unsupported) x = start;
-  out.choice = out.requested;
+  out.choice = startAnswered_ ? kStartChoice : out.requested;
   const bool islandMemory = autoChoice && !cone;  // pgsFirst and cutsInRow
   if (islandMemory && share > 0 && !policy.polishSolver.empty() &&
       out.requested == policy.largeIslandSolver && out.requested != policy.polishSolver &&

@@ -104,7 +104,8 @@ struct IslandStats {
   Status status = Status::Converged;
   std::string message;
   // The solver whose answer was applied: a core name ("dantzig", "ldlt", "pgs", ...; "auto"'s
-  // choice), "none" for an island without rows, or "ode-lcp"/"ode-step"/"ode-quickstep".
+  // choice), "none" for an island without rows, "start" when the start already solved its rows
+  // (RowSolver, stage 3), or "ode-lcp"/"ode-step"/"ode-quickstep".
   std::string choice;
   bool fellBack = false;  // the primary's answer was rejected and the fallback ran
   bool accepted = true;   // the applied answer passes mlcp::acceptable
