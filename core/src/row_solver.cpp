@@ -227,11 +227,6 @@ Result RowSolver::run(const RowSystem& rows, const std::string& name, const Opti
     if (r.status == Status::TimeLimit) keepStartIfBetter(rows, start, x, r, o.tolerance);
     return r;
   }
-  Result done;
-  if (startSolves(rows, start, o.tolerance, x, done)) {
-    startAnswered_ = true;
-    return done;
-  }
   // Every assembled-problem solver follows the storage (ldlt: dense or sparse LDL^T).
   const bool sparse = rows.size() > settings_.denseMaxRows;
   if (!haveAssembled_ || assembled_.isSparse() != sparse) {
@@ -262,11 +257,17 @@ Result RowSolver::run(const RowSystem& rows, const std::string& name, const Opti
   return solver->solveWithGuess(assembled_, start, x);
 }
 
+namespace {
+Accuracy startAccuracy(const RowSystem& rows, const Vector& start) {
+  return accuracy(start, rows.slack(start), rows.lo, rows.hi, rows.findex,
+                  rows.b.lpNorm<Eigen::Infinity>());
+}
+}  // namespace
+
 bool RowSolver::startSolves(const RowSystem& rows, const Vector& start, double tolerance, Vector& x,
                             Result& r) {
   if (start.size() != rows.size()) return false;  // the solver reports the wrong size
-  const Accuracy a = accuracy(start, rows.slack(start), rows.lo, rows.hi, rows.findex,
-                              rows.b.lpNorm<Eigen::Infinity>());
+  const Accuracy a = startAccuracy(rows, start);
   if (!a.finite || !(a.residual <= std::min(kExactStart * tolerance, kExactStartLimit)))
     return false;
   x = start;
@@ -280,8 +281,7 @@ bool RowSolver::startSolves(const RowSystem& rows, const Vector& start, double t
 
 void RowSolver::keepStartIfBetter(const RowSystem& rows, const Vector& start, Vector& x, Result& r,
                                   double tolerance) {
-  const Accuracy a = accuracy(start, rows.slack(start), rows.lo, rows.hi, rows.findex,
-                              rows.b.lpNorm<Eigen::Infinity>());
+  const Accuracy a = startAccuracy(rows, start);
   if (takeStartIfBetter(r, a, tolerance)) x = start;
 }
 
@@ -446,7 +446,6 @@ IslandSolve RowSolver::solveScreened(const RowSystem& rows, const Vector& start,
   solveStart_ = t0;
   ++calls_;
   haveAssembled_ = false;
-  startAnswered_ = false;
   coneNote_.clear();
   IslandSolve out;
   const int n = rows.size();
@@ -485,10 +484,12 @@ IslandSolve RowSolver::solveScreened(const RowSystem& rows, const Vector& start,
   } else {
     out.requested = settings_.solver;
   }
-  if (!cone)
+  const bool fromStart = !cone && !equals(out.requested, "pgs") &&
+                         startSolves(rows, start, settings_.options.tolerance, x, r);
+  if (!cone && !fromStart)
     r = run(rows, out.requested, withBudget(settings_.options, share, t0), start, x, island, out);
   if (r.status == Status::InvalidInput || r.status == Status::Unsupported) x = start;
-  out.choice = startAnswered_ ? kStartChoice : out.requested;
+  out.choice = fromStart ? kStartChoice : out.requested;
   const bool islandMemory = autoChoice && !cone;  // pgsFirst and cutsInRow
   if (islandMemory && share > 0 && !policy.polishSolver.empty() &&
       out.requested == policy.largeIslandSolver && out.requested != policy.polishSolver &&

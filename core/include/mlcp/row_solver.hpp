@@ -32,29 +32,30 @@
 //     no matrix); every other name gets A assembled once per island, dense up to denseMaxRows
 //     rows and sparse above. Solver objects live per island key and name, so the sparse analyses
 //     of ldlt and dantzig (ordering, elimination tree) are redone only when that island's
-//     pattern changes, and RowPgs' buffers are reused. A start that already solves the rows far
-//     within the tolerance (residual <= min(1e-4 tolerance, 1e-12)) is the answer of every solver
-//     but pgs (whose own first check finds it), with choice "start": one product through the rows
-//     instead of an assembly and a solver's set-up. Such starts are common in real content:
-//     touching bodies that nothing presses together (Bullet's BasicDemo block in free fall: every
-//     contact's answer is 0). A start that is only within the tolerance is solved again, so that
-//     exact methods' answers stay exact and do not lag their problems. Polish ("auto" under a time
-//     budget): when the policy's largeIslandSolver (newton) ends short of the tolerance with a
-//     finite residual, Policy::polishSolver (dantzig) continues from newton's answer with what is
-//     left of the island's share, and its answer replaces newton's when its residual is lower
-//     (IslandSolve::polished, choice "newton+dantzig"). Newton's line search stalls where hundreds
-//     of friction rows slide (Bullet's resting pyramids end at residuals 1e-5..1e-3); pivoting from
-//     newton's pieces exchanges the few rows left and ends exact (docs/benchmarks.md, "auto's
-//     polish"). Without a budget it does not run: its only bound is the budget's share (an
-//     unbounded dantzig from newton's answer on Bullet's 210-box pyramid pivots for tens of
-//     seconds), and runs without one stay reproducible. With friction "cone"
-//     (RowSolverSettings::friction, friction_model.hpp) an island with friction rows is solved
-//     instead as the polyhedral cone's standard LCP (RowSolver::solveCone: FrictionCone built from
-//     the rows, the start mapped into it, the requested solver or for "auto" the policy's choice
-//     for an LCP with zero diagonal entries, lemke; its residual recomputed on that LCP), and the
-//     answer mapped back to the rows' impulses. The pgs-first memory of stage 2 is the box's: the
-//     cone runs on every solve (pgs cannot take its LCP, and one rejected lemke answer would
-//     otherwise cost the island the cone for 30 steps).
+//     pattern changes, and RowPgs' buffers are reused.
+//     A start that already solves the rows far within the tolerance (residual <= min(1e-4
+//     tolerance, 1e-12)) is the answer of every primary but pgs (whose own first check finds it),
+//     with choice "start": one product through the rows instead of an assembly and a solver's
+//     set-up. Such starts are common in real content: touching bodies that nothing presses
+//     together (Bullet's BasicDemo block in free fall: every contact's answer is 0). A start only
+//     within the tolerance is solved again, so that exact answers stay exact and do not lag.
+//     Polish ("auto" under a time budget): when the policy's largeIslandSolver (newton) ends
+//     short of the tolerance with a finite residual, Policy::polishSolver (dantzig) continues
+//     from newton's answer with what is left of the island's share, and its answer replaces
+//     newton's when its residual is lower (IslandSolve::polished, choice "newton+dantzig").
+//     Newton's line search stalls where hundreds of friction rows slide (Bullet's resting
+//     pyramids end at residuals 1e-5..1e-3); pivoting from newton's pieces exchanges the few
+//     rows left and ends exact (docs/benchmarks.md, "auto's polish"). Without a budget it does
+//     not run: its only bound is the budget's share (an unbounded dantzig from newton's answer
+//     on Bullet's 210-box pyramid pivots for tens of seconds), and runs without one stay
+//     reproducible.
+//     With friction "cone" (RowSolverSettings::friction, friction_model.hpp) an island with
+//     friction rows is solved instead as the polyhedral cone's standard LCP (RowSolver::solveCone:
+//     FrictionCone built from the rows, the start mapped into it, the requested solver or for
+//     "auto" the policy's choice for an LCP with zero diagonal entries, lemke; its residual
+//     recomputed on that LCP), and the answer mapped back to the rows' impulses. The pgs-first
+//     memory of stage 2 is the box's: the cone runs on every solve (pgs cannot take its LCP,
+//     and one rejected lemke answer would otherwise cost the island the cone for 30 steps).
 //  4. verify and fall back, by the one fallback rule of policy.hpp: an answer is acceptable when
 //     its status is not a breakdown and its residual, recomputed from the rows by residual.hpp,
 //     is finite and <= acceptResidual; an unacceptable one sends the island to the fallback
@@ -337,8 +338,7 @@ class RowSolver {
   Problem assembled_;  // reused across solves with assembleScratch_: no per-step allocation
   RowSystem::AssembleScratch assembleScratch_;
   bool haveAssembled_ = false;
-  bool startAnswered_ = false;  // the last island's answer is its start (stage 3)
-  double solveStart_ = 0;       // the current solve's start, until its primary's run() reads it
+  double solveStart_ = 0;  // the current solve's start, until its primary's run() reads it
   Vector xFallback_;
   Vector xPolish_;
   RowScreen screen_;
