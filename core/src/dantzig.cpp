@@ -6,10 +6,8 @@
 #include <optional>
 #include <sstream>
 
-#include "dantzig_block.hpp"
 #include "dantzig_small.hpp"
 #include "dantzig_workspace.hpp"
-#include "mlcp/pgs.hpp"
 #include "mlcp/residual.hpp"
 #include "mlcp/rows.hpp"
 #include "sparse_pattern.hpp"
@@ -23,19 +21,7 @@ namespace {
 // Largest residual (residual.hpp) of a guess whose friction values set the first pass's bounds.
 constexpr double kTrustedGuess = 1e-2;
 
-// Projected Gauss-Seidel sweeps (pgs.hpp) over x; none when a diagonal entry is not positive.
-void preSweeps(const Problem& problem, int sweeps, Vector& x) {
-  Vector invDiag;
-  if (detail::inverseDiagonal(problem, invDiag) >= 0) return;
-  for (int k = 0; k < sweeps; ++k) detail::pgsSweep(problem, invDiag, 1.0, x);
-}
-
 }  // namespace
-
-// runPivoting's retry of a breakdown adds kRegularization * max |A_ii| to A's diagonal: on
-// Bullet's redundant bridge (two ball joints per hinge line) 1e-10 left a residual of 3-5e-8 on
-// A, 1e-8 of 3-7e-7, 1e-6 of 2-7e-5 (the drift between redundant rows stays either way).
-constexpr double kRegularization = 1e-10;
 
 // ============================================================================ set-up
 
@@ -528,26 +514,12 @@ void DantzigSolver::Workspace::setFrictionBounds(const Vector& nu) {
 
 // ======================================================================= the solver
 
-DantzigSolver::DantzigSolver()
-    : ws_(std::make_unique<Workspace>()), block_(std::make_unique<detail::BlockPivoting>()) {}
+DantzigSolver::DantzigSolver() : ws_(std::make_unique<Workspace>()) {}
 DantzigSolver::~DantzigSolver() = default;
 DantzigSolver::DantzigSolver(DantzigSolver&&) noexcept = default;
 DantzigSolver& DantzigSolver::operator=(DantzigSolver&&) noexcept = default;
 
 int DantzigSolver::passes() const { return ws_->passes; }
-
-bool DantzigSolver::wantsBlockStage(const Problem& problem) const {
-  const int n = problem.size();
-  if (n == 0 || params_.blockStage == DantzigParams::BlockStage::Never ||
-      options().frictionBounds == FrictionBounds::FixedOnce)
-    return false;
-  if (params_.blockStage == DantzigParams::BlockStage::Always) return true;
-  if (n < params_.autoMinRows) return false;
-  const double nonZeros = problem.isSparse()
-                              ? static_cast<double>(problem.sparseA().nonZeros())
-                              : static_cast<double>((problem.denseA().array() != 0).count());
-  return nonZeros <= params_.autoMaxDensity * double(n) * n;
-}
 
 void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
   Workspace& ws = *ws_;
@@ -557,137 +529,32 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
     result.message = "empty problem";
     return;
   }
-  blockSteps_ = 0;
-  blockFactorizations_ = 0;
-  blockBodyFactorizations_ = 0;
-  blockSettled_ = false;
-  const bool warm = !x.isZero(0.0);
-  if (!wantsBlockStage(problem)) {
-    // A tiny island's guessed index sets (warm, or the cold guess of dantzig_small.hpp): the
-    // same steps on fixed-size arrays, else the general path.
-    if (detail::smallDenseApplies(problem) &&
-        detail::solveSmallDense(problem, options().pivotTolerance, x)) {
-      ws.passes = 1;
-      result.status = Status::Converged;
-      result.iterations = 0;
-      result.message = "tiny-island path: guessed index sets (at most two block corrections)";
-      return;
-    }
-    runPivoting(problem, x, result, false);
-    return;
-  }
-  std::string blockMessage;
-  auto settle = [&](const detail::BlockPivoting::Report& rep) {
-    blockSettled_ = true;
+  // A tiny island's guessed index sets (warm, or the cold guess of dantzig_small.hpp): the same
+  // steps on fixed-size arrays, else the general path.
+  if (detail::smallDenseApplies(problem) &&
+      detail::solveSmallDense(problem, options().pivotTolerance, x)) {
     ws.passes = 1;
     result.status = Status::Converged;
-    result.iterations = blockSteps_;
-    result.message = blockMessage.empty() ? rep.message : blockMessage + "; " + rep.message;
-  };
-  bool symmetric = false;  // known after a first run of the block stage
-  // Body-space steps cost a fraction of an A_CC factorization: more of them before the hand-over.
-  const bool bodySpace =
-      params_.blockBodySpace && rows_ != nullptr && rows_->size() == problem.size();
-  const int maxSteps = std::max(1, bodySpace ? params_.maxBodyBlockSteps : params_.maxBlockSteps);
-  block_->setRows(params_.blockBodySpace ? rows_ : nullptr);
-  block_->setLimits({params_.blockWoodburyRows, params_.blockUpdateRows, params_.blockDescentSteps,
-                     params_.blockBreakCycles, params_.blockBodyMinDiagonal});
-  // Auto first tries a few full steps from the cold guess (every row clamped): resting piles
-  // (ODE) settle in one step there, often sooner than from a warm guess whose sets are off by
-  // a few rows; when they do not settle the trial is dropped (its iterate is a worse start than
-  // none: synthetic pyramids from cold), so it costs at most autoColdSteps factorizations.
-  // A guess within kTrustedGuess (an engine's own last answers at rest) skips it: its sets are
-  // right up to a few rows, where the cold sets are not (Bullet's resting pyramid).
-  // A warm solve with a ColdTrialMemory also skips it while the last trial it records missed (an
-  // engine whose cold sets are never right: Bullet's moving pyramid), re-trying every
-  // autoColdRetry solves.
-  const bool autoStage = params_.blockStage == DantzigParams::BlockStage::Auto;
-  const double guessResidual = warm ? residual(problem, x) : kInf;
-  const bool trusted = autoStage && guessResidual <= kTrustedGuess;
-  const bool setsAtGuess =
-      params_.blockTrustedSets && warm && guessResidual <= params_.blockSetsAtGuessResidual;
-  bool coldTrial = autoStage && !trusted;
-  bool continued = false;  // the cold trial's iterate is the block stage's start
-  ColdTrialMemory* memory = coldMemory_;
-  if (coldTrial && warm && memory && memory->missed > 0 && memory->rows == problem.size()) {
-    coldTrial = memory->missed % std::max(1, params_.autoColdRetry) == 0;
-    ++memory->missed;
-  }
-  if (coldTrial) {
-    Vector trial = Vector::Zero(problem.size());
-    const detail::BlockPivoting::Report rep = block_->run(
-        problem, trial, options(), std::max(1, std::min(params_.autoColdSteps, maxSteps)), true);
-    symmetric = rep.symmetric;
-    blockSteps_ += rep.steps;
-    blockFactorizations_ += rep.factorizations;
-    blockBodyFactorizations_ += rep.bodyFactorizations;
-    if (memory) *memory = {rep.settled ? 0 : 1, problem.size()};
-    if (rep.settled) {
-      x = trial;
-      settle(rep);
-      return;
-    }
-    blockMessage = "cold trial: " + rep.message;
-    // A cold solve whose trial came within kTrustedGuess continues from the trial's best iterate
-    // (Bullet's first step of a new pyramid: a few steps, where pivoting from zero took ~5600).
-    if (!warm && params_.autoColdContinue && problem.size() >= params_.autoWarmMinRows &&
-        residual(problem, trial) <= kTrustedGuess) {
-      x = trial;
-      continued = true;
-    }
-  }
-  const bool warmStage =
-      (warm || continued) && (trusted || problem.size() >= params_.autoWarmMinRows);
-  const bool blockIterate = warmStage || params_.blockStage == DantzigParams::BlockStage::Always;
-  if (blockIterate) {
-    // A guess far from the answer (Bullet's pyramid right after the switch from SI) starts the
-    // block stage from a few projected Gauss-Seidel sweeps over it ("Pre-sweeps" in dantzig.hpp).
-    if (warm && params_.blockPgsSweeps > 0 && guessResidual > params_.blockPgsResidual)
-      preSweeps(problem, params_.blockPgsSweeps, x);
-    const detail::BlockPivoting::Report rep =
-        block_->run(problem, x, options(), maxSteps, false, symmetric, setsAtGuess);
-    blockSteps_ += rep.steps;
-    blockFactorizations_ += rep.factorizations;
-    blockBodyFactorizations_ += rep.bodyFactorizations;
-    if (rep.settled) {
-      settle(rep);
-      return;
-    }
-    // x holds the best iterate: its index sets warm start the incremental pivoting.
-    blockMessage += (blockMessage.empty() ? "" : "; ") + rep.message;
-  }
-  if (outOfTime()) {  // the budget went to the block stage: its best iterate is the answer
-    result.status = Status::TimeLimit;
-    result.iterations = blockSteps_;
-    result.message = "block stage: " + blockMessage + "; time budget spent before pivoting";
+    result.iterations = 0;
+    result.message = "tiny-island path: guessed index sets (at most two block corrections)";
     return;
   }
-  if (blockIterate) blockBest_ = x;
-  runPivoting(problem, x, result, blockIterate);
-  result.iterations += blockSteps_;
-  result.message = "block stage: " + blockMessage + "; pivoting: " + result.message;
-  // Pivoting cut short (time, pivot limit, a breakdown) can end worse than the block stage's
-  // best iterate, which is then the answer: never worse than what the solve had found.
-  if (blockIterate && result.status != Status::Converged &&
-      residual(problem, blockBest_) < residual(problem, x)) {
-    x = blockBest_;
-    result.message += "; the block stage's iterate is lower: returned";
-  }
+  runPivoting(problem, x, result);
 }
 
-void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& result, bool fromBlock) {
+void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& result) {
   const Options& opt = options();
   Workspace& ws = *ws_;
   const int n = problem.size();
   const bool exact = opt.frictionBounds == FrictionBounds::Exact;
   const bool useGuess = !x.isZero(0.0);
   // A guess's friction values fix the first pass's friction bounds only when the guess is
-  // close (the block stage's iterate, or a residual within kTrustedGuess): Bullet's cached
+  // close (a residual within kTrustedGuess): Bullet's cached
   // impulses (residual 0.1-0.7, friction directions that turn between steps) gave bounds so far
   // off that the second pass redid most pivots, where the first pass's cold bounds (as
   // FixedOnce) needed half as many pivots in all.
-  const bool trustFriction = useGuess && exact && problem.hasFindex() &&
-                             (fromBlock || residual(problem, x) <= kTrustedGuess);
+  const bool trustFriction =
+      useGuess && exact && problem.hasFindex() && residual(problem, x) <= kTrustedGuess;
   if (ws.shift == 0) ws.guess = x;
   ws.build(problem, x, useGuess, trustFriction);
   if (ws.shift > 0) ws.shiftDiagonal(ws.shift);
@@ -711,7 +578,7 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
   };
   int totalPivots = 0;
   const int nf = static_cast<int>(ws.frictionRows.size());
-  constexpr int depth = 6;
+  const int depth = std::max(1, params_.andersonDepth);
   int stored = 0;
   double bestF = kInf, damping = 1.0;
   int lastGain = 0;
@@ -736,10 +603,10 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
       // the regularised friction passes needed more than 50); the residual is measured on A.
       const std::string first = ws.message;
       const int spent = totalPivots;
-      const double delta = kRegularization * ws.scale;
+      const double delta = params_.breakdownShift * ws.scale;
       ws.shift = delta;
       x = Vector::Zero(n);
-      runPivoting(problem, x, result, fromBlock);
+      runPivoting(problem, x, result);
       ws.shift = 0;
       result.iterations += spent;
       std::ostringstream os;
@@ -801,8 +668,9 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
     if (fNorm < bestF) {
       bestF = fNorm;
       lastGain = it;
-    } else if (it - lastGain > 20 && damping == 1.0) {
-      damping = 0.3;  // stalled (a cycle between active sets): plain damped iteration
+    } else if (it - lastGain > params_.andersonStall && damping == 1.0) {
+      damping =
+          params_.stallDamping;  // stalled (a cycle between active sets): plain damped iteration
       stored = 0;
     }
     if (stored == depth) {

@@ -5,7 +5,9 @@
 #include <sstream>
 #include <vector>
 
+#include "block_pivoting.hpp"
 #include "mlcp/pgs.hpp"
+#include "mlcp/residual.hpp"
 #include "newton_system.hpp"
 
 namespace mlcp {
@@ -36,6 +38,8 @@ struct NewtonSolver::Work {
     }
   };
   detail::NewtonSystem system;
+  detail::BlockPivoting pivoting;
+  const RowSystem* rows = nullptr;
   Point at, trial, best;
   Vector dx, adx, g, jg, invDiag;  // adx = A dx
   // The merits of the iterates so far, and the line search's reference: the largest of the
@@ -51,7 +55,10 @@ NewtonSolver& NewtonSolver::operator=(NewtonSolver&&) noexcept = default;
 
 int NewtonSolver::analyses() const { return work_->system.analyses(); }
 int NewtonSolver::bodyFactorizations() const { return work_->system.bodyFactorizations(); }
-void NewtonSolver::useRows(const RowSystem* rows) { work_->system.useRows(rows); }
+void NewtonSolver::useRows(const RowSystem* rows) {
+  work_->system.useRows(rows);
+  work_->rows = rows;
+}
 
 // Backtracking from t = 1 along wk.dx from wk.at: the first t = 2^-k (k <= the halvings) with
 // ||H(x + t dx)||^2 <= reference + sigma t slope (slope < 0, the directional derivative;
@@ -147,6 +154,7 @@ void NewtonSolver::run(const Problem& pb, Vector& x, Result& result) {
   const Options& opt = options();
   const int n = pb.size();
   factorizations_ = 0;
+  pivotingSteps_ = 0;
   result.iterations = 0;
   if (n == 0) {
     result.status = Status::Converged;
@@ -210,7 +218,30 @@ void NewtonSolver::run(const Problem& pb, Vector& x, Result& result) {
     std::swap(wk.at, wk.trial);
   }
   x.swap(result.status == Status::Converged ? wk.at.x : wk.best.x);
+  if (result.status == Status::MaxIterations || result.status == Status::Failed)
+    pivotingPhase(pb, x, result, os);
   result.message = os.str();
+}
+
+// The pivoting phase (newton.hpp "Pivoting phase"): block principal pivoting from x, the damped
+// steps' best iterate, with its first index sets from where x lies. x and result take its answer
+// when it settles, else its best iterate (never worse than x: its start counts as an iterate).
+void NewtonSolver::pivotingPhase(const Problem& pb, Vector& x, Result& result, std::ostream& os) {
+  Work& wk = *work_;
+  const bool body = wk.rows != nullptr && wk.rows->size() == pb.size();
+  const int steps = body ? params_.bodyPivotingSteps : params_.pivotingSteps;
+  if (steps <= 0 || !wk.system.isSparse() || !wk.system.symmetric() || outOfTime()) return;
+  wk.pivoting.setRows(body ? wk.rows : nullptr);
+  wk.pivoting.setLimits({params_.pivotingWoodburyRows, params_.pivotingUpdateRows,
+                         params_.pivotingDescentSteps, params_.pivotingBreakCycles});
+  const detail::BlockPivoting::Report rep = wk.pivoting.run(pb, x, options(), steps, true, true);
+  pivotingSteps_ = rep.steps;
+  result.iterations += rep.steps;
+  os << "; then " << rep.message;
+  if (rep.settled)
+    result.status = Status::Converged;
+  else if (outOfTime())
+    result.status = Status::TimeLimit;
 }
 
 }  // namespace mlcp

@@ -7,7 +7,6 @@
 #include <stdexcept>
 #include <string_view>
 
-#include "mlcp/dantzig.hpp"
 #include "mlcp/io.hpp"
 #include "mlcp/registry.hpp"
 #include "mlcp/residual.hpp"
@@ -75,8 +74,6 @@ struct RowSolver::Slot {
   std::uint64_t lastUse = 0;
   int pgsFirst = 0;
   int cutsInRow = 0;
-  // dantzig's cold-trial memory over this island's solves (DantzigSolver::useColdTrialMemory).
-  DantzigSolver::ColdTrialMemory coldTrial;
 };
 
 namespace {
@@ -112,9 +109,6 @@ RowSolver::RowSolver(const RowSolverSettings& settings) : settings_(settings) {
   if (!known(settings_.solver)) refuse("solver", settings_.solver, "");
   if (!settings_.fallback.empty() && (settings_.fallback == "auto" || !known(settings_.fallback)))
     refuse("fallback", settings_.fallback, "; auto only as the primary");
-  const std::string& polish = settings_.policy.polishSolver;
-  if (!polish.empty() && (polish == "auto" || !known(polish)))
-    refuse("polish solver", polish, "; not auto");
   if (!(settings_.acceptResidual >= 0))
     throw std::invalid_argument("mlcp::RowSolver: acceptResidual must be >= 0");
   setTimeBudget(settings_.timeBudget);
@@ -240,20 +234,13 @@ Result RowSolver::run(const RowSystem& rows, const std::string& name, const Opti
   }
   Solver* solver = assembledSolver(island, name);
   solver->setOptions(o);
-  // The rows (and dantzig's cold-trial memory, the island slot's) for this solve only, cleared
-  // on every way out (a throw included): the solver is kept per island and must not hold them
-  // past this call.
-  auto* dantzig = dynamic_cast<DantzigSolver*>(solver);
+  // The rows for this solve only, cleared on every way out (a throw included): the solver is
+  // kept per island and must not hold them past this call.
   struct Rows {
     Solver* solver;
-    DantzigSolver* dantzig;
-    ~Rows() {
-      solver->useRows(nullptr);
-      if (dantzig) dantzig->useColdTrialMemory(nullptr);
-    }
-  } scope{solver, dantzig};
+    ~Rows() { solver->useRows(nullptr); }
+  } scope{solver};
   solver->useRows(&rows);
-  if (dantzig) dantzig->useColdTrialMemory(&island.coldTrial);
   return solver->solveWithGuess(assembled_, start, x);
 }
 
@@ -345,38 +332,6 @@ Result RowSolver::solveCone(const Vector& start, Vector& x, Slot& island, Island
               std::to_string(cone_.contacts()) + " contacts, " + std::to_string(p.size()) +
               " unknowns: " + r.message;
   return r;
-}
-
-// Stage 3's polish: r is auto's largeIslandSolver answer that did not converge, x its x. The
-// polish solver starts from x with what is left of the island's share; its answer replaces r's
-// only when its residual is lower (better()).
-Result RowSolver::polish(const RowSystem& rows, Vector& x, Slot& island, IslandSolve& out, Result r,
-                         double share, double t0) {
-  const std::string& name = settings_.policy.polishSolver;
-  const double now = nowSeconds();
-  const double cap = share - (now - t0);
-  const std::string stopped = out.requested + " stopped (" + toString(r.status) + ", residual " +
-                              shortNumber(r.residual) + ", " + std::to_string(r.iterations) +
-                              " steps)";
-  if (!(cap > 0)) {
-    r.message = stopped + "; no time left to polish: " + r.message;
-    return r;
-  }
-  Options o = settings_.options;
-  o.timeBudget = cap;
-  o.budgetStart = now;
-  Result p = run(rows, name, o, x, xPolish_, island, out);
-  if (!better(p, r)) {
-    r.message = stopped + "; " + name + " polish no better (" + toString(p.status) + ", residual " +
-                shortNumber(p.residual) + "): " + r.message;
-    return r;
-  }
-  p.iterations += r.iterations;
-  p.message = stopped + "; " + name + " from its answer: " + p.message;
-  x.swap(xPolish_);
-  out.choice = out.requested + "+" + name;
-  out.polished = true;
-  return p;
 }
 
 // Stage 4's fallback (policy.hpp's rule): r is the primary's unacceptable answer, x its x.
@@ -491,10 +446,6 @@ IslandSolve RowSolver::solveScreened(const RowSystem& rows, const Vector& start,
   if (r.status == Status::InvalidInput || r.status == Status::Unsupported) x = start;
   out.choice = fromStart ? kStartChoice : out.requested;
   const bool islandMemory = autoChoice && !cone;  // pgsFirst and cutsInRow
-  if (islandMemory && share > 0 && !policy.polishSolver.empty() &&
-      out.requested == policy.largeIslandSolver && out.requested != policy.polishSolver &&
-      r.status != Status::Converged && std::isfinite(r.residual))
-    r = polish(rows, x, island, out, std::move(r), share, t0);
   if (islandMemory) island.cutsInRow = r.status == Status::TimeLimit ? island.cutsInRow + 1 : 0;
   if (!acceptable(r, settings_.acceptResidual)) {
     if (islandMemory && !equals(out.requested, "pgs") && !equals(out.requested, "ldlt") &&

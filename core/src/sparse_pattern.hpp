@@ -1,4 +1,4 @@
-// Helpers shared by the sparse direct solves (ldlt.cpp, dantzig_block.cpp): a symbolic analysis
+// Helpers shared by the sparse direct solves (ldlt.cpp, block_pivoting.cpp): a symbolic analysis
 // (ordering, elimination tree) depends only on the sparsity pattern, so it is redone only when
 // the pattern changes, as SuiteSparse's analyze/factorize split does.
 #pragma once

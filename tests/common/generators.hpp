@@ -183,4 +183,29 @@ inline Problem seedLemkeExample() {
   return Problem(M, Vector((Vector(3) << -1, -10, 6).finished()));
 }
 
+// Random J (rows x 6 bodies' worth of columns), A = J J^T + eps I.
+inline DenseMatrix jacobianGram(Generator& g, int rows, int cols, double eps) {
+  DenseMatrix J(rows, cols);
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < cols; ++j) J(i, j) = g.uniform(-1, 1);
+  return J * J.transpose() + eps * DenseMatrix::Identity(rows, rows);
+}
+
+// Friction pyramids: per contact a normal row [0, inf) and two rows [-mu, mu] -> normal.
+inline Problem frictionPyramids(DenseMatrix A, Generator& g, double mu) {
+  const int n = static_cast<int>(A.rows());
+  Vector b(n);
+  for (int i = 0; i < n; ++i) b[i] = g.uniform(-1, 1);
+  for (int k = 0; k < n; k += 3) b[k] = -g.uniform(0.2, 1);  // approaching contacts
+  Problem p(std::move(A), b);
+  p.findex.assign(n, -1);
+  for (int k = 0; k < n; k += 3)
+    for (int t = 1; t <= 2; ++t) {
+      p.lo[k + t] = -mu;
+      p.hi[k + t] = mu;
+      p.findex[k + t] = k;
+    }
+  return p;
+}
+
 }  // namespace mlcp::test

@@ -175,8 +175,8 @@ TEST(Newton, BodySpaceStateDoesNotOutliveItsProblem) {
 
 // A warm start far from an answer (scaled residual above warmSweepsResidual, as ODE's impulses
 // of the last step on new contacts are) is swept before the first Newton step; a near one is
-// used as given. With no Newton step allowed the answer is the better of the start and the
-// swept point.
+// used as given. With no Newton step allowed (and no pivoting phase) the answer is the better of
+// the start and the swept point.
 TEST(Newton, FarWarmStartIsSweptNearOneIsKept) {
   Vector answer;
   const Problem p = nextStepAfterAnswer(answer);
@@ -188,6 +188,7 @@ TEST(Newton, FarWarmStartIsSweptNearOneIsKept) {
     NewtonSolver newton;
     newton.options().maxIterations = 0;
     newton.params().warmSweeps = sweeps;
+    newton.params().pivotingSteps = 0;
     Vector x;
     newton.solveWithGuess(p, guess, x);
     return x;
@@ -360,6 +361,38 @@ TEST(Newton, NonmonotoneLineSearchLetsFullStepsAcrossKinks) {
   EXPECT_EQ(converged[0], 0);
   EXPECT_GE(converged[1], 1);
   EXPECT_LT(steps[1], steps[0]);
+}
+
+// The pivoting phase (newton.hpp): ten damped steps leave a cold friction pyramid short of the
+// tolerance; block principal pivoting from their best iterate ends within it, without and with
+// the rows (body space). Without the phase the damped steps' answer stands,
+// with an honest status.
+TEST(Newton, PivotingPhaseFinishesWhatTheDampedStepsLeftShort) {
+  test::PyramidSpec spec;
+  spec.levels = 5;
+  test::BoxPyramid pyramid(spec);
+  const Problem p = pyramid.rows().assemble(true);
+  ASSERT_GT(p.size(), NewtonParams().denseMaxRows);  // the sparse path
+  for (const bool rows : {false, true}) {
+    NewtonSolver newton;
+    newton.options().tolerance = 1e-6;
+    newton.options().maxIterations = 10;
+    newton.useRows(rows ? &pyramid.rows() : nullptr);
+    newton.params().pivotingSteps = newton.params().bodyPivotingSteps = 0;
+    Vector x;
+    const Result without = newton.solve(p, x);
+    ASSERT_EQ(without.status, Status::MaxIterations) << without.message;
+    EXPECT_EQ(newton.pivotingSteps(), 0);
+    EXPECT_GT(without.residual, 1e-6);
+    newton.params() = NewtonParams();
+    newton.params().pivotingSteps = newton.params().bodyPivotingSteps;  // the same steps
+    const Result with = newton.solve(p, x);
+    EXPECT_TRUE(with.converged()) << with.message;
+    EXPECT_GT(newton.pivotingSteps(), 0);
+    EXPECT_EQ(with.iterations, 10 + newton.pivotingSteps());
+    EXPECT_EQ(rows, newton.bodyFactorizations() > 0) << with.message;
+    EXPECT_LE(accuracy(p, x).residual, 1e-6);
+  }
 }
 
 }  // namespace

@@ -303,43 +303,36 @@ TEST(LemkeLimits, RefusesATableauBeyondItsRowLimit) {
   EXPECT_TRUE(x.isApproxToConstant(7.0));  // untouched
 }
 
-// Auto's polish (row_solver.hpp, stage 3): newton limited to ten steps stops short of the
-// tolerance on a cold pyramid (it needs 161); dantzig, warm-started from newton's answer in what is
-// left of the island's share, ends exact. Without the polish, or without a budget, newton's answer
-// stands.
-IslandSolve solveWithPolish(const std::string& polishSolver, double timeBudget, Vector& x) {
+// Auto on a large island: newton limited to ten damped steps stops short of the tolerance on a
+// cold pyramid (it needs 161); its pivoting phase (newton.hpp) finishes from there and ends
+// exact, with or without a time budget, and the answer is newton's own (no second solver).
+IslandSolve solveLargeIsland(double timeBudget, Vector& x) {
   test::PyramidSpec spec;
   spec.levels = 5;
   const test::BoxPyramid pyramid(spec);
   RowSolverSettings s;            // auto
   s.policy.smallIslandRows = 10;  // newton for this island
-  s.policy.polishSolver = polishSolver;
-  s.options.maxIterations = 10;  // newton's steps, dantzig's friction passes
+  s.options.maxIterations = 10;   // newton's damped steps
   s.fallback = "";
   s.timeBudget = timeBudget;
   RowSolver solver(s);
   return solver.solve(pyramid.rows(), Vector::Zero(pyramid.rows().size()), x);
 }
 
-TEST(Polish, DantzigFinishesANewtonAnswerThatStoppedShort) {
-  Vector x, unpolished, unbudgeted;
-  const IslandSolve plain = solveWithPolish("", 10, unpolished);
-  EXPECT_EQ(plain.choice, "newton");
-  EXPECT_FALSE(plain.polished);
-  ASSERT_NE(plain.result.status, Status::Converged) << plain.result.message;
-  EXPECT_GT(plain.result.residual, kDefaultIslandTolerance);
-
-  const IslandSolve out = solveWithPolish("dantzig", 10, x);
-  EXPECT_EQ(out.requested, "newton");
-  EXPECT_EQ(out.choice, "newton+dantzig");
-  EXPECT_TRUE(out.polished);
-  EXPECT_EQ(out.result.status, Status::Converged) << out.result.message;
-  EXPECT_LE(out.result.residual, kDefaultIslandTolerance);
-  EXPECT_NE(out.result.message.find("newton stopped"), std::string::npos) << out.result.message;
-
-  const IslandSolve noBudget = solveWithPolish("dantzig", 0, unbudgeted);
-  EXPECT_EQ(noBudget.choice, "newton");
-  EXPECT_EQ(unbudgeted, unpolished);  // the same answer bit for bit
+TEST(AutoLargeIsland, NewtonsPivotingPhaseFinishesWhatItsDampedStepsLeftShort) {
+  Vector budgeted, unbudgeted;
+  for (const double budget : {10.0, 0.0}) {
+    Vector& x = budget > 0 ? budgeted : unbudgeted;
+    const IslandSolve out = solveLargeIsland(budget, x);
+    EXPECT_EQ(out.requested, "newton");
+    EXPECT_EQ(out.choice, "newton");
+    EXPECT_EQ(out.result.status, Status::Converged) << out.result.message;
+    EXPECT_LE(out.result.residual, kDefaultIslandTolerance);
+    EXPECT_NE(out.result.message.find("10 Newton steps"), std::string::npos) << out.result.message;
+    EXPECT_NE(out.result.message.find("block pivoting settled"), std::string::npos)
+        << out.result.message;
+  }
+  EXPECT_EQ(budgeted, unbudgeted);  // the same answer bit for bit
 }
 
 }  // namespace

@@ -30,8 +30,7 @@ struct RunArgs {
   std::string fallback = "pgs";
   double fallbackResidual = -1;
   double timeBudget = -1;  // -1: the adapters' default
-  std::string polish = kPolishSolver;
-  std::string friction;  // "" : the scene's
+  std::string friction;    // "" : the scene's
   int frictionDirections = -1;
   std::string csv;
   std::string trajectory;
@@ -56,7 +55,6 @@ int runScene(const RunArgs& args) {
   run.fallback = args.fallback == "none" ? "" : args.fallback;
   if (args.fallbackResidual >= 0) run.fallbackResidual = args.fallbackResidual;
   if (args.timeBudget >= 0) run.timeBudget = args.timeBudget;
-  run.polish = args.polish == "none" ? "" : args.polish;
   if (!args.friction.empty()) parseFrictionModel(args.friction, run.friction);  // checked by CLI11
   if (args.frictionDirections >= 0) run.frictionDirections = args.frictionDirections;
   const int steps = args.steps >= 0 ? args.steps : s.settings.steps;
@@ -182,10 +180,6 @@ Runner addRunCommand(CLI::App& app) {
                   "only; default 0.05): islands solved after it ran out get a minimal share and "
                   "answers stopped by it report time-limit")
       ->check(nonNegativeNumber());
-  cmd->add_option("--polish", args->polish,
-                  "core solver that continues auto's newton answer on a large island when it "
-                  "ends short of the tolerance, in what is left of the time budget, or none "
-                  "(default dantzig)");
   cmd->add_option("--friction", args->friction,
                   "friction model: box (the engines' own) or cone (the polyhedral cone's LCP; "
                   "core solvers that take an LCP: auto, lemke, dantzig) (default: the scene's "

@@ -120,7 +120,6 @@ class BulletWorld : public scene::World {
       settings.acceptResidual = run.fallbackResidual;
       settings.engineIterations = run.engineIterations;  // m_numIterations is run.iterations
       settings.timeBudget = run.timeBudget;
-      settings.policy.polishSolver = run.polish;
       settings.friction = run.friction;
       settings.frictionDirections = run.frictionDirections;
       solver = scenes::makeBulletSolver(name, settings);  // throws for unknown names

@@ -115,7 +115,6 @@ class OdeWorld : public scene::World {
     options.fallback = run.fallback;  // the stepper never falls back from "ode-..."
     options.acceptResidual = run.fallbackResidual;
     options.timeBudget = run.timeBudget;
-    options.policy.polishSolver = run.polish;
     options.friction = run.friction;
     options.frictionDirections = run.frictionDirections;
     stepper_ = std::make_unique<Stepper>(stepperName, options);

@@ -21,10 +21,9 @@
 //   contacts, rows >  smallIslandRows:
 //     the step's time budget spent             -> "pgs"      (improves any start in any share)
 //     tolerance >= looseTolerance              -> "pgs"      (fallback "dantzig")
-//     otherwise                                -> largeIslandSolver ("newton"), continued
-//                                                 by polishSolver ("dantzig") from its answer
-//                                                 when it ends short of the tolerance
-//                                                 (RowSolver, under a time budget)
+//     otherwise                                -> largeIslandSolver ("newton"), whose
+//                                                 pivoting phase finishes the islands its
+//                                                 damped steps leave short (newton.hpp)
 // ("contacts": StandardLcp, Boxed and Findex islands.) Why: one LDL^T solve is exact and cheaper
 // than any iteration on joint chains; pivoting is exact and fastest on small contact islands,
 // but its pivot count grows with the rows, so above ~1000 rows a cold answer takes seconds a
@@ -64,8 +63,6 @@ namespace mlcp {
 
 // The solver for contact islands above Policy::smallIslandRows rows at a tight tolerance.
 inline constexpr const char* kLargeIslandSolver = "newton";
-// The solver that continues kLargeIslandSolver's answers when they end short of the tolerance.
-inline constexpr const char* kPolishSolver = "dantzig";
 
 // What the policy picked, and why in words (for Result::message). Static strings, or (solver)
 // the Policy's largeIslandSolver: choosing allocates nothing (it runs for every island).
@@ -92,13 +89,6 @@ struct Policy {
   // A rejected pivoting answer within this factor of the acceptance limit is a near miss: it
   // falls back for that solve only, without the pgsAfterBreakdown memory. Default 10.
   double nearMiss = 10;
-  // Solver that continues a largeIslandSolver answer that did not converge, warm-started from
-  // it, in what is left of the island's time budget (RowSolver, row_solver.hpp, stage 3; not
-  // without a budget); "" for none. Default kPolishSolver ("dantzig"): from newton's last iterate,
-  // whose pieces are nearly the answer's, pivoting exchanges the few rows newton's line search
-  // keeps crossing (Bullet's resting pyramids, where hundreds of friction rows slide) and ends
-  // exact.
-  std::string polishSolver = kPolishSolver;
 
   // The choice for a problem of this class and size. positiveDiagonal: every A_ii > 0 (always
   // true for engine rows with cfm > 0; RowSolver does not look). budgetSpent: the step's time

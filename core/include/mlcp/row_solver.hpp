@@ -3,7 +3,7 @@
 //     mlcp::RowSolver solver;                      // settings: solver "auto", fallback "pgs"
 //     solver.beginStep();                          // once per engine step (the time budget's)
 //     mlcp::IslandSolve s = solver.solve(rows, start, x, islandKey);
-//     s.choice;    // "ldlt", "dantzig", "newton+dantzig" (polished), ...: whose answer x is
+//     s.choice;    // "ldlt", "dantzig", "newton", "start", ...: whose answer x is
 //     s.fellBack;  // the primary's answer was not acceptable and the fallback ran
 //     s.accepted;  // the returned answer is acceptable (policy.hpp, rule 1)
 //
@@ -39,16 +39,6 @@
 //     set-up. Such starts are common in real content: touching bodies that nothing presses
 //     together (Bullet's BasicDemo block in free fall: every contact's answer is 0). A start only
 //     within the tolerance is solved again, so that exact answers stay exact and do not lag.
-//     Polish ("auto" under a time budget): when the policy's largeIslandSolver (newton) ends
-//     short of the tolerance with a finite residual, Policy::polishSolver (dantzig) continues
-//     from newton's answer with what is left of the island's share, and its answer replaces
-//     newton's when its residual is lower (IslandSolve::polished, choice "newton+dantzig").
-//     Newton's line search stalls where hundreds of friction rows slide (Bullet's resting
-//     pyramids end at residuals 1e-5..1e-3); pivoting from newton's pieces exchanges the few
-//     rows left and ends exact (docs/benchmarks.md, "auto's polish"). Without a budget it does
-//     not run: its only bound is the budget's share (an unbounded dantzig from newton's answer
-//     on Bullet's 210-box pyramid pivots for tens of seconds), and runs without one stay
-//     reproducible.
 //     With friction "cone" (RowSolverSettings::friction, friction_model.hpp) an island with
 //     friction rows is solved instead as the polyhedral cone's standard LCP (RowSolver::solveCone:
 //     FrictionCone built from the rows, the start mapped into it, the requested solver or for
@@ -225,7 +215,6 @@ struct IslandSolve {
   std::string choice;
   std::string requested;       // the primary that ran ("auto"'s choice, or the requested name)
   bool fellBack = false;       // the primary's answer was rejected and the fallback ran
-  bool polished = false;       // auto's polish continued the primary's answer (choice "a+b")
   bool accepted = true;        // the returned answer passes acceptable()
   double assembleSeconds = 0;  // part of result.seconds spent classifying and assembling A
   ScreenCounts screened;       // rows screened in stage 0 (inert ones answered x = 0)
@@ -253,8 +242,8 @@ class ChoiceCounts {
 
 class RowSolver {
  public:
-  // Throws std::invalid_argument naming the known solvers for an unknown solver, fallback or
-  // policy.polishSolver name, for a negative or NaN acceptResidual, timeBudget or minShare
+  // Throws std::invalid_argument naming the known solvers for an unknown solver or fallback
+  // name, for a negative or NaN acceptResidual, timeBudget or minShare
   // outside (0, 1], and for frictionDirections outside [3, 64] or the cone with a primary that
   // cannot take its LCP.
   explicit RowSolver(const RowSolverSettings& settings = RowSolverSettings());
@@ -313,8 +302,6 @@ class RowSolver {
   Solver* assembledSolver(Slot& island, const std::string& name, const char* tag = "");
   Result run(const RowSystem& rows, const std::string& name, const Options& options,
              const Vector& start, Vector& x, Slot& island, IslandSolve& report);
-  Result polish(const RowSystem& rows, Vector& x, Slot& island, IslandSolve& out, Result r,
-                double share, double t0);
   Result fallBack(const RowSystem& rows, const Vector& start, Vector& x, Slot& island,
                   IslandSolve& out, Result r, double share, double t0);
   void assemble(const RowSystem& rows, bool sparse);
@@ -340,7 +327,6 @@ class RowSolver {
   bool haveAssembled_ = false;
   double solveStart_ = 0;  // the current solve's start, until its primary's run() reads it
   Vector xFallback_;
-  Vector xPolish_;
   RowScreen screen_;
   Vector keptStart_, keptX_;  // the kept rows' start and answer when rows were screened
   std::unordered_map<std::uint64_t, std::unique_ptr<Slot>> slots_;

@@ -1,6 +1,6 @@
-// The reduced systems of an MLCP assembled from rows, solved in body space: the block steps of
-// DantzigSolver's block stage (see "Body space" in mlcp/dantzig.hpp) and NewtonSolver's steps
-// (newton.hpp, "Linear algebra"). Internal to the library.
+// The reduced systems of an MLCP assembled from rows, solved in body space: NewtonSolver's damped
+// steps (newton.hpp, "Linear algebra") and the block steps of its pivoting phase
+// (block_pivoting.hpp, "Body space"). Internal to the library.
 //
 // For a problem assembled from rows (rows.hpp: A = J W J^T + diag(cfm), W = M^-1), the matrix on
 // a set C of clamped (free) rows, with sliding rows t (x_t = c_t x_n(t)) substituted, is
@@ -52,7 +52,7 @@ class BodySpaceSystem {
   bool prepareFor(const RowSystem& rows, const Problem& problem, double dMax);
   // Whether products through the rows (multiply) may stand for A's: every cfm > 0 (on a singular
   // A, cfm = 0 and coplanar contacts, their round-off differences from A's rows are not damped:
-  // a test's sliding pyramid went from settling to 120 unsettled steps in dantzig's block stage).
+  // a test's sliding pyramid went from settling to 120 unsettled steps in block pivoting).
   bool productsStandForA() const {
     return !cfm_.empty() && *std::min_element(cfm_.begin(), cfm_.end()) > 0;
   }

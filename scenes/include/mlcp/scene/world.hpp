@@ -70,9 +70,6 @@ struct RunSettings {
   // Wall-clock budget of one step's solves in seconds, 0 for none (core solvers only;
   // RowSolverSettings::timeBudget). Default the adapters' kDefaultTimeBudget (0.05 s).
   double timeBudget = kDefaultTimeBudget;
-  // Solver that continues auto's newton answers that end short of the tolerance, under a time
-  // budget, "" for none (Policy::polishSolver). Default kPolishSolver ("dantzig").
-  std::string polish = kPolishSolver;
   // Friction model of contacts (mlcp/friction_model.hpp; core solvers only: a stock solver with
   // Cone is refused). Default Box.
   FrictionModel friction = FrictionModel::Box;

@@ -38,9 +38,9 @@
 //     point's m_appliedImpulseLateral1/2 when the directions persist (direction caching, or
 //     directions not from the velocity). Why our own answers: once a stack rests under exact
 //     answers, they are a start about 100x closer than the cached impulse (start residual ~1e-4
-//     against ~0.1 on bullet_bench's 55-box pyramid), and dantzig's block stage then settles in
-//     a few steps instead of tens. Right after a switch from SI no start helps: the stack moves
-//     from SI's approximate state to the exact answers' for ~20-40 steps.
+//     against ~0.1 on bullet_bench's 55-box pyramid), and newton (with its pivoting phase) then
+//     settles in a few steps instead of tens. Right after a switch from SI no start helps: the
+//     stack moves from SI's approximate state to the exact answers' for ~20-40 steps.
 //  5. solve and 6. check — mlcp::RowSolver (mlcp/row_solver.hpp), shared with the ODE adapter:
 //     it classifies the island (bilateral only, frictionless contacts, boxed, friction), runs
 //     the named solver or `auto`'s choice ("pgs" on the rows, others on an assembled A, dense up

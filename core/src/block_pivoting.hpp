@@ -1,5 +1,57 @@
-// The sparse block principal pivoting stage of DantzigSolver (see "Block stage" in
-// mlcp/dantzig.hpp for the method). Internal to the library.
+// Block principal pivoting on the natural map of a sparse symmetric MLCP with findex: the
+// pivoting phase of NewtonSolver (mlcp/newton.hpp, "Pivoting phase"). Internal to the library.
+//
+// Method. Whole index sets are guessed and exchanged at once: semismooth Newton steps on the
+// natural map H(x) = x - clamp(x - w, lo', hi') (block principal pivoting, Kostreva /
+// Judice-Pires, when every step is full). Each row is clamped (w_i = 0), held at lo or hi, or
+// fixed; a friction row at a bound is the linear equation x_t = mu_t s_j x_j coupling it to its
+// normal j (s_j the normal's sign), so findex is exact, and friction rows whose normal is held at
+// 0 are fixed at 0. One step solves those equations.
+//
+// Steps. First the steps are full: the next sets change only rows violated beyond 0.01 tolerance
+// (1 + |b|) (setsAt), so that degenerate rows do not flip on rounding. A full step that brings no
+// new lowest merit ||H||^2 but is below the step before is free (up to Limits::descentSteps per
+// run: from a guess that is itself the best point so far, Bullet's full steps often descend for
+// several steps, residual 5e-2 -> 1e-2 -> 2e-3 -> ..., before beating it); a full step whose sets
+// are those of two steps before (a 2-cycle, which would repeat that step's x) ends the full steps
+// at once (Limits::breakCycles). When 3 other full steps in a row bring no new lowest merit (or a
+// block is singular), the run goes back to the best point and continues damped: sets from the
+// natural map at x, a proximal term rho (x_C - x_C,prev) on the clamped rows (rho = 1e-2
+// max|A_ii| min(1, ||H||): coplanar contacts make clamped blocks nearly singular, and far from
+// the answer their exact equations throw the null-space part far away), and the step shortened
+// by backtracking until ||H||^2 decreases (Armijo); at a kink where no step length descends the
+// full step is taken up to 2 times in a row. A run ends when the residual (residual.hpp) is within
+// Options::tolerance (then x is projected onto the bounds when that keeps it within tolerance),
+// or after maxSteps, no descent, a singular damped block or the time budget, with the best
+// iterate (the start included).
+//
+// First sets. Cold (x = 0): every row clamped. Warm: from the natural map at the guess, or, with
+// atGuess (newton's phase, whose guess is its damped steps' best iterate), from where the guess
+// lies: a row within 1e-6 of a bound held there, the others clamped. An engine hands a sliding
+// friction row's last answer back rotated onto the new friction direction, so its relative change
+// is of the order of the rotation squared.
+//
+// Linear algebra. A_CC + rho I is factored by an up-looking sparse LDL^T (SymmetricPatternLu,
+// linalg/symmetric_pattern_lu.hpp) in a fill-reducing AMD order of the whole A, computed once per
+// pattern of A and inherited by every clamped block. Sliding rows (at a bound, normal clamped) are
+// substituted, which makes K = B + U E^T nonsymmetric (B = A_CC + rho I; U's column c_t A_{C,t}
+// per sliding row t, E's the unit vector of t's normal); up to Limits::woodburyRows of them are
+// bordered onto B's factor (Woodbury: a k x k capacitance S = I + E^T B^-1 U from sparse forward
+// solves, whose reach in the elimination tree is short), more are factored as K = L D U without
+// pivoting (K keeps A_CC's pattern: a contact's friction and normal rows touch the same bodies;
+// a K outside that pattern falls back to Eigen's SparseLU). A later step whose sets differ from
+// the last factored ones by at most Limits::updateRows rows (joined, left, sliding), with the same
+// rho, reuses that factor: the joined rows are bordered on, a left row's x is held at 0 by a
+// multiplier that frees its equation, and the p x p Schur complement of the border is factored
+// densely. One step of iterative refinement follows. Why not KLU (newton's reduced system): the
+// full steps run at rho = 0, where the coplanar contacts' clamped blocks are singular up to cfm;
+// the LDL^T's pivot tolerance reports such a block at once (the run then goes damped), and the
+// bordered updates make most full steps near the answer a few sparse forward solves.
+//
+// Body space. With the rows (setRows; A = J W J^T + diag(cfm)), a step whose every cfm_c + rho is
+// at least Limits::bodyMinDiagonal max |A_ii| is solved by Woodbury in body space instead
+// (linalg/body_space.hpp, the factor newton's damped steps use), with two steps of refinement
+// against the true K; with every cfm > 0 the products with A go through the rows too.
 #pragma once
 
 #include <Eigen/SparseLU>
@@ -7,6 +59,7 @@
 #include <string>
 #include <vector>
 
+#include "linalg/symmetric_pattern_lu.hpp"
 #include "mlcp/problem.hpp"
 #include "mlcp/result.hpp"
 #include "sparse_pattern.hpp"
@@ -19,50 +72,13 @@ namespace mlcp::detail {
 
 class BodySpaceSystem;
 
-// K = L D U without pivoting (L unit lower, U unit upper) for a sparse square K whose pattern
-// is symmetric, in the given order: up-looking, row k of L and column k of U from two sparse
-// triangular solves over the elimination tree (built as it goes), so L and U^T share one
-// pattern, that of the Cholesky factor of the pattern. Twice an LDL^T's work; the symbolic pass
-// (elimination tree, column counts) is skipped when the pattern is the last factorization's.
-// factorSymmetric is the same for a symmetric K (U = L^T, one triangular solve per row).
-class SymmetricPatternLu {
- public:
-  // K (m x m) in compressed columns, rows in any order within a column; kt holds the values of
-  // K^T on the same pattern (kt at the entry (i, j) is K(j, i)). False when a pivot's magnitude
-  // is at most pivotTolerance (or not finite).
-  bool factor(int m, const std::vector<int>& outer, const std::vector<int>& inner,
-              const std::vector<double>& k, const std::vector<double>& kt, double pivotTolerance);
-  bool factorSymmetric(int m, const std::vector<int>& outer, const std::vector<int>& inner,
-                       const std::vector<double>& k, double pivotTolerance);
-  void solve(Vector& y) const;  // y <- K^-1 y
-  // y <- L^-1 y for a y that is zero outside idx; idx becomes the rows where the result may be
-  // nonzero (idx's reach in the elimination tree: L(r, i) != 0 only for ancestors r of i), in
-  // increasing order. Costs the entries of L in those columns, not m.
-  void forward(std::vector<int>& idx, Vector& y);
-  double pivot(int c) const { return d_[c]; }                         // D's entry c
-  int entries() const { return start_.empty() ? 0 : start_.back(); }  // L's off-diagonal entries
-
- private:
-  bool run(int m, const std::vector<int>& outer, const std::vector<int>& inner,
-           const std::vector<double>& k, const std::vector<double>* kt, double pivotTolerance);
-  // Column c of L (and row c of U) at [start_[c], start_[c + 1]): rows_, l_ = L(row, c),
-  // u_ = U(c, row) (unused when symmetric_), sized by a symbolic pass over the elimination tree.
-  std::vector<int> start_, fill_, rows_;
-  std::vector<double> l_, u_, d_, y_, z_;
-  std::vector<int> parent_, tag_, stack_;
-  std::vector<int> analyzedOuter_, analyzedInner_;  // the pattern parent_ and start_ are for
-  std::vector<char> reached_;
-  bool symmetric_ = false;
-};
-
 class BlockPivoting {
  public:
   BlockPivoting();
   ~BlockPivoting();
   // The rows the next runs' problem was assembled from (nullptr: none): block steps may then be
   // solved in body space (linalg/body_space.hpp). Not owned; must outlive the runs. Prepared once,
-  // at the first run after this call (DantzigSolver's cold trial and warm stage share it): call it
-  // again for another problem.
+  // at the first run after this call: call it again for another problem.
   void setRows(const RowSystem* rows) {
     rows_ = rows;
     rowsPrepared_ = false;
@@ -77,20 +93,18 @@ class BlockPivoting {
     std::string message;
   };
 
-  // Runs from x (all zero: the cold guess "every row clamped"); leaves in x the solution when
-  // settled, else the iterate with the fewest violated rows. A must be symmetric (checked unless
-  // symmetryKnown: a previous run() on the same problem found it so). A trial takes full steps
-  // only and ends at the first one that brings no new lowest merit.
+  // Runs from x (all zero: the cold guess "every row clamped"; atGuess: "First sets" above);
+  // leaves in x the solution when settled, else the best iterate by residual (the start
+  // included). A must be symmetric (checked unless symmetryKnown: the caller has checked it).
   Report run(const Problem& problem, Vector& x, const Options& options, int maxSteps,
-             bool trial = false, bool symmetryKnown = false, bool atGuess = false);
+             bool atGuess = false, bool symmetryKnown = false);
 
   int orderings() const { return aPattern_.analyses(); }
 
   // Most sliding rows handled by Woodbury on the symmetric factor (more: the LU), and most
   // unknowns by which a step's sets may differ from the last factored ones (joined, left and
-  // sliding rows) for the step to reuse that factor. DantzigParams documents them.
-  // descentSteps and breakCycles: see DantzigParams::blockDescentSteps / blockBreakCycles;
-  // bodyMinDiagonal: DantzigParams::blockBodyMinDiagonal.
+  // sliding rows) for the step to reuse that factor; descentSteps and breakCycles: "Steps" above;
+  // bodyMinDiagonal: "Body space" above. NewtonParams documents the first four.
   struct Limits {
     int woodburyRows = 16;
     int updateRows = 40;
