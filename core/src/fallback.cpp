@@ -90,7 +90,8 @@ void AutoSolver::run(const Problem& problem, Vector& x, Result& result) {
     return;
   }
   const Choice choice =
-      policy.choose(c, problem.size(), options().tolerance, positiveDiagonal(problem));
+      policy.choose(c, problem.size(), options().tolerance, positiveDiagonal(problem), false,
+                    hasFreeRows(problem.lo, problem.hi));
   std::string chain;
   for (const char* name : {choice.solver, choice.fallback})
     if (registered(name)) chain += (chain.empty() ? "" : ">") + std::string(name);

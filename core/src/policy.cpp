@@ -5,14 +5,15 @@
 namespace mlcp {
 
 Choice Policy::choose(ProblemClass c, int rows, double tolerance, bool positiveDiagonal,
-                      bool budgetSpent) const {
+                      bool budgetSpent, bool freeRows) const {
   switch (c) {
     case ProblemClass::Empty: return {"none", "", "empty"};
     case ProblemClass::Linear: return {"ldlt", "pgs", "bilateral rows only"};
     default: break;
   }
   if (!positiveDiagonal) return {"lemke", "newton", "a row with A_ii <= 0"};
-  if (rows <= smallIslandRows) return {"dantzig", "pgs", "small contact island"};
+  if (rows <= (freeRows ? smallIslandRows : smallContactRows))
+    return {"dantzig", "pgs", "small contact island"};
   if (budgetSpent) return {"pgs", "", "large contact island, step budget spent"};
   if (tolerance >= looseTolerance)
     return {"pgs", "dantzig", "large contact island, loose tolerance"};
@@ -25,6 +26,12 @@ bool Policy::demotes(const Result& rejected, double acceptResidual, int cutsInRo
   if (!std::isfinite(rejected.residual)) return true;
   if (rejected.status == Status::TimeLimit && cutsInRow < cutsBeforeDemotion) return false;
   return !(rejected.residual <= nearMiss * acceptResidual);
+}
+
+bool hasFreeRows(const Vector& lo, const Vector& hi) {
+  for (Eigen::Index i = 0; i < lo.size(); ++i)
+    if (lo[i] == -kInf && hi[i] == kInf) return true;
+  return false;
 }
 
 bool acceptable(const Result& r, double acceptResidual) {

@@ -430,7 +430,8 @@ IslandSolve RowSolver::solveScreened(const RowSystem& rows, const Vector& start,
     r = solveCone(start, x, island, out, share, t0);
   } else if (autoChoice) {
     const bool spent = budgetSpent(share);
-    const Choice c = policy.choose(out.problemClass, n, settings_.options.tolerance, true, spent);
+    const Choice c = policy.choose(out.problemClass, n, settings_.options.tolerance, true, spent,
+                                   hasFreeRows(rows.lo, rows.hi));
     out.requested = c.solver;
     if (island.pgsFirst > 0 && !equals(out.requested, "ldlt") && !equals(out.requested, "pgs")) {
       --island.pgsFirst;

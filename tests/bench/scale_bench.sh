@@ -21,6 +21,7 @@
 #
 # Usage: tests/bench/scale_bench.sh MLCP_BINARY OUT.csv [STEPS] [LIMIT_SECONDS] [SCENES...]
 # Environment: ENGINES (default "bullet ode"), SOLVERS (ours, default "pgs dantzig newton auto"),
+# STOCK (the engines' solvers to run, default all of the engine's above; "" for none),
 # DENSE_ROWS (default 12000), MEMORY_KB (address-space limit of each run, default 8000000),
 # CAPTURE_STEP (default 0), MLCP_RUN_ARGS (more `mlcp run` options for every run).
 set -uo pipefail
@@ -71,7 +72,9 @@ for scene in "${scenes[@]}"; do
       --capture "$capture_step" --capture-dir "$cap" > /dev/null 2>&1
     sizes=$(island_sizes "$cap")
     largest=${sizes##*,}
-    if [ "$engine" = bullet ]; then
+    if [ -n "${STOCK+set}" ]; then
+      read -r -a stock <<< "$STOCK"
+    elif [ "$engine" = bullet ]; then
       stock=(bullet-si bullet-mlcp-dantzig bullet-mlcp-lemke)
     else
       stock=(ode-world ode-quick)

@@ -51,6 +51,36 @@ TEST(Policy, TheLargeIslandSolverIsOneNamedParameter) {
   EXPECT_STREQ(p.choose(ProblemClass::Findex, 11, 1e-8).solver, "newton");
 }
 
+// Contact islands without free rows are newton's above smallContactRows; with a free (joint)
+// row dantzig keeps them up to smallIslandRows. RowSolver reads the structure from the rows.
+TEST(Policy, IslandsOfContactsOnlyAreNewtonsFromFewerRows) {
+  const Policy p;
+  ASSERT_LT(p.smallContactRows, p.smallIslandRows);
+  for (ProblemClass c : {ProblemClass::StandardLcp, ProblemClass::Boxed, ProblemClass::Findex}) {
+    const int mid = p.smallContactRows + 1;
+    EXPECT_STREQ(p.choose(c, p.smallContactRows, 1e-6, true, false, false).solver, "dantzig");
+    EXPECT_EQ(p.choose(c, mid, 1e-6, true, false, false).solver, std::string(kLargeIslandSolver));
+    EXPECT_STREQ(p.choose(c, mid, 1e-6, true, false, true).solver, "dantzig");
+    EXPECT_STREQ(p.choose(c, mid, 1e-6).solver, "dantzig");  // unknown: the joints' threshold
+  }
+  const Vector lo = (Vector(3) << 0, -1, -kInf).finished();
+  EXPECT_TRUE(hasFreeRows(lo, Vector::Constant(3, kInf)));
+  EXPECT_FALSE(hasFreeRows(lo, (Vector(3) << kInf, 1, 2).finished()));
+
+  test::PyramidSpec spec;
+  spec.levels = 4;
+  const test::BoxPyramid pyramid(spec);
+  RowSystem rows = pyramid.rows();
+  ASSERT_GT(rows.size(), p.smallContactRows);
+  ASSERT_LE(rows.size(), p.smallIslandRows);
+  RowSolver solver;
+  Vector x;
+  EXPECT_EQ(solver.solve(rows, Vector::Zero(rows.size()), x).requested, "newton");
+  rows.lo[0] = -kInf;  // a contact's normal row made a joint's
+  rows.hi[0] = kInf;
+  EXPECT_EQ(solver.solve(rows, Vector::Zero(rows.size()), x).requested, "dantzig");
+}
+
 TEST(Policy, BreakdownsAndFarMissesDemoteNearMissesDoNot) {
   const Policy p;
   Result r;

@@ -113,11 +113,6 @@ constexpr const char* kPgsLimit =
     "pgs convergence: at the engine's count (the scene's 50 sweeps; no fallback, the same sweeps "
     "would repeat) pgs does not reach the 1e-3 acceptance on these large contact islands (a "
     "method limit; the slow-exact-solvers-on-large-islands work replaces pgs here)";
-constexpr const char* kFrictionPasses =
-    "dantzig's exact-friction fixed point: on one island of step 28 (395 rows, 112 friction) its "
-    "passes settle after 124 (80-200 pivots in all), beyond the scene's 50 iterations "
-    "(Options::maxIterations bounds the passes; --iterations 200 leaves no step unsolved), and "
-    "the pgs fallback (the scene's 50 sweeps) reaches 0.12";
 constexpr const char* kVehiclePgs =
     "pgs at QuickStep's count (the scene's 50 sweeps, w 1.3; no fallback: the same sweeps would "
     "repeat): the 200 kg chassis on 10 kg wheels gives A a condition number of 2.8e3 after "
@@ -132,8 +127,6 @@ constexpr const char* kHullsPgs =
     "after diagonal scaling; two steps end at 1.1e-3, just above the 1e-3 acceptance (a method "
     "limit at the engine's count)";
 const KnownFailure kKnownFailures[] = {
-    {"ragdoll_pile", "bullet", "dantzig", kFrictionPasses, false},
-    {"ragdoll_pile", "bullet", "auto", kFrictionPasses, false},
     {"vehicle", "ode", "pgs", kVehiclePgs, false},
     {"vehicle", "ode", "ldlt", kVehicleLdlt, false},
     {"hull_stack", "ode", "pgs", kHullsPgs, false},

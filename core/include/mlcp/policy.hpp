@@ -10,15 +10,17 @@
 // islands (RowSolver, row_solver.hpp) and for the CLI (which reaches them through those two).
 //
 // The choice, from the problem's structure (ProblemClass, problem.hpp: read from the bounds and
-// findex alone), its size in rows, the requested tolerance and whether a time budget is spent:
+// findex alone, and whether any row is free: (-inf, inf), a joint's), its size in rows, the
+// requested tolerance and whether a time budget is spent:
 //   Empty                           -> "none"     nothing to solve
 //   Linear (bilateral joints only)  -> "ldlt"     one LDL^T solve: exact, the cheapest answer
 //   a row with A_ii <= 0            -> "lemke"    (fallback "newton"): neither pgs nor dantzig's
 //                                                 ratio tests can divide by it; newton's dense
 //                                                 LU / least-squares steps take the singular
 //                                                 equality blocks (diode bridges) lemke cannot
-//   contacts, rows <= smallIslandRows          -> "dantzig" exact pivoting answer (~1e-12)
-//   contacts, rows >  smallIslandRows:
+//   contacts with free rows (joints), rows <= smallIslandRows,
+//   contacts only, rows <= smallContactRows    -> "dantzig" exact pivoting answer (~1e-12)
+//   larger contact islands:
 //     the step's time budget spent             -> "pgs"      (improves any start in any share)
 //     tolerance >= looseTolerance              -> "pgs"      (fallback "dantzig")
 //     otherwise                                -> largeIslandSolver ("newton"), whose
@@ -32,7 +34,11 @@
 // body-space factorization (newton.hpp) and whose cold starts never pivot from zero (Bullet's
 // 55-box pyramid under the 0.05 s budget: 18 of 30 steps converged, against none for dantzig,
 // whose cut first steps demote the island to pgs), all bounded by the time budget
-// (row_solver.hpp).
+// (row_solver.hpp). Islands of contacts only are newton's from fewer rows: there its steps
+// converge in a few factorizations where pivoting's cost grows with the rows (Bullet's and
+// ODE's 15-box pyramids, 255 and 285 rows: newton 0.47 and 0.20 ms a step against dantzig's 2.3
+// and 1.8 ms); with joint rows newton can stall where pivoting ends exact (Bullet's ragdoll
+// pile, a 196-row island of 128 joint rows: newton stops at 1e-2, dantzig converges).
 // The measurements: docs/benchmarks.md, "auto's choices and the time budget".
 //
 // The fallback rule (the same for a registry chain "a>b>c" and for RowSolver's primary and
@@ -61,7 +67,8 @@
 
 namespace mlcp {
 
-// The solver for contact islands above Policy::smallIslandRows rows at a tight tolerance.
+// The solver for contact islands above Policy::smallIslandRows rows (smallContactRows without
+// free rows) at a tight tolerance.
 inline constexpr const char* kLargeIslandSolver = "newton";
 
 // What the policy picked, and why in words (for Result::message). Static strings, or (solver)
@@ -75,8 +82,12 @@ struct Choice {
 };
 
 struct Policy {
-  // Largest contact island handed to dantzig whatever the tolerance, in rows. Default 600.
+  // Largest contact island with free rows (joints) handed to dantzig whatever the tolerance, in
+  // rows. Default 600.
   int smallIslandRows = 600;
+  // Largest contact island without free rows (contacts only) handed to dantzig whatever the
+  // tolerance, in rows. Default 100.
+  int smallContactRows = 100;
   // Solver of larger contact islands at tolerances below looseTolerance. Default
   // kLargeIslandSolver ("newton").
   std::string largeIslandSolver = kLargeIslandSolver;
@@ -92,9 +103,10 @@ struct Policy {
 
   // The choice for a problem of this class and size. positiveDiagonal: every A_ii > 0 (always
   // true for engine rows with cfm > 0; RowSolver does not look). budgetSpent: the step's time
-  // budget is spent and this solve has only its minimal share.
+  // budget is spent and this solve has only its minimal share. freeRows: some row is free
+  // (hasFreeRows); when not known, true (the joints' threshold, the more conservative one).
   Choice choose(ProblemClass c, int rows, double tolerance, bool positiveDiagonal = true,
-                bool budgetSpent = false) const;
+                bool budgetSpent = false, bool freeRows = true) const;
   // Solves in a row of one island cut by the time budget before a far miss of the last demotes
   // it. Default 2: one cut solve is often a cold first step (newton's 11-20 steps on the 210-box
   // pyramid when the contacts appear) that leaves a start from which the next, warm solve
@@ -109,6 +121,9 @@ struct Policy {
   // in it.
   bool demotes(const Result& rejected, double acceptResidual, int cutsInRow = 1) const;
 };
+
+// Whether any row is free, lo = -inf and hi = +inf (a joint's bilateral row).
+bool hasFreeRows(const Vector& lo, const Vector& hi);
 
 // Rule 1 above: the status is not Failed, NumericalIssue, InvalidInput or Unsupported and the
 // residual is finite and <= acceptResidual.
