@@ -130,7 +130,7 @@ BULLET_STATES = [
     ("bullet-steady-55", "55, the demo's steady state"),
     ("bullet-switch-210", "210 boxes, after the switch"),
 ]
-BULLET_SOLVERS = ["SI (stock)", "ours pgs", "MLCP-PGS (stock)", "ours dantzig",
+BULLET_SOLVERS = ["SI (stock)", "ours pgs", "MLCP-PGS (stock)", "ours dantzig", "ours newton",
                   "MLCP-Dantzig (stock)", "ours lemke", "MLCP-Lemke (stock)"]
 
 
@@ -157,11 +157,12 @@ def bullet(out):
     for label in BULLET_SOLVERS:
         if any(label in rows for _, _, rows in parsed):
             lines.append(f"| {label} | " + " | ".join(cell(r, label) for _, _, r in parsed) + " |")
-    ratios = []
-    for _, _, rows in parsed:
-        a, b = rows.get("MLCP-Dantzig (stock)"), rows.get("ours dantzig")
-        ratios.append(f"**{a[0] / b[0]:.1f}x**" if a and b and b[0] > 0 else "")
-    lines.append("| dantzig speed-up (stock / ours) | " + " | ".join(ratios) + " |")
+    for ours in ("dantzig", "newton"):
+        ratios = []
+        for _, _, rows in parsed:
+            a, b = rows.get("MLCP-Dantzig (stock)"), rows.get("ours " + ours)
+            ratios.append(f"**{a[0] / b[0]:.1f}x**" if a and b and b[0] > 0 else "")
+        lines.append(f"| {ours} speed-up (stock Dantzig / ours) | " + " | ".join(ratios) + " |")
     return stamp(out, [n for n, _, _ in states]) + "\n".join(lines) + "\n"
 
 

@@ -44,7 +44,7 @@ run() {
 }
 bench=$build/bench
 bin=$build/bin
-dz="ours dantzig,MLCP-Dantzig"
+dz="ours dantzig,ours newton,MLCP-Dantzig"
 run core "$bench/core_bench" --benchmark_min_time=0.2 --benchmark_format=json
 run bullet-switch-15 "$bin/bullet_bench" --sizes 15 --steps 10
 run bullet-switch-55 "$bin/bullet_bench" --sizes 55 --steps 10 --only "SI,ours pgs,MLCP-PGS,$dz"
