@@ -16,10 +16,18 @@
 // factor); the block LU is timed on both. Each time is the median of repeats (at least 5, until
 // 0.5 s); each factor is checked by a solve (relative residual of S z = r). The BLAS is whichever
 // libblas.so.3 the process loaded (printed).
+//
+// A second table does the same for the row-space systems of newton's pivoting phase
+// (core/src/block_pivoting.hpp) when body space does not apply (cfm = 0 at rho = 0): K = A_CC with
+// each sliding row's column c_t A_{C,t} added to its normal's column, in the AMD order of A that
+// block pivoting inherits, factored by the library's SymmetricPatternLu (LU without pivoting on
+// the symmetric pattern; LDL^T without the sliding rows) against CHOLMOD (without the sliding
+// rows), KLU and UMFPACK on the same matrix.
 #include <suitesparse/cholmod.h>
 #include <suitesparse/klu.h>
 #include <suitesparse/umfpack.h>
 
+#include <Eigen/OrderingMethods>
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -29,7 +37,8 @@
 #include <string>
 #include <vector>
 
-#include "../core/src/linalg/body_space.hpp"  // BodySpaceSystem (internal)
+#include "../core/src/linalg/body_space.hpp"            // BodySpaceSystem (internal)
+#include "../core/src/linalg/symmetric_pattern_lu.hpp"  // (internal)
 #include "common/contact_scenes.hpp"
 #include "mlcp/newton.hpp"
 
@@ -183,37 +192,49 @@ Sets setsOf(const mlcp::Problem& p, const Vector& x) {
   return s;
 }
 
+// A timing as a table cell: "median ms (solve check)", "-" when not run.
+std::string cell(const Timing& t) {
+  char buf[64];
+  if (t.ms < 0) return std::string("-");
+  std::snprintf(buf, sizeof buf, "%.3g ms (%.0e)", t.ms, t.residual);
+  return std::string(buf);
+}
+
 void row(int boxes, int coords, const Sets& sets, bool withSliding, const Csc& s, double blockMs,
          double blockResidual, const Vector& r) {
   const Timing ch = withSliding ? Timing{} : cholmod(s, r);
   const Timing k = klu(s, r), u = umfpack(s, r);
-  auto cell = [](const Timing& t) {
-    char buf[64];
-    if (t.ms < 0) return std::string("-");
-    std::snprintf(buf, sizeof buf, "%.3g ms (%.0e)", t.ms, t.residual);
-    return std::string(buf);
-  };
   std::printf("| %d | %d | %zu | %zu | %s | %zu | %.3g ms (%.0e) | %s | %s | %s |\n", boxes, coords,
               sets.order.size(), withSliding ? sets.sliding.size() : 0,
               withSliding ? "with sliding rows" : "without", s.index.size(), blockMs, blockResidual,
               cell(ch).c_str(), cell(k).c_str(), cell(u).c_str());
 }
 
-void bench(int levels, bool square) {
+// The bench's pyramid: levels boxes at the bottom (square: a square pyramid), sliding bodies.
+mlcp::test::PyramidSpec pyramidSpec(int levels, bool square) {
   mlcp::test::PyramidSpec spec;
   spec.levels = levels;
   spec.square = square;
   spec.sideVelocity = 0.5;
-  mlcp::test::BoxPyramid pyramid(spec);
-  const mlcp::RowSystem& rows = pyramid.rows();
-  const mlcp::Problem p = rows.assemble(true);
+  return spec;
+}
+
+// The sets of newton's answer (tolerance 1e-6, at most 60 steps) on the pyramid's problem p.
+Sets answerSets(const mlcp::test::BoxPyramid& pyramid, const mlcp::Problem& p) {
   mlcp::NewtonSolver newton;
   newton.options().tolerance = 1e-6;
   newton.options().maxIterations = 60;
-  newton.useRows(&rows);
+  newton.useRows(&pyramid.rows());
   Vector x;
   newton.solve(p, x);
-  const Sets sets = setsOf(p, x);
+  return setsOf(p, x);
+}
+
+void bench(int levels, bool square) {
+  mlcp::test::BoxPyramid pyramid(pyramidSpec(levels, square));
+  const mlcp::RowSystem& rows = pyramid.rows();
+  const mlcp::Problem p = rows.assemble(true);
+  const Sets sets = answerSets(pyramid, p);
   double dMax = 0;
   for (int i = 0; i < p.size(); ++i) dMax = std::max(dMax, p.diagonal(i));
   mlcp::detail::BodySpaceSystem body;
@@ -248,6 +269,94 @@ void bench(int levels, bool square) {
   }
 }
 
+// K of the sets (with or without the sliding rows' coupling) on A_CC's pattern, the clamped rows
+// in the AMD order of A; kt holds K^T's values on the same entries. False when a sliding row's
+// coupling falls outside that pattern (block pivoting then factors K by a general LU).
+bool clampedSystem(const mlcp::Problem& p, const Sets& sets, bool withSliding, Csc& k,
+                   std::vector<double>& kt) {
+  const mlcp::SparseMatrix& a = p.sparseA();  // symmetric: row i is column i
+  const Eigen::SparseMatrix<double, Eigen::ColMajor, int> pattern = a;
+  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> perm;
+  Eigen::AMDOrdering<int>()(pattern, perm);
+  std::vector<int> pos(p.size(), -1), order;
+  for (int r = 0; r < p.size(); ++r) {
+    const int i = perm.indices()[r];
+    if (sets.pos[i] >= 0) {
+      pos[i] = static_cast<int>(order.size());
+      order.push_back(i);
+    }
+  }
+  const int m = static_cast<int>(order.size());
+  // Dense per column is too big at 990 boxes: K's columns as maps from rows to values.
+  std::vector<std::vector<std::pair<int, double>>> col(m);
+  for (int c = 0; c < m; ++c)
+    for (mlcp::SparseMatrix::InnerIterator it(a, order[c]); it; ++it)
+      if (pos[it.index()] >= 0) col[c].push_back({pos[it.index()], it.value()});
+  auto add = [&](int c, int r, double v) {
+    for (auto& e : col[c])
+      if (e.first == r) return (e.second += v), true;
+    return false;
+  };
+  for (size_t q = 0; withSliding && q < sets.sliding.size(); ++q) {
+    const int t = sets.sliding[q], c = pos[p.findex[t]];
+    for (mlcp::SparseMatrix::InnerIterator it(a, t); it; ++it)
+      if (pos[it.index()] >= 0 && !add(c, pos[it.index()], sets.coeff[q] * it.value()))
+        return false;
+  }
+  k.n = m;
+  k.start.assign(1, 0);
+  k.index.clear();
+  k.values.clear();
+  for (int c = 0; c < m; ++c) {
+    std::sort(col[c].begin(), col[c].end());
+    for (const auto& [r, v] : col[c]) {
+      k.index.push_back(r);
+      k.values.push_back(v);
+    }
+    k.start.push_back(static_cast<int>(k.index.size()));
+  }
+  kt.resize(k.values.size());
+  for (int c = 0; c < m; ++c)
+    for (int e = k.start[c]; e < k.start[c + 1]; ++e) {
+      const int r = k.index[e];
+      const int* at = std::lower_bound(&k.index[k.start[r]], &k.index[k.start[r + 1]], c);
+      kt[e] = k.values[at - k.index.data()];  // K(c, r): the mirror entry (symmetric pattern)
+    }
+  return true;
+}
+
+void pivotingRow(int boxes, const mlcp::Problem& p, const Sets& sets, bool withSliding) {
+  Csc k;
+  std::vector<double> kt;
+  if (!clampedSystem(p, sets, withSliding, k, kt)) {
+    std::printf("| %d | %zu | %zu | coupling outside A_CC's pattern |\n", boxes, sets.order.size(),
+                sets.sliding.size());
+    return;
+  }
+  const Vector r = Vector::Ones(k.n);
+  mlcp::detail::SymmetricPatternLu lu;
+  bool ok = true;
+  const double ms = medianMs([&] {
+    ok = withSliding ? lu.factor(k.n, k.start, k.index, k.values, kt, 0.0)
+                     : lu.factorSymmetric(k.n, k.start, k.index, k.values, 0.0);
+  });
+  Vector z = r;
+  if (ok) lu.solve(z);
+  const Timing ch = withSliding ? Timing{} : cholmod(k, r);
+  const Timing kl = klu(k, r), u = umfpack(k, r);
+  std::printf("| %d | %d | %zu | %zu | %s | %.3g ms (%.0e) | %s | %s | %s |\n", boxes, k.n,
+              withSliding ? sets.sliding.size() : 0, k.index.size(),
+              withSliding ? "with sliding rows" : "without", ms, ok ? relResidual(k, r, z) : -1.0,
+              cell(ch).c_str(), cell(kl).c_str(), cell(u).c_str());
+}
+
+void pivotingBench(int levels, bool square) {
+  mlcp::test::BoxPyramid pyramid(pyramidSpec(levels, square));
+  const mlcp::Problem p = pyramid.rows().assemble(true);
+  const Sets sets = answerSets(pyramid, p);
+  for (const bool withSliding : {true, false}) pivotingRow(pyramid.boxes(), p, sets, withSliding);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -258,5 +367,10 @@ int main(int argc, char** argv) {
       "| boxes | S size | clamped rows | sliding rows | S | nnz(S) | block LU | CHOLMOD | KLU | "
       "UMFPACK |\n|---|---|---|---|---|---|---|---|---|---|\n");
   for (const std::string& l : levels) bench(std::atoi(l.c_str()), l.back() == 's');
+  std::printf(
+      "\nThe pivoting phase's K in row space:\n\n| boxes | clamped rows | sliding rows | nnz(K) | "
+      "K | SymmetricPatternLu | CHOLMOD | KLU | UMFPACK "
+      "|\n|---|---|---|---|---|---|---|---|---|\n");
+  for (const std::string& l : levels) pivotingBench(std::atoi(l.c_str()), l.back() == 's');
   return 0;
 }
