@@ -1,6 +1,7 @@
 #include "mlcp/input_limits.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -91,8 +92,26 @@ std::string jsonErrorText(const std::exception& e) {
 }
 
 std::string capped(const std::string& s, std::size_t maxChars) {
-  if (s.size() <= maxChars) return s;
-  return s.substr(0, maxChars > 3 ? maxChars - 3 : 0) + "...";
+  std::string out;
+  for (const char c : s) {
+    if (out.size() > maxChars) break;
+    const auto u = static_cast<unsigned char>(c);
+    if (c == '\n') {
+      out += "\\n";
+    } else if (c == '\r') {
+      out += "\\r";
+    } else if (c == '\t') {
+      out += "\\t";
+    } else if (u < 0x20 || u == 0x7f) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\x%02x", u);
+      out += hex;
+    } else {
+      out += c;
+    }
+  }
+  if (out.size() <= maxChars) return out;
+  return out.substr(0, maxChars > 3 ? maxChars - 3 : 0) + "...";
 }
 
 }  // namespace mlcp::io

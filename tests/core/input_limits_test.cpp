@@ -92,6 +92,7 @@ TEST(InputFiles, NestingLimitIs64Levels) {
 TEST(InputFiles, MessagesEchoAtMost60Characters) {
   EXPECT_EQ(io::capped("short"), "short");
   EXPECT_EQ(io::capped(std::string(1000, 'x')).size(), io::kMaxEchoChars);
+  EXPECT_EQ(io::capped(std::string(1000, '\n')).size(), io::kMaxEchoChars);
   // A megabyte string where a number belongs: the message stays short.
   const std::string text = R"({"format": "mlcp-problem/1", "n": 1, "A": [[1]], "b": [")" +
                            std::string(1 << 20, 'x') + "\"]}";

@@ -71,6 +71,12 @@ TEST(SceneFuzzRegression, LongUnknownField) {
   expectFileError("scene_long_unknown_field.json", {"unknown field \"po[[[[", "...\""});
 }
 
+// Found by scene_parser_fuzz: a key with an escaped newline ("radi\ns") was echoed with the
+// newline, a message of two lines. Echoed keys and names have their control characters escaped.
+TEST(SceneFuzzRegression, UnknownFieldWithANewlineIsOneLine) {
+  expectFileError("scene_unknown_field_with_newline.json", {"unknown field \"radi\\ns\""});
+}
+
 TEST(SceneFuzzRegression, LongNamesAreCappedInEveryMessage) {
   const std::string name(5000, 'n');
   for (const std::string& text :

@@ -54,7 +54,9 @@ void checkJsonNesting(const std::string& text, const std::string& source);
 // one short line.
 std::string jsonErrorText(const std::exception& e);
 
-// s itself when at most maxChars long, else its first maxChars - 3 characters and "...".
+// s with its control characters escaped (a newline as \n, others as \xHH: an echoed key or name
+// never breaks the message's line), itself when at most maxChars long, else its first
+// maxChars - 3 characters and "...".
 std::string capped(const std::string& s, std::size_t maxChars = kMaxEchoChars);
 
 }  // namespace mlcp::io
