@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <sstream>
 
 #include "../core/src/dantzig_small.hpp"      // the tiny dense path (internal)
 #include "../core/src/linalg/body_space.hpp"  // BodySpaceSystem (internal)
@@ -498,6 +499,28 @@ TEST(Dantzig, SingularBridgeIslandsAreRetriedRegularised) {
     EXPECT_NE(r.message.find("regularised"), std::string::npos) << r.message;
     EXPECT_LE(accuracy(p, x).residual, 1e-6);
   }
+}
+
+// DantzigParams::breakdownShift sets the retry's delta (relative to max |A_ii|): the message
+// names it, and a shift 100x larger leaves a residual on A that is not smaller.
+TEST(Dantzig, BreakdownShiftIsTheRetrysDelta) {
+  const Problem p = io::readProblemJson(std::string(MLCP_SOURCE_DIR) +
+                                        "/tests/data/plank_bridge_bullet_step26.json");
+  double dMax = 0;
+  for (int i = 0; i < p.size(); ++i) dMax = std::max(dMax, std::abs(p.diagonal(i)));
+  double residuals[2];
+  for (const int k : {0, 1}) {
+    DantzigSolver s;
+    s.options().tolerance = 1e-6;
+    s.params().breakdownShift = k == 0 ? 1e-10 : 1e-8;
+    Vector x;
+    const Result r = s.solve(p, x);
+    std::ostringstream delta;
+    delta << "A + " << s.params().breakdownShift * dMax << " I";
+    EXPECT_NE(r.message.find(delta.str()), std::string::npos) << r.message;
+    residuals[k] = accuracy(p, x).residual;
+  }
+  EXPECT_LE(residuals[0], residuals[1]);
 }
 
 // Redundant joints: a ball joint given twice (the second copy's rows scaled, as Bullet's two
