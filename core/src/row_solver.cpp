@@ -193,6 +193,8 @@ Solver* RowSolver::assembledSolver(Slot& island, const std::string& name, const 
       return solver.get();
   }
   island.solvers.emplace_back(tag + name, makeSolver(name));
+  if (auto* newton = dynamic_cast<NewtonSolver*>(island.solvers.back().second.get()))
+    newton->params() = settings_.newton;
   // solve() times the whole island (assembly, solve, check) with fewer clock reads.
   island.solvers.back().second->setTimed(false);
   return island.solvers.back().second.get();

@@ -335,8 +335,9 @@ TEST(LemkeLimits, RefusesATableauBeyondItsRowLimit) {
 
 // Auto on a large island: newton limited to ten damped steps stops short of the tolerance on a
 // cold pyramid (it needs 161); its pivoting phase (newton.hpp) finishes from there and ends
-// exact, with or without a time budget, and the answer is newton's own (no second solver).
-IslandSolve solveLargeIsland(double timeBudget, Vector& x) {
+// exact, with or without a time budget, and the answer is newton's own (no second solver). With
+// the phase off (RowSolverSettings::newton) the damped steps' answer stands, not converged.
+IslandSolve solveLargeIsland(double timeBudget, Vector& x, int pivotingSteps = -1) {
   test::PyramidSpec spec;
   spec.levels = 5;
   const test::BoxPyramid pyramid(spec);
@@ -345,6 +346,7 @@ IslandSolve solveLargeIsland(double timeBudget, Vector& x) {
   s.options.maxIterations = 10;   // newton's damped steps
   s.fallback = "";
   s.timeBudget = timeBudget;
+  if (pivotingSteps >= 0) s.newton.pivotingSteps = s.newton.bodyPivotingSteps = pivotingSteps;
   RowSolver solver(s);
   return solver.solve(pyramid.rows(), Vector::Zero(pyramid.rows().size()), x);
 }
@@ -363,6 +365,12 @@ TEST(AutoLargeIsland, NewtonsPivotingPhaseFinishesWhatItsDampedStepsLeftShort) {
         << out.result.message;
   }
   EXPECT_EQ(budgeted, unbudgeted);  // the same answer bit for bit
+  Vector off;
+  const IslandSolve damped = solveLargeIsland(10, off, 0);
+  EXPECT_EQ(damped.choice, "newton");
+  EXPECT_NE(damped.result.status, Status::Converged) << damped.result.message;
+  EXPECT_GT(damped.result.residual, kDefaultIslandTolerance);
+  EXPECT_EQ(damped.result.message.find("block pivoting"), std::string::npos);
 }
 
 }  // namespace

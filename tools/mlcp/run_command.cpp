@@ -30,6 +30,7 @@ struct RunArgs {
   std::string fallback = "pgs";
   double fallbackResidual = -1;
   double timeBudget = -1;  // -1: the adapters' default
+  int pivotingSteps = -1;  // -1: NewtonParams' defaults
   std::string friction;    // "" : the scene's
   int frictionDirections = -1;
   std::string csv;
@@ -55,6 +56,7 @@ int runScene(const RunArgs& args) {
   run.fallback = args.fallback == "none" ? "" : args.fallback;
   if (args.fallbackResidual >= 0) run.fallbackResidual = args.fallbackResidual;
   if (args.timeBudget >= 0) run.timeBudget = args.timeBudget;
+  run.pivotingSteps = args.pivotingSteps;
   if (!args.friction.empty()) parseFrictionModel(args.friction, run.friction);  // checked by CLI11
   if (args.frictionDirections >= 0) run.frictionDirections = args.frictionDirections;
   const int steps = args.steps >= 0 ? args.steps : s.settings.steps;
@@ -180,6 +182,10 @@ Runner addRunCommand(CLI::App& app) {
                   "only; default 0.05): islands solved after it ran out get a minimal share and "
                   "answers stopped by it report time-limit")
       ->check(nonNegativeNumber());
+  cmd->add_option("--pivoting-steps", args->pivotingSteps,
+                  "most block steps of newton's pivoting phase after damped steps that end short "
+                  "(core solvers only), 0 to turn it off (default 40, 120 on an engine's rows)")
+      ->check(CLI::Range(0, 1000000));
   cmd->add_option("--friction", args->friction,
                   "friction model: box (the engines' own) or cone (the polyhedral cone's LCP; "
                   "core solvers that take an LCP: auto, lemke, dantzig) (default: the scene's "

@@ -120,6 +120,8 @@ class BulletWorld : public scene::World {
       settings.acceptResidual = run.fallbackResidual;
       settings.engineIterations = run.engineIterations;  // m_numIterations is run.iterations
       settings.timeBudget = run.timeBudget;
+      if (run.pivotingSteps >= 0)
+        settings.newton.pivotingSteps = settings.newton.bodyPivotingSteps = run.pivotingSteps;
       settings.friction = run.friction;
       settings.frictionDirections = run.frictionDirections;
       solver = scenes::makeBulletSolver(name, settings);  // throws for unknown names

@@ -115,6 +115,8 @@ class OdeWorld : public scene::World {
     options.fallback = run.fallback;  // the stepper never falls back from "ode-..."
     options.acceptResidual = run.fallbackResidual;
     options.timeBudget = run.timeBudget;
+    if (run.pivotingSteps >= 0)
+      options.newton.pivotingSteps = options.newton.bodyPivotingSteps = run.pivotingSteps;
     options.friction = run.friction;
     options.frictionDirections = run.frictionDirections;
     stepper_ = std::make_unique<Stepper>(stepperName, options);

@@ -97,6 +97,7 @@
 
 #include "mlcp/friction_cone.hpp"
 #include "mlcp/friction_model.hpp"
+#include "mlcp/newton.hpp"
 #include "mlcp/policy.hpp"
 #include "mlcp/problem.hpp"
 #include "mlcp/result.hpp"
@@ -193,6 +194,10 @@ struct RowSolverSettings {
   // Friction directions per contact of the cone, in [kMinConeDirections, kMaxConeDirections]
   // ([3, 64]). Default kDefaultConeDirections (4: the engine's tangents +-t1, +-t2).
   int frictionDirections = kDefaultConeDirections;
+  // newton's parameters wherever it runs on an island (named, auto's choice or the fallback):
+  // e.g. pivotingSteps = bodyPivotingSteps = 0 turns its pivoting phase off. Default
+  // NewtonParams().
+  NewtonParams newton;
 };
 
 // Sets options' sweep limit to an engine's iteration count, checked once at the end.

@@ -70,6 +70,9 @@ struct RunSettings {
   // Wall-clock budget of one step's solves in seconds, 0 for none (core solvers only;
   // RowSolverSettings::timeBudget). Default the adapters' kDefaultTimeBudget (0.05 s).
   double timeBudget = kDefaultTimeBudget;
+  // Most block steps of newton's pivoting phase (RowSolverSettings::newton: pivotingSteps and
+  // bodyPivotingSteps), 0 to turn it off; -1 for NewtonParams' defaults (40, 120 with the rows).
+  int pivotingSteps = -1;
   // Friction model of contacts (mlcp/friction_model.hpp; core solvers only: a stock solver with
   // Cone is refused). Default Box.
   FrictionModel friction = FrictionModel::Box;
