@@ -557,7 +557,6 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
     rep.message = "A is not symmetric";
     return rep;
   }
-  rep.symmetric = true;
   problemFindex_ = pb.findex.empty() ? std::vector<int>(n, -1) : pb.findex;
   double dMax = 0;
   for (int i = 0; i < n; ++i) dMax = std::max(dMax, std::abs(pb.diagonal(i)));

@@ -87,7 +87,6 @@ class BlockPivoting {
   struct Report {
     bool settled = false;    // x solves the problem to Options::tolerance (checked by residual())
     int steps = 0;           // block steps (each one linear solve of the index sets' equations)
-    bool symmetric = false;  // A passed the symmetry check (else the stage did not run)
     int factorizations = 0;  // of the steps, those that factored their clamped block afresh
     int bodyFactorizations = 0;  // of those, the ones factored in body space
     std::string message;
@@ -98,8 +97,6 @@ class BlockPivoting {
   // included). A must be symmetric (checked unless symmetryKnown: the caller has checked it).
   Report run(const Problem& problem, Vector& x, const Options& options, int maxSteps,
              bool atGuess = false, bool symmetryKnown = false);
-
-  int orderings() const { return aPattern_.analyses(); }
 
   // Most sliding rows handled by Woodbury on the symmetric factor (more: the LU), and most
   // unknowns by which a step's sets may differ from the last factored ones (joined, left and

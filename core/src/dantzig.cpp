@@ -9,7 +9,6 @@
 #include "dantzig_small.hpp"
 #include "dantzig_workspace.hpp"
 #include "mlcp/residual.hpp"
-#include "mlcp/rows.hpp"
 #include "sparse_pattern.hpp"
 
 namespace mlcp {
@@ -31,7 +30,7 @@ void DantzigSolver::Workspace::build(const Problem& pb, const Vector& guess, boo
   const bool hasF = pb.hasFindex();
   auto friction = [&](int i) { return hasF && pb.findex[i] >= 0; };
   auto interior = [&](int i) {
-    if (isEquality(pb.lo[i], pb.hi[i])) return true;
+    if (isFreeRow(pb.lo[i], pb.hi[i])) return true;
     if (!useGuess) return false;
     if (friction(i)) {
       if (!exactFriction) return false;
@@ -45,7 +44,7 @@ void DantzigSolver::Workspace::build(const Problem& pb, const Vector& guess, boo
   inv.resize(n);  // the group of each row until the positions are known
   int start[5] = {0, 0, 0, 0, 0};
   for (int i = 0; i < n; ++i) {
-    const int g = isEquality(pb.lo[i], pb.hi[i]) ? 0 : interior(i) ? 1 : friction(i) ? 3 : 2;
+    const int g = isFreeRow(pb.lo[i], pb.hi[i]) ? 0 : interior(i) ? 1 : friction(i) ? 3 : 2;
     inv[i] = g;
     ++start[g + 1];
   }
@@ -567,7 +566,7 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
   // Pass 1 guesses the equality rows and (warm) the rows inside their bounds as clamped.
   for (int p = 0; p < n; ++p) {
     const int i = ws.perm[p];
-    const bool guessed = isEquality(problem.lo[i], problem.hi[i]) ||
+    const bool guessed = isFreeRow(problem.lo[i], problem.hi[i]) ||
                          (useGuess && ws.x[p] > ws.lo[p] && ws.x[p] < ws.hi[p]);
     ws.set[p] = guessed ? Set::Clamped : Set::Unprocessed;
   }

@@ -18,8 +18,6 @@ namespace {
 
 constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
 
-bool isEquality(double lo, double hi) { return lo == -kInf && hi == kInf; }
-
 // The guessed block's factors A_CC = L D L^T (D kept as its reciprocals), the clamped rows
 // being the first m positions of the processing order. The block is padded to n x n by
 // identity rows (L's row 0, D 1: the rows at a bound, which come after the clamped ones), so
@@ -118,7 +116,7 @@ Try solveFixed(const Problem& pb, double pivotTolerance, double* guess, Vector& 
   int group[n], perm[n], start[4] = {0, 0, 0, 0};
   for (int i = 0; i < n; ++i) {
     const double lo = pb.lo[i], hi = pb.hi[i], g = guess[i];
-    group[i] = isEquality(lo, hi) ? 0 : g > lo && g < hi ? 1 : 2;
+    group[i] = isFreeRow(lo, hi) ? 0 : g > lo && g < hi ? 1 : 2;
     ++start[group[i] + 1];
   }
   start[2] += start[1];

@@ -28,8 +28,6 @@ inline VMap vmap(std::vector<double>& v, int len, int offset = 0) {
   return VMap(v.data() + offset, len);
 }
 
-inline bool isEquality(double lo, double hi) { return lo == -kInf && hi == kInf; }
-
 // Sizes (rows of a product or of the clamped block) up to which plain loops beat Eigen's
 // vectorized kernels: islands of a few joints.
 constexpr int kSmall = 8;

@@ -7,7 +7,6 @@
 
 #include "block_pivoting.hpp"
 #include "mlcp/pgs.hpp"
-#include "mlcp/residual.hpp"
 #include "newton_system.hpp"
 
 namespace mlcp {
@@ -39,7 +38,6 @@ struct NewtonSolver::Work {
   };
   detail::NewtonSystem system;
   detail::BlockPivoting pivoting;
-  const RowSystem* rows = nullptr;
   Point at, trial, best;
   Vector dx, adx, g, jg, invDiag;  // adx = A dx
   // The merits of the iterates so far, and the line search's reference: the largest of the
@@ -55,10 +53,7 @@ NewtonSolver& NewtonSolver::operator=(NewtonSolver&&) noexcept = default;
 
 int NewtonSolver::analyses() const { return work_->system.analyses(); }
 int NewtonSolver::bodyFactorizations() const { return work_->system.bodyFactorizations(); }
-void NewtonSolver::useRows(const RowSystem* rows) {
-  work_->system.useRows(rows);
-  work_->rows = rows;
-}
+void NewtonSolver::useRows(const RowSystem* rows) { work_->system.useRows(rows); }
 
 // Backtracking from t = 1 along wk.dx from wk.at: the first t = 2^-k (k <= the halvings) with
 // ||H(x + t dx)||^2 <= reference + sigma t slope (slope < 0, the directional derivative;
@@ -228,10 +223,11 @@ void NewtonSolver::run(const Problem& pb, Vector& x, Result& result) {
 // when it settles, else its best iterate (never worse than x: its start counts as an iterate).
 void NewtonSolver::pivotingPhase(const Problem& pb, Vector& x, Result& result, std::ostream& os) {
   Work& wk = *work_;
-  const bool body = wk.rows != nullptr && wk.rows->size() == pb.size();
+  const RowSystem* rows = wk.system.rows();
+  const bool body = rows != nullptr && rows->size() == pb.size();
   const int steps = body ? params_.bodyPivotingSteps : params_.pivotingSteps;
   if (steps <= 0 || !wk.system.isSparse() || !wk.system.symmetric() || outOfTime()) return;
-  wk.pivoting.setRows(body ? wk.rows : nullptr);
+  wk.pivoting.setRows(body ? rows : nullptr);
   wk.pivoting.setLimits({params_.pivotingWoodburyRows, params_.pivotingUpdateRows,
                          params_.pivotingDescentSteps, params_.pivotingBreakCycles});
   const detail::BlockPivoting::Report rep = wk.pivoting.run(pb, x, options(), steps, true, true);

@@ -29,6 +29,7 @@ class NewtonSystem {
   // The rows the next prepared problem was assembled from (A = J W J^T + diag(cfm)), or null.
   // With them the sparse path solves the reduced system in body space when that applies.
   void useRows(const RowSystem* rows) { rows_ = rows; }
+  const RowSystem* rows() const { return rows_; }
   // Of the last solve: factorizations done in body space.
   int bodyFactorizations() const { return bodyFactorizations_; }
   // Per solve, before the steps: the problem (kept by reference until the next prepare); whole

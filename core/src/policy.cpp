@@ -28,12 +28,6 @@ bool Policy::demotes(const Result& rejected, double acceptResidual, int cutsInRo
   return !(rejected.residual <= nearMiss * acceptResidual);
 }
 
-bool hasFreeRows(const Vector& lo, const Vector& hi) {
-  for (Eigen::Index i = 0; i < lo.size(); ++i)
-    if (lo[i] == -kInf && hi[i] == kInf) return true;
-  return false;
-}
-
 bool acceptable(const Result& r, double acceptResidual) {
   switch (r.status) {
     case Status::Failed:

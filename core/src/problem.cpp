@@ -245,7 +245,7 @@ ProblemClass classifyBounds(const Vector& lo, const Vector& hi, const std::vecto
     if (f >= 0) return ProblemClass::Findex;
   bool allFree = true, allStandard = true;
   for (Eigen::Index i = 0; i < lo.size(); ++i) {
-    const bool freeRow = lo[i] == -kInf && hi[i] == kInf;
+    const bool freeRow = isFreeRow(lo[i], hi[i]);
     const bool standardRow = lo[i] == 0 && hi[i] == kInf;
     allFree = allFree && freeRow;
     allStandard = allStandard && standardRow;
@@ -253,6 +253,12 @@ ProblemClass classifyBounds(const Vector& lo, const Vector& hi, const std::vecto
   if (allFree) return ProblemClass::Linear;
   if (allStandard) return ProblemClass::StandardLcp;
   return ProblemClass::Boxed;
+}
+
+bool hasFreeRows(const Vector& lo, const Vector& hi) {
+  for (Eigen::Index i = 0; i < lo.size(); ++i)
+    if (isFreeRow(lo[i], hi[i])) return true;
+  return false;
 }
 
 ProblemClass Problem::classify() const {

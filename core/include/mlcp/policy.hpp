@@ -36,7 +36,7 @@
 // whose cut first steps demote the island to pgs), all bounded by the time budget
 // (row_solver.hpp). Islands of contacts only are newton's from fewer rows: there its steps
 // converge in a few factorizations where pivoting's cost grows with the rows (Bullet's and
-// ODE's 15-box pyramids, 255 and 285 rows: newton 0.47 and 0.20 ms a step against dantzig's 2.3
+// ODE's 15-box pyramids, 255 and 285 rows: newton 0.57 and 0.13 ms a step against dantzig's 2.3
 // and 1.8 ms); with joint rows newton can stall where pivoting ends exact (Bullet's ragdoll
 // pile, a 196-row island of 128 joint rows: newton stops at 1e-2, dantzig converges).
 // The measurements: docs/benchmarks.md, "auto's choices and the time budget".
@@ -104,7 +104,8 @@ struct Policy {
   // The choice for a problem of this class and size. positiveDiagonal: every A_ii > 0 (always
   // true for engine rows with cfm > 0; RowSolver does not look). budgetSpent: the step's time
   // budget is spent and this solve has only its minimal share. freeRows: some row is free
-  // (hasFreeRows); when not known, true (the joints' threshold, the more conservative one).
+  // (hasFreeRows, problem.hpp); when not known, true (the joints' threshold, the more conservative
+  // one).
   Choice choose(ProblemClass c, int rows, double tolerance, bool positiveDiagonal = true,
                 bool budgetSpent = false, bool freeRows = true) const;
   // Solves in a row of one island cut by the time budget before a far miss of the last demotes
@@ -121,9 +122,6 @@ struct Policy {
   // in it.
   bool demotes(const Result& rejected, double acceptResidual, int cutsInRow = 1) const;
 };
-
-// Whether any row is free, lo = -inf and hi = +inf (a joint's bilateral row).
-bool hasFreeRows(const Vector& lo, const Vector& hi);
 
 // Rule 1 above: the status is not Failed, NumericalIssue, InvalidInput or Unsupported and the
 // residual is finite and <= acceptResidual.

@@ -47,6 +47,10 @@ enum class ProblemClass {
 const char* toString(ProblemClass c);
 // The class from the bounds and findex alone (size n = lo.size(); findex may be empty).
 ProblemClass classifyBounds(const Vector& lo, const Vector& hi, const std::vector<int>& findex);
+// A free row, lo = -inf and hi = +inf: an equality (a joint's bilateral row), w = 0 at the answer.
+inline bool isFreeRow(double lo, double hi) { return lo == -kInf && hi == kInf; }
+// Whether any row is free.
+bool hasFreeRows(const Vector& lo, const Vector& hi);
 
 class Problem {
  public:
