@@ -20,7 +20,7 @@ columns in any order, extra columns ignored):
   solver_ms        wall time of the MLCP solve(s) in this step, milliseconds
   residual         scaled natural-map residual of the step's MLCP (dimensionless)
   iterations       iterations (or pivots) the solver used
-  status           converged | max-iterations | time-limit | failed | unsupported |
+  status           converged | least-squares | max-iterations | time-limit | failed | unsupported |
                    invalid-input | numerical-issue
   fallbacks        number of fallbacks taken in this step
   max_penetration  deepest contact penetration after the step, m
@@ -74,7 +74,7 @@ SWEEP_COLUMNS = ["scene", "engine", "solver", "setting", "value", "step", "solve
                  "joint_error"]
 STABILITY_COLUMNS = ["engine", "solver", "x_name", "x_value", "y_name", "y_value", "outcome"]
 FAILED = {"failed", "unsupported", "invalid-input", "numerical-issue"}
-STATUSES = ["converged", "max-iterations", "time-limit"] + sorted(FAILED)
+STATUSES = ["converged", "least-squares", "max-iterations", "time-limit"] + sorted(FAILED)
 OUTCOMES = OrderedDict([  # outcome -> (colour, letter); colour-blind-safe-ish, lettered anyway
     ("stable", ("#1b7837", "S")),
     ("drifting", ("#e8c547", "D")),

@@ -33,7 +33,7 @@ from collections import Counter, OrderedDict, defaultdict
 from chart import SWEEP_COLUMNS, InputError, aggregate, read_rows, safe_name, solver_order
 
 STATUS_SHORT = OrderedDict([("converged", "conv"), ("max-iterations", "max-it"),
-                            ("time-limit", "time"), ("failed", "FAILED"),
+                            ("time-limit", "time"), ("least-squares", "lsq"), ("failed", "FAILED"),
                             ("numerical-issue", "NUMERICAL"), ("unsupported", "UNSUPPORTED"),
                             ("invalid-input", "INVALID")])
 

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "linalg/min_norm.hpp"
 #include "sparse_pattern.hpp"
 
 namespace mlcp {
@@ -17,6 +18,23 @@ constexpr double kEnvelopeResidual = 1e-11;
 }  // namespace
 
 using ColMajor = Eigen::SparseMatrix<double, Eigen::ColMajor>;
+
+namespace {
+// The singular path's answer (linalg/min_norm.hpp) and its status: Converged when it solves A
+// x = -b to kEnvelopeResidual (a consistent system, e.g. a redundant joint that has not
+// drifted), LeastSquares otherwise (the base verifies its stationarity, solver.hpp).
+void reportSingular(const Vector& residual, const Vector& rhs, int steps, const char* storage,
+                    Result& result) {
+  const bool consistent =
+      residual.lpNorm<Eigen::Infinity>() <= kEnvelopeResidual * (1 + rhs.lpNorm<Eigen::Infinity>());
+  result.status = consistent ? Status::Converged : Status::LeastSquares;
+  result.iterations = steps;
+  result.message = std::string("A is singular (redundant rows): minimum-norm ") +
+                   (consistent ? "answer" : "least-squares answer, the rows are inconsistent") +
+                   " from the " + storage + " LL^T of A + delta I, " + std::to_string(steps) +
+                   " steps";
+}
+}  // namespace
 
 struct LdltSolver::Impl {
   Eigen::SimplicialLDLT<ColMajor> ldlt;
@@ -31,6 +49,9 @@ struct LdltSolver::Impl {
   std::vector<Eigen::Index> first;
   Eigen::LDLT<DenseMatrix> denseLdlt;
   Eigen::PartialPivLU<DenseMatrix> denseLu;
+  // The singular path's factorizations of A + delta I (linalg/min_norm.hpp).
+  Eigen::LLT<DenseMatrix> shifted;
+  Eigen::SimplicialLDLT<ColMajor> shiftedSparse;
 
   // Whether A equals A^T to 1e-14 relative to its largest entry (detail::isSymmetric's rule).
   static bool isSymmetric(const DenseMatrix& A);
@@ -135,53 +156,33 @@ void LdltSolver::runDense(const Problem& problem, Vector& x, Result& result) {
     }
   }
   const bool symmetric = Impl::isSymmetric(A);
-  if (symmetric && factored) {
-    // Symmetric, no small pivot, but the answer missed kEnvelopeResidual (ill-conditioned):
-    // the pivoting LDL^T below may do better; the base's check has the final say either way.
+  if (symmetric) {
+    // A (near-)zero pivot without pivoting, or an ill-conditioned A: Eigen's LDL^T with diagonal
+    // pivoting first (it takes indefinite A too).
     factorSolve(m.denseLdlt);
-    result.message = "dense pivoting LDL^T solve (envelope LDL^T residual too large)";
-  } else if (symmetric) {
-    // A (near-)zero pivot without pivoting: Eigen's LDL^T with diagonal pivoting, which drops
-    // (near-)zero pivots: a singular but consistent system still gets an answer, an
-    // inconsistent one a large residual, which the base reports as Failed.
-    factorSolve(m.denseLdlt);
-    const auto dd = m.denseLdlt.vectorD().cwiseAbs();
-    const bool singular = dd.minCoeff() <= 1e-14 * std::max(1.0, dd.maxCoeff());
-    result.message =
-        singular ? "dense pivoting LDL^T solve (A is singular)" : "dense pivoting LDL^T solve";
+    result.message = factored ? "dense pivoting LDL^T solve (envelope LDL^T residual too large)"
+                              : "dense pivoting LDL^T solve";
+    m.correction = m.rhs;
+    m.correction.noalias() -= A * x;
+    if (m.correction.lpNorm<Eigen::Infinity>() <=
+        kEnvelopeResidual * (1 + m.rhs.lpNorm<Eigen::Infinity>()))
+      return;
+    // Still a residual: A is singular (redundant rows). The minimum-norm least-squares answer
+    // (linalg/min_norm.hpp) from the LL^T of A + delta I; an indefinite A keeps the pivoting
+    // answer, which the base measures.
+    const double delta = linalg::kMinNormShift * std::max(1.0, A.diagonal().cwiseAbs().maxCoeff());
+    m.shifted.compute(A + delta * DenseMatrix::Identity(A.rows(), A.cols()));
+    if (m.shifted.info() != Eigen::Success) return;
+    const int steps = linalg::minNormSolve(
+        m.rhs, [&](const Vector& r, Vector& out) { out = m.shifted.solve(r); },
+        [&](const Vector& v, Vector& out) { out.noalias() = A * v; }, x);
+    reportSingular(A * x - m.rhs, m.rhs, steps, "dense", result);
   } else {
     // A zero pivot of a singular A gives Inf/NaN, which the base reports.
     factorSolve(m.denseLu);
     result.message = "dense LU solve";
   }
 }
-
-namespace {
-// A singular symmetric A (redundant joints) whose system is consistent: factor A + delta I,
-// delta = kRegularization * max |A_ii|, and refine against A itself. Each refinement step
-// multiplies the error's part along an eigenvalue lambda of A by delta / (lambda + delta), so
-// the part in A's range vanishes in a few steps and the part in its null space (which changes
-// neither A x nor the bodies' motion) stays bounded. True when the factorization succeeded;
-// the base's residual check says whether the system was consistent.
-constexpr double kRegularization = 1e-9;
-constexpr int kRefinements = 8;
-
-bool solveRegularized(const Eigen::SparseMatrix<double>& A, const Vector& rhs, Vector& x) {
-  const double delta = kRegularization * std::max(1.0, A.diagonal().cwiseAbs().maxCoeff());
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> f;
-  f.setShift(delta);
-  f.compute(A);
-  if (f.info() != Eigen::Success) return false;
-  x = f.solve(rhs);
-  const double target = 1e-14 * (1 + rhs.lpNorm<Eigen::Infinity>());
-  for (int k = 0; k < kRefinements; ++k) {
-    const Vector r = rhs - A * x;
-    if (!(r.lpNorm<Eigen::Infinity>() > target)) break;
-    x += f.solve(r);
-  }
-  return x.allFinite();
-}
-}  // namespace
 
 LdltSolver::LdltSolver() : impl_(std::make_unique<Impl>()) {}
 LdltSolver::~LdltSolver() = default;
@@ -236,17 +237,21 @@ void LdltSolver::run(const Problem& problem, Vector& x, Result& result) {
   m.lastSymmetric = symmetric;
   if (symmetric && !ok) ok = factorSolve(m.ldlt, true);
   if (!symmetric) ok = factorSolve(m.lu, false);
-  // A singular A factors with a (near-)zero pivot or not at all: regularised instead, and the
-  // better of the two answers kept.
+  // A singular A factors with a (near-)zero pivot or not at all, or leaves a residual: the
+  // minimum-norm least-squares answer (linalg/min_norm.hpp) from the LL^T of A + delta I.
   const double target = kEnvelopeResidual * (1 + rhs.lpNorm<Eigen::Infinity>());
-  const double plain = ok ? (rhs - A * x).lpNorm<Eigen::Infinity>() : kInf;
-  Vector xr;
-  if (symmetric && !(plain <= target) && solveRegularized(A, rhs, xr) &&
-      !((rhs - A * xr).lpNorm<Eigen::Infinity>() >= plain)) {
-    x.swap(xr);
-    result.status = Status::Converged;
-    result.message = "sparse LDL^T solve of A + delta I, refined (A is singular)";
-    return;
+  if (symmetric && !(ok && (rhs - A * x).lpNorm<Eigen::Infinity>() <= target)) {
+    const double delta = linalg::kMinNormShift * std::max(1.0, A.diagonal().cwiseAbs().maxCoeff());
+    m.shiftedSparse.setShift(delta);
+    m.shiftedSparse.compute(A);
+    if (m.shiftedSparse.info() == Eigen::Success) {
+      const int steps = linalg::minNormSolve(
+          rhs, [&](const Vector& r, Vector& out) { out = m.shiftedSparse.solve(r); },
+          [&](const Vector& v, Vector& out) { out = A * v; }, x);
+      reportSingular(A * x - rhs, rhs, steps, "sparse", result);
+      return;
+    }
+    ok = false;
   }
   if (!ok) {
     result.status = Status::Failed;

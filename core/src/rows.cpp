@@ -147,6 +147,8 @@ Vector RowSystem::slack(const Vector& x) const {
   return w;
 }
 
+double RowSystem::impulseEnergy(const Vector& x) const { return 0.5 * x.dot(slack(x) - b); }
+
 Problem RowSystem::assemble(bool sparse) const {
   Problem p;
   AssembleScratch scratch;

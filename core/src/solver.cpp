@@ -21,6 +21,7 @@ const char* toString(Status s) {
     case Status::Unsupported: return "unsupported";
     case Status::InvalidInput: return "invalid-input";
     case Status::NumericalIssue: return "numerical-issue";
+    case Status::LeastSquares: return "least-squares";
   }
   return "unknown";
 }
@@ -48,7 +49,11 @@ void applyAccuracy(Result& r, const Accuracy& a, double tolerance) {
     if (r.message.empty()) r.message = "the iterate holds NaN or Inf";
   } else if (a.residual <= tolerance) {
     // An iterative method may stop on its own criterion; the checked residual decides.
-    if (r.status == Status::MaxIterations || r.status == Status::TimeLimit) {
+    if (r.status == Status::LeastSquares) {
+      // Inconsistent only below the tolerance: an answer like any other.
+      r.status = Status::Converged;
+      r.message += "; the residual is within tolerance";
+    } else if (r.status == Status::MaxIterations || r.status == Status::TimeLimit) {
       r.status = Status::Converged;
       r.message = "residual within tolerance";
     }
@@ -106,6 +111,35 @@ void Solver::keepStartIfBetter(const Problem& problem, const Vector* start, Resu
     start_ = *start;
   else
     start_.setZero(problem.size());
+}
+
+void verifyLeastSquares(const Problem& problem, const Vector& w, Result& r) {
+  const bool linear = problem.classify() == ProblemClass::Linear;
+  Vector g;
+  double normA = 0;
+  if (problem.isSparse()) {
+    g = problem.sparseA().transpose() * w;
+    for (Eigen::Index k = 0; k < problem.sparseA().outerSize(); ++k) {
+      double row = 0;
+      for (SparseMatrix::InnerIterator it(problem.sparseA(), k); it; ++it)
+        row += std::abs(it.value());
+      normA = std::max(normA, row);
+    }
+  } else {
+    g = problem.denseA().transpose() * w;
+    normA = problem.denseA().cwiseAbs().rowwise().sum().maxCoeff();
+  }
+  const double scale = normA * (1 + problem.b.lpNorm<Eigen::Infinity>());
+  const double stationarity = g.lpNorm<Eigen::Infinity>();
+  if (linear && stationarity <= kLeastSquaresStationarity * scale) return;
+  std::ostringstream os;
+  if (linear)
+    os << "not a least-squares answer: ||A^T w|| / (||A|| (1 + ||b||)) = " << stationarity / scale;
+  else
+    os << "a least-squares answer is defined for equality rows only";
+  os << " (" << r.message << ")";
+  r.status = Status::Failed;
+  r.message = os.str();
 }
 
 bool takeStartIfBetter(Result& r, const Accuracy& start, double tolerance) {
@@ -171,6 +205,7 @@ Result Solver::runChecked(const Problem& problem, Vector& x, const Vector* start
   applyAccuracy(r, checkedAccuracy(problem, start_, slack_, options_.tolerance),
                 options_.tolerance);
   if (r.status == Status::TimeLimit) keepStartIfBetter(problem, start, r);
+  if (r.status == Status::LeastSquares) verifyLeastSquares(problem, slack_, r);
   x.swap(start_);
   r.seconds = elapsed();
   return r;

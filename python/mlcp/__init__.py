@@ -86,7 +86,7 @@ class Result:
 
     x: np.ndarray  # the solution (or the last iterate), n entries
     w: np.ndarray  # A x + b at x
-    status: str  # "converged", "max-iterations", "time-limit", "failed", "unsupported", ...
+    status: str  # "converged", "least-squares", "max-iterations", "time-limit", "failed", ...
     residual: float  # scaled natural-map residual at x, recomputed from the problem
     iterations: int  # sweeps, or pivots for pivoting methods
     solver: str  # the solver that produced x (auto and fallback chains name their choice)

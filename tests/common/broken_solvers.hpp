@@ -1,5 +1,6 @@
 // Solvers that break on purpose, to check that fallbacks happen, are counted and reported.
-// registerBrokenSolvers() adds them to the registry as "test-nan", "test-fail" and "test-throw",
+// registerBrokenSolvers() adds them to the registry as "test-nan", "test-fail", "test-explode" and
+// "test-throw",
 // so that the adapters (which take solvers by name) can be handed them too.
 #pragma once
 
@@ -33,6 +34,20 @@ class BrokenSolver : public Solver {
   bool nan_;
 };
 
+// Answers the start plus 1e4 in every row and claims MaxIterations: an exploded iterate, finite
+// and far too large (what a diverged method or a singular system's regularised answer gives).
+class ExplodingSolver : public Solver {
+ public:
+  const char* name() const override { return "test-explode"; }
+
+ protected:
+  void run(const Problem&, Vector& x, Result& result) override {
+    x.array() += 1e4;
+    result.status = Status::MaxIterations;
+    result.message = "injected explosion";
+  }
+};
+
 // Throws std::runtime_error("injected exception") from its solve: an exception from inside an
 // engine's step, for the adapters' error paths.
 class ThrowingSolver : public Solver {
@@ -51,6 +66,8 @@ inline void registerBrokenSolvers() {
                     [] { return std::unique_ptr<Solver>(new BrokenSolver(true)); }});
     registerSolver({"test-fail", "reports Failed (tests only)",
                     [] { return std::unique_ptr<Solver>(new BrokenSolver(false)); }});
+    registerSolver({"test-explode", "answers the start + 1e4 (tests only)",
+                    [] { return std::unique_ptr<Solver>(new ExplodingSolver()); }});
     registerSolver({"test-throw", "throws from its solve (tests only)",
                     [] { return std::unique_ptr<Solver>(new ThrowingSolver()); }});
     return true;

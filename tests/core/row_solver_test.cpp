@@ -187,6 +187,73 @@ TEST(RowSolver, NothingUsableKeepsTheStart) {
   EXPECT_NEAR(s.result.residual, rowResidual(rows, start), 1e-12);
 }
 
+// Stage 5: an unacceptable answer that moves the bodies far more than pgs's is never applied
+// (with no fallback configured, pgs runs for the comparison); one of sane size is.
+TEST(RowSolver, AnExplodedAnswerIsNeverAppliedPgsIsInstead) {
+  test::registerBrokenSolvers();
+  const RowSystem rows = boxOnGround(true);
+  const Vector start = Vector::Zero(rows.size());
+  RowSolverSettings settings;
+  settings.solver = "test-explode";
+  settings.fallback = "";
+  settings.fallbackOptions.maxIterations = 10;
+  RowSolver solver(settings);
+  Vector x;
+  const IslandSolve s = solver.solve(rows, start, x);
+  EXPECT_TRUE(s.energyGuard) << s.result.message;
+  EXPECT_EQ(s.choice, "pgs");
+  EXPECT_NE(s.result.message.find("pgs's applied"), std::string::npos) << s.result.message;
+  EXPECT_LE(x.lpNorm<Eigen::Infinity>(), 10.0);
+  EXPECT_NEAR(s.result.residual, rowResidual(rows, x), 1e-12);
+
+  // A failed primary's answer of the exact answer's size (its start) is kept: the guard is
+  // about explosions, not about residuals.
+  settings.solver = "dantzig";
+  RowSolver exact(settings);
+  Vector answer;
+  ASSERT_TRUE(exact.solve(rows, start, answer).accepted);
+  settings.solver = "test-fail";
+  RowSolver failing(settings);
+  const Vector near = 1.5 * answer;
+  const IslandSolve f = failing.solve(rows, near, x);
+  EXPECT_FALSE(f.energyGuard) << f.result.message;
+  EXPECT_EQ(f.choice, "test-fail");
+  EXPECT_EQ(x, near);
+}
+
+// Bullet's Bridge (ExtendedTutorials/Bridge.cpp): planks hung on pairs of point-to-point
+// constraints, 6 rows for the 5 freedoms a hinge takes, whose rhs disagree once the bridge has
+// drifted. The bilateral system has no solution; ldlt's answer was A + delta I refined against
+// A, 1e9 times the drift along the rows' dependency (a body at 2,495 m/s). It is now the
+// minimum-norm least-squares answer, accepted and reported as such.
+TEST(RowSolver, BridgeDriftedPointToPointPairsGetTheMinimumNormLeastSquaresAnswer) {
+  RowSystem rows;
+  rows.bodies = {unitBody()};
+  const Eigen::Vector3d pivots[2] = {{0.5, 0.1, 0.2}, {-0.5, 0.1, 0.2}};  // the hinge line
+  const double drift[6] = {0.10, -0.20, 0.05, 0.13, -0.17, 0.02};
+  for (int p = 0; p < 2; ++p)
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d e = Eigen::Vector3d::Unit(k);
+      addRow(rows, e, pivots[p].cross(e), drift[3 * p + k], -kInf, kInf, 0);
+    }
+  RowSolver solver;
+  Vector x;
+  const IslandSolve s = solver.solve(rows, Vector::Zero(rows.size()), x);
+  EXPECT_EQ(s.choice, "ldlt");
+  EXPECT_EQ(s.result.status, Status::LeastSquares) << s.result.message;
+  EXPECT_TRUE(s.accepted);
+  EXPECT_NE(s.result.message.find("least-squares"), std::string::npos) << s.result.message;
+  // Least squares: A (A x + b) = 0; minimum norm: x has no part along the rows' dependency (the
+  // two pivots' along-axis rows are the same row, so x_0 - x_3 moves nothing and is 0).
+  const Problem p = rows.assemble(false);
+  const Vector w = p.denseA() * x + p.b;
+  EXPECT_GT(w.lpNorm<Eigen::Infinity>(), 1e-3);  // inconsistent: no exact answer
+  EXPECT_LE((p.denseA() * w).lpNorm<Eigen::Infinity>(), 1e-6);
+  EXPECT_NEAR(x[0], x[3], 1e-9);
+  // Bounded: the bodies move as the rows ask, not 1e9 times faster.
+  for (const Vector6& v : rows.bodyVelocities(x)) EXPECT_LE(v.norm(), 1.0);
+}
+
 TEST(RowSolver, AnAnswerAboveTheLimitFallsBackWhateverTheSolver) {
   RowSolverSettings settings;
   settings.solver = "pgs";

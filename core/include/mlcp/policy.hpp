@@ -45,9 +45,10 @@
 // fallback):
 //  1. Acceptable answers (acceptable()): the status is not Failed, NumericalIssue, InvalidInput
 //     or Unsupported, and the residual recomputed by residual.hpp (never a solver's claim) is
-//     finite and <= the limit. The limit is RowSolverSettings::acceptResidual for islands
-//     (default 1e-3) and Options::tolerance for a registry chain (an accepted member answer is
-//     a converged one).
+//     finite and <= the limit. A LeastSquares answer (equality rows with no exact solution,
+//     verified by the base) is acceptable whatever its residual: no method does better. The limit
+//     is RowSolverSettings::acceptResidual for islands (default 1e-3) and Options::tolerance for a
+//     registry chain (an accepted member answer is a converged one).
 //  2. The next solver runs only when the answers so far are all unacceptable; it starts from the
 //     caller's start point again, with the time left (RowSolver: at least a minimal share).
 //  3. The returned answer is the first acceptable one, else the best answer any solver found:
@@ -124,7 +125,7 @@ struct Policy {
 };
 
 // Rule 1 above: the status is not Failed, NumericalIssue, InvalidInput or Unsupported and the
-// residual is finite and <= acceptResidual.
+// residual is finite and <= acceptResidual; or the status is LeastSquares.
 bool acceptable(const Result& r, double acceptResidual);
 // Rule 3 above: candidate has a finite residual lower than best's (or best has none).
 bool better(const Result& candidate, const Result& best);

@@ -16,7 +16,16 @@ enum class Status {
   Unsupported,     // the method does not apply to this class of problem
   InvalidInput,    // Problem::validate() or the guess rejected the input; x is untouched
   NumericalIssue,  // NaN or Inf appeared during the solve
+  // Equality rows only (Problem::classify() == Linear) with no exact solution: redundant rows
+  // whose right-hand sides disagree (a closed loop of joints that has drifted). x is the
+  // minimum-norm least-squares answer; the residual is what no x removes. The base verifies it
+  // (||A^T (A x + b)||_inf <= kLeastSquaresStationarity ||A||_inf (1 + ||b||_inf)), else the
+  // status is Failed. Acceptable to the fallback rule (policy.hpp): no method does better.
+  LeastSquares,
 };
+// The scaled stationarity a LeastSquares answer must meet (above). Dimensionless: it admits
+// the least-squares solve's rank decision (1e-6 of A's largest diagonal, linalg/min_norm.hpp).
+inline constexpr double kLeastSquaresStationarity = 1e-5;
 const char* toString(Status s);
 
 // How friction-coupled (findex) rows take their bounds.

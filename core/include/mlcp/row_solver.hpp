@@ -52,6 +52,13 @@
 //     from the same start, the better of the two answers (lower finite residual, the primary's
 //     on a tie) is returned, and only when neither is finite the start (the engine's "no
 //     change": Bullet's applied impulses, ODE's last forces).
+//  5. apply safely: when the returned answer is still not acceptable, it is applied only if the
+//     velocity change it makes (RowSystem::impulseEnergy: 1/2 x^T A x) is at most 100 times
+//     (10x in speed) that of the engine's own method's answer from the same start, pgs at the
+//     fallback's sweeps (SI's and QuickStep's count under engineIterations); otherwise pgs's
+//     answer is applied (IslandSolve::energyGuard). A residual alone cannot tell a near miss
+//     from an exploded iterate (impulses along nearly dependent rows that solve them to the
+//     last digit and throw the bodies); the velocity change can.
 //
 // The time budget. timeBudget is the wall-clock time of one engine step's solves (beginStep()
 // opens a step; without it each solve is a step of its own). An island gets what is left of the
@@ -223,6 +230,9 @@ struct IslandSolve {
   bool accepted = true;        // the returned answer passes acceptable()
   double assembleSeconds = 0;  // part of result.seconds spent classifying and assembling A
   ScreenCounts screened;       // rows screened in stage 0 (inert ones answered x = 0)
+  // Stage 5 replaced the lowest-residual answer, whose velocity change was far above pgs's, by
+  // pgs's.
+  bool energyGuard = false;
   // The friction model of the returned answer: Cone when the cone's LCP answered (result then
   // holds that LCP's residual), Box otherwise (no friction rows, the cone refused the island,
   // or the fallback's box answer was returned).
@@ -309,6 +319,9 @@ class RowSolver {
              const Vector& start, Vector& x, Slot& island, IslandSolve& report);
   Result fallBack(const RowSystem& rows, const Vector& start, Vector& x, Slot& island,
                   IslandSolve& out, Result r, double share, double t0);
+  // Stage 5: an unacceptable answer moving the bodies far more than pgs's is replaced by pgs's.
+  void keepSafe(const RowSystem& rows, const Vector& start, Vector& x, Slot& island,
+                IslandSolve& out, Result& r, Result* projectionAnswer, double share, double t0);
   void assemble(const RowSystem& rows, bool sparse);
   // Stage 3 with friction "cone": builds the cone's LCP (false: the rows do not fit, the reason
   // goes to out's message and the box runs), then solves it.

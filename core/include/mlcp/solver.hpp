@@ -92,6 +92,9 @@ void applyAccuracy(Result& r, const Accuracy& a, double tolerance);
 // residual, or r's is not finite) r takes it (with a note in the message) and true is returned;
 // the caller then returns the start as x.
 bool takeStartIfBetter(Result& r, const Accuracy& start, double tolerance);
+// Keeps r's LeastSquares status only when x, with w = A x + b, is a least-squares answer of a
+// Linear problem (result.hpp's stationarity test); otherwise r becomes Failed and says why.
+void verifyLeastSquares(const Problem& problem, const Vector& w, Result& r);
 
 // Seconds on a monotonic clock (for timing and time budgets).
 double nowSeconds();
