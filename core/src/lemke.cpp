@@ -326,6 +326,10 @@ void LemkeSolver::pivot(const Problem& problem, const DenseMatrix& A, Vector& x,
   };
 
   Vector current = x;  // seeds the friction bounds
+  // The pivot limit bounds the whole solve, the friction passes together: a pass that does not
+  // settle the bounds cannot buy another full limit (50 m + 100 pivots a pass times 1000 passes
+  // ran for minutes on a 600-row contact problem).
+  int pivotLimit = -1;
   for (int outer = 1; outer <= outerLimit; ++outer) {
     Vector lo(n), hi(n);
     for (int i = 0; i < n; ++i) {
@@ -334,8 +338,9 @@ void LemkeSolver::pivot(const Problem& problem, const DenseMatrix& A, Vector& x,
     }
     const StandardForm f = toStandard(A, problem.b, lo, hi);
     const int m = static_cast<int>(f.q.size());
-    const int maxPivots = opt.maxPivots > 0 ? opt.maxPivots : 50 * m + 100;
-    const LcpSolution s = solveLcp(f, rules, maxPivots, stop);
+    if (pivotLimit < 0) pivotLimit = opt.maxPivots > 0 ? opt.maxPivots : 50 * m + 100;
+    const int maxPivots = pivotLimit - result.iterations;
+    const LcpSolution s = solveLcp(f, rules, std::max(1, maxPivots), stop);
     result.iterations += s.outcome.pivots;
 
     std::ostringstream os;
@@ -348,8 +353,8 @@ void LemkeSolver::pivot(const Problem& problem, const DenseMatrix& A, Vector& x,
         result.message = detail::rayMessage(s.outcome, s.rayLabel, lcp) + where;
         return;
       case LemkeEnd::PivotLimit:
-        os << "gave up: pivot limit " << maxPivots << " reached" << where
-           << " (Options::maxPivots; 0 means 50 m + 100 for m = " << m
+        os << "gave up: pivot limit " << pivotLimit << " reached" << where
+           << " (Options::maxPivots, over all friction iterations; 0 means 50 m + 100 for m = " << m
            << "): " << (outer > 1 ? "the last friction iteration's answer" : "the start")
            << " is returned";
         result.status = Status::MaxIterations;

@@ -411,6 +411,27 @@ TEST(Lemke, FrictionByFixedPoint) {
   EXPECT_GE(converged, trials * 9 / 10);
 }
 
+// A findex contact problem without CFM whose contact rows outnumber the bodies' freedoms (A
+// singular): its friction passes ran a full pivot limit each, 1000 times (minutes at 600 rows).
+// The one limit now bounds the passes together, and the status says how the solve ended.
+TEST(Lemke, FindexContactProblemEndsWithinOnePivotLimit) {
+  Generator g(35);
+  const Problem p = test::frictionPyramids(test::jacobianGram(g, 150, 30, 0), g, 0.6);
+  Options opt;
+  opt.tolerance = 1e-9;
+  opt.maxPivots = 1500;
+  LemkeSolver lemke;
+  lemke.setOptions(opt);
+  Vector x;
+  const Result r = lemke.solve(p, x);
+  EXPECT_LE(r.iterations, opt.maxPivots) << r.message;
+  if (!r.converged()) {
+    EXPECT_TRUE(r.status == Status::MaxIterations || r.status == Status::Failed) << r.message;
+    EXPECT_FALSE(r.message.empty());
+  }
+  EXPECT_NEAR(r.residual, residual(p, x), 1e-12);
+}
+
 TEST(Lemke, FrictionSingleContactSliding) {
   // One contact pushed sideways: normal x0 = 1, friction saturates at mu = 0.5.
   DenseMatrix A(3, 3);

@@ -25,7 +25,8 @@
 // feasible, and ray termination then proves infeasibility. For other matrices (bimatrix games,
 // general indefinite M) it may end on a ray although a solution exists. Murty's examples take
 // 2^n - 1 pivots; the pivot limit is Options::maxPivots, 0 meaning 50 m + 100 for an LCP of
-// size m (Status::MaxIterations when reached), and Options::timeBudget stops it between pivots
+// size m, counted over the whole solve (every friction iteration below together; Status::
+// MaxIterations when reached), and Options::timeBudget stops it between pivots
 // (Status::TimeLimit); either way the message says so and the start (or, with friction, the
 // last outer iteration's answer) is returned, never a half-pivoted tableau.
 //
@@ -73,7 +74,8 @@
 // true bounds is within Options::tolerance (Converged), when the bounds stop moving above the
 // tolerance (Failed), or after Options::maxIterations outer steps (MaxIterations). The fixed
 // point need not converge (large mu, strongly coupled contacts); the status then says so.
-// Result::iterations counts pivots over all outer steps.
+// Result::iterations counts pivots over all outer steps, and the one pivot limit bounds them
+// together, so a solve costs at most maxPivots pivots of O(m^2) whatever the passes do.
 //
 // Warm start: a guess only seeds the friction bounds; pivoting always starts from the slack
 // basis.
