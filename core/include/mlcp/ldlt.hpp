@@ -8,10 +8,14 @@
 // only on the sparsity pattern and is kept between calls: a simulation whose joint graph does not
 // change pays for it once and refactorizes numerically each step, as SuiteSparse's
 // analyze/factorize split does. One step of iterative refinement follows the solve. Bounded rows
-// are refused (Unsupported). A singular symmetric sparse A (redundant joints) whose LDL^T fails
-// or misses the residual is factored as A + delta I (delta = 1e-9 max |A_ii|) and refined
-// against A, up to 8 steps; the message says so and the residual check says how consistent it
-// was. A singular non-symmetric A is reported as Failed.
+// are refused (Unsupported). A singular symmetric A (redundant joints) whose LDL^T fails or
+// leaves a residual gets the minimum-norm least-squares answer (linalg/min_norm.hpp: the LL^T of
+// A + delta I, delta = 1e-6 max |A_ii|, iterated so that nothing enters A's null space): a
+// consistent system is then solved (Converged), an inconsistent one (a closed loop of joints
+// that has drifted, whose rows disagree) gets Status::LeastSquares, which the base verifies.
+// Why not A + delta I refined against A: each refinement adds the inconsistent part / delta
+// along the rows' dependency, impulses of 1e9 times the drift. A singular non-symmetric A is
+// reported as Failed.
 //
 // The storage chooses the path. A dense A (RowSolver assembles islands up to denseMaxRows = 64
 // rows dense) is factored without pivoting inside its envelope: row i of L starts at A's first
@@ -19,8 +23,8 @@
 // ordering, analysis or storage conversion. Only A's lower triangle is read; the refined answer
 // is kept when it solves the whole A to a scaled residual of 1e-11, which checks symmetry in
 // passing. Otherwise (a pivot below 1e-13 relative, or that residual missed) the exact symmetry
-// check sends A to Eigen's pivoting dense LDL^T (which answers a consistent singular system) or,
-// non-symmetric, to dense partial-pivoting LU. The base's residual check has the final say.
+// check sends A to Eigen's pivoting dense LDL^T (a residual it leaves takes the least-squares
+// path above) or, non-symmetric, to dense partial-pivoting LU. The base's check has the final say.
 // The sparse path likewise tries LDL^T first and runs the exact symmetry check (A - A^T) only
 // when the answer misses 1e-11 (a pattern found non-symmetric goes to the check and LU directly
 // next time): forming A - A^T costs more than the factorization of a small island.
