@@ -170,7 +170,7 @@ void LdltSolver::runDense(const Problem& problem, Vector& x, Result& result) {
     // Still a residual: A is singular (redundant rows). The minimum-norm least-squares answer
     // (linalg/min_norm.hpp) from the LL^T of A + delta I; an indefinite A keeps the pivoting
     // answer, which the base measures.
-    const double delta = linalg::kMinNormShift * std::max(1.0, A.diagonal().cwiseAbs().maxCoeff());
+    const double delta = linalg::minNormShift(A.diagonal().cwiseAbs().maxCoeff());
     m.shifted.compute(A + delta * DenseMatrix::Identity(A.rows(), A.cols()));
     if (m.shifted.info() != Eigen::Success) return;
     const int steps = linalg::minNormSolve(
@@ -241,7 +241,7 @@ void LdltSolver::run(const Problem& problem, Vector& x, Result& result) {
   // minimum-norm least-squares answer (linalg/min_norm.hpp) from the LL^T of A + delta I.
   const double target = kEnvelopeResidual * (1 + rhs.lpNorm<Eigen::Infinity>());
   if (symmetric && !(ok && (rhs - A * x).lpNorm<Eigen::Infinity>() <= target)) {
-    const double delta = linalg::kMinNormShift * std::max(1.0, A.diagonal().cwiseAbs().maxCoeff());
+    const double delta = linalg::minNormShift(A.diagonal().cwiseAbs().maxCoeff());
     m.shiftedSparse.setShift(delta);
     m.shiftedSparse.compute(A);
     if (m.shiftedSparse.info() == Eigen::Success) {

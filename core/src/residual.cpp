@@ -42,6 +42,16 @@ Accuracy accuracy(const Problem& problem, const Vector& x) {
 
 double residual(const Problem& problem, const Vector& x) { return accuracy(problem, x).residual; }
 
+double rowSumNorm(const Problem& problem) {
+  if (problem.size() == 0) return 0;
+  if (!problem.isSparse()) return problem.denseA().cwiseAbs().rowwise().sum().maxCoeff();
+  Vector sums = Vector::Zero(problem.size());
+  const SparseMatrix& A = problem.sparseA();
+  for (int k = 0; k < A.outerSize(); ++k)
+    for (SparseMatrix::InnerIterator it(A, k); it; ++it) sums[it.row()] += std::abs(it.value());
+  return sums.maxCoeff();
+}
+
 namespace {
 
 constexpr double kUnitRoundoff = 0x1p-53;
@@ -55,17 +65,6 @@ void twoSum(double a, double b, double& s, double& e) {
 void twoProduct(double a, double b, double& p, double& e) {
   p = a * b;
   e = std::fma(a, b, -p);
-}
-
-// ||A||_inf, the largest absolute row sum.
-double rowSumNorm(const Problem& problem) {
-  if (problem.size() == 0) return 0;
-  if (!problem.isSparse()) return problem.denseA().cwiseAbs().rowwise().sum().maxCoeff();
-  Vector sums = Vector::Zero(problem.size());
-  const SparseMatrix& A = problem.sparseA();
-  for (int k = 0; k < A.outerSize(); ++k)
-    for (SparseMatrix::InnerIterator it(A, k); it; ++it) sums[it.row()] += std::abs(it.value());
-  return sums.maxCoeff();
 }
 
 // Dot2 of row i of A with x, plus b_i.

@@ -115,21 +115,9 @@ void Solver::keepStartIfBetter(const Problem& problem, const Vector* start, Resu
 
 void verifyLeastSquares(const Problem& problem, const Vector& w, Result& r) {
   const bool linear = problem.classify() == ProblemClass::Linear;
-  Vector g;
-  double normA = 0;
-  if (problem.isSparse()) {
-    g = problem.sparseA().transpose() * w;
-    for (Eigen::Index k = 0; k < problem.sparseA().outerSize(); ++k) {
-      double row = 0;
-      for (SparseMatrix::InnerIterator it(problem.sparseA(), k); it; ++it)
-        row += std::abs(it.value());
-      normA = std::max(normA, row);
-    }
-  } else {
-    g = problem.denseA().transpose() * w;
-    normA = problem.denseA().cwiseAbs().rowwise().sum().maxCoeff();
-  }
-  const double scale = normA * (1 + problem.b.lpNorm<Eigen::Infinity>());
+  const Vector g = problem.isSparse() ? Vector(problem.sparseA().transpose() * w)
+                                      : Vector(problem.denseA().transpose() * w);
+  const double scale = rowSumNorm(problem) * (1 + problem.b.lpNorm<Eigen::Infinity>());
   const double stationarity = g.lpNorm<Eigen::Infinity>();
   if (linear && stationarity <= kLeastSquaresStationarity * scale) return;
   std::ostringstream os;

@@ -1,7 +1,6 @@
 // Solvers that break on purpose, to check that fallbacks happen, are counted and reported.
 // registerBrokenSolvers() adds them to the registry as "test-nan", "test-fail", "test-explode" and
-// "test-throw",
-// so that the adapters (which take solvers by name) can be handed them too.
+// "test-throw", so that the adapters (which take solvers by name) can be handed them too.
 #pragma once
 
 #include <cmath>

@@ -14,7 +14,7 @@ namespace {
 int severity(Status s) {
   switch (s) {
     case Status::Converged: return 0;
-    case Status::LeastSquares: return 1;
+    case Status::LeastSquares:
     case Status::MaxIterations: return 1;
     case Status::TimeLimit: return 2;
     case Status::Failed: return 3;

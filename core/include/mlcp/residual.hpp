@@ -49,6 +49,9 @@ double residual(const Problem& problem, const Vector& x);
 Accuracy checkedAccuracy(const Problem& problem, const Vector& x, const Vector& w,
                          double tolerance);
 
+// ||A||_inf, the largest absolute row sum (0 for an empty problem), one pass over A.
+double rowSumNorm(const Problem& problem);
+
 // w = A x + b with each row's sum compensated (Ogita, Rump and Oishi's Dot2: every product
 // split exactly by an fma, every addition's error kept by TwoSum, the errors summed and added
 // at the end). The result is as accurate as if computed in twice the working precision, then

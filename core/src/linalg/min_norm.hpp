@@ -27,7 +27,6 @@
 #pragma once
 
 #include <algorithm>
-#include <cmath>
 
 #include "mlcp/problem.hpp"
 
@@ -41,6 +40,11 @@ inline constexpr int kMinNormSteps = 40;
 // dependent rows) are where an exact answer would throw bodies, and they are left out, as a
 // CFM of that size (ODE's default 1e-5 / h is ~6e-4 of a unit mass's diagonal) would damp them.
 inline constexpr double kMinNormShift = 1e-6;
+
+// delta for a matrix whose largest |A_ii| is maxDiagonal.
+inline double minNormShift(double maxDiagonal) {
+  return kMinNormShift * std::max(1.0, maxDiagonal);
+}
 
 // x = A^+ rhs as above. solveShifted(r, out) solves (A + delta I) out = r with the caller's
 // factorization; multiply(v, out) sets out = A v. Returns the steps taken.
