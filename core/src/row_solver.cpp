@@ -64,6 +64,11 @@ constexpr double kExactStart = 1e-4;
 constexpr double kExactStartLimit = 1e-12;
 // IslandSolve::choice of an island that the start answered (no solver ran).
 constexpr const char* kStartChoice = "start";
+// Stage 5's trigger for an acceptable answer: some body's linear velocity change exceeds this
+// multiple of ||b||_inf (the largest velocity error a row states). A sane answer changes a
+// body's velocity by about the errors of the rows on it (a landing ragdoll: 1-2x); an answer
+// along nearly dependent rows, exact to 1e-7, by thousands of times. Dimensionless.
+constexpr double kSpeedFactor = 10;
 // Stage 5's bound: an unacceptable answer is applied when its impulse energy is at most this
 // multiple of pgs's (keepSafe), 10x in speed: an exact answer asks more of the bodies than pgs's
 // few sweeps give, by a factor of a few; an exploded one by many orders. Dimensionless.
@@ -389,13 +394,22 @@ Result RowSolver::fallBack(const RowSystem& rows, const Vector& start, Vector& x
   return r;
 }
 
-// Stage 5 (safe application): x, r are the lowest-residual answer, and it is not acceptable. It is
+// Stage 5 (safe application): x, r are the lowest-residual answer, and it is not acceptable, or
+// it is acceptable but throwsBodies() (an exact answer along nearly dependent rows). It is
 // applied only when the velocity change it makes (RowSystem::impulseEnergy) is within
 // kEnergyFactor of the one the engine's own method's answer from the same start makes, pgs at
 // the fallback's sweeps (under engineIterations SI's and QuickStep's count): an answer that
 // beats pgs on the residual but moves the bodies 10 times as fast is a diverged or exploded
 // iterate, and pgs's answer is applied instead. projectionAnswer: pgs's result when the fallback
 // was pgs or gs and lost on the residual (its x in xFallback_); else pgs runs here.
+bool RowSolver::throwsBodies(const RowSystem& rows, const Vector& x) {
+  if (x.size() != rows.size()) return false;
+  const double limit = kSpeedFactor * rows.b.lpNorm<Eigen::Infinity>();
+  for (const Vector6& v : rows.bodyVelocities(x))
+    if (v.head<3>().squaredNorm() > limit * limit) return true;
+  return false;
+}
+
 void RowSolver::keepSafe(const RowSystem& rows, const Vector& start, Vector& x, Slot& island,
                          IslandSolve& out, Result& r, Result* projectionAnswer, double share,
                          double t0) {
@@ -503,6 +517,8 @@ IslandSolve RowSolver::solveScreened(const RowSystem& rows, const Vector& start,
         policy.demotes(r, settings_.acceptResidual, island.cutsInRow))
       island.pgsFirst = policy.pgsAfterBreakdown;
     r = fallBack(rows, start, x, island, out, std::move(r), share, t0);
+  } else if (!fromStart && throwsBodies(rows, x)) {
+    keepSafe(rows, start, x, island, out, r, nullptr, share, t0);
   }
   out.accepted = acceptable(r, settings_.acceptResidual);
   if (!coneNote_.empty()) r.message = coneNote_ + r.message;
