@@ -110,6 +110,9 @@ TEST(StackScene, MassesGrowGeometricallyToTheRatio) {
     EXPECT_NEAR(s.bodies[i].inertia[0], s.bodies[i].mass / 6, 1e-9);  // m/12 (1 + 1)
   }
   EXPECT_DOUBLE_EQ(s.settings.timeStep, 0.01);
+  EXPECT_DOUBLE_EQ(s.settings.cfm, kStackCfm);  // not the scenes' 1e-5: see stability.hpp
+  EXPECT_DOUBLE_EQ(stackScene("s", 2, 1, 0.01, 1e-5).settings.cfm, 1e-5);
+  EXPECT_THROW(stackScene("s", 2, 1, 0.01, -1), std::invalid_argument);
   EXPECT_THROW(stackScene("s", 0, 1, 0.01), std::invalid_argument);
   EXPECT_THROW(stackScene("s", 2, 0, 0.01), std::invalid_argument);
   EXPECT_THROW(stackScene("s", 2, 1, 0), std::invalid_argument);

@@ -54,16 +54,20 @@ Classification classify(const CellMeasures& m, const StabilityThresholds& t) {
   return {Outcome::Stable, describe("top box moved", m.topDisplacement, "<=", t.drift, " m")};
 }
 
-scene::Scene stackScene(const std::string& name, int height, double massRatio, double timeStep) {
+scene::Scene stackScene(const std::string& name, int height, double massRatio, double timeStep,
+                        double cfm) {
   if (height < 1) throw std::invalid_argument("stack height must be at least 1");
   if (!(massRatio > 0)) throw std::invalid_argument("mass ratio must be positive");
   if (!(timeStep > 0)) throw std::invalid_argument("time step must be positive");
+  if (!(cfm >= 0) || !std::isfinite(cfm))
+    throw std::invalid_argument("cfm must be finite and >= 0");
   scene::Scene s;
   s.name = name;
   s.source = "<mlcp stability>";
   s.description = "stack of " + std::to_string(height) + " cubes, top/bottom mass ratio " +
                   std::to_string(massRatio);
   s.settings.timeStep = timeStep;
+  s.settings.cfm = cfm;
   s.materials.push_back(scene::Material{"default"});
   scene::Body ground;
   ground.name = "ground";

@@ -38,6 +38,7 @@ struct StabilityArgs {
   double seconds = 2;
   int iterations = 20;
   double massTimeStep = 1.0 / 60;
+  double cfm = kStackCfm;
   std::string fallback = "none";
   bool quick = false;
   std::string csv;
@@ -131,9 +132,9 @@ int runStability(StabilityArgs args) {
         if (massGrid)
           for (int h : args.heights)
             for (double r : args.ratios)
-              cells.push_back({engine, solver, "stack_mass_ratio", "mass_ratio", "height", r,
-                               double(h), stackScene("stack_mass_ratio", h, r, args.massTimeStep),
-                               run});
+              cells.push_back(
+                  {engine, solver, "stack_mass_ratio", "mass_ratio", "height", r, double(h),
+                   stackScene("stack_mass_ratio", h, r, args.massTimeStep, args.cfm), run});
         if (stepGrid)
           for (int it : args.iterationCounts)
             for (double dt : args.timeSteps) {
@@ -144,7 +145,7 @@ int runStability(StabilityArgs args) {
                      "iterations",
                      dt,
                      double(it),
-                     stackScene("stack_time_step", args.stepHeight, args.stepRatio, dt),
+                     stackScene("stack_time_step", args.stepHeight, args.stepRatio, dt, args.cfm),
                      run};
               c.run.iterations = it;
               cells.push_back(std::move(c));
@@ -266,6 +267,11 @@ Runner addStabilityCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--step-ratio", args->stepRatio, "step grid: top/bottom mass ratio")
       ->check(positiveNumber())
+      ->capture_default_str();
+  cmd->add_option("--cfm", args->cfm,
+                  "world cfm of the stacks (the scenes' 1e-5 is a contact spring that a heavy "
+                  "stack compresses by centimetres)")
+      ->check(nonNegativeNumber())
       ->capture_default_str();
   cmd->add_option("--seconds", args->seconds, "simulated time per cell (s)")
       ->check(positiveNumber())
