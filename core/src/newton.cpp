@@ -190,7 +190,9 @@ void NewtonSolver::run(const Problem& pb, Vector& x, Result& result) {
       break;
     }
     if (++sinceBest > params_.maxStagnation) {
-      result.status = Status::Failed;
+      // A limit reached before the tolerance (the best iterate is the answer, measured like any
+      // other), not a breakdown: the fallback rule then judges it by its residual alone.
+      result.status = Status::MaxIterations;
       os << "no progress in " << params_.maxStagnation << " Newton steps, residual "
          << wk.best.inf / scale;
       break;

@@ -59,10 +59,11 @@
 // (pgs.hpp) where they apply (A symmetric with a positive diagonal: they decrease the QP's
 // objective, a restart from a point with other active pieces), otherwise a Cauchy step along
 // -J^T H (the linear model's minimizer on that line) with the same line search. After
-// NewtonParams::maxStalls failed Newton steps in a row, a Cauchy step that does not descend, or
-// NewtonParams::maxStagnation steps without a new best iterate (the rounding floor of a
-// tolerance below what the problem's conditioning allows), the solve ends Failed with its best
-// iterate.
+// NewtonParams::maxStalls failed Newton steps in a row or a Cauchy step that does not descend
+// the solve ends Failed with its best iterate; after NewtonParams::maxStagnation steps without a
+// new best iterate (the rounding floor of a tolerance below what the problem's conditioning
+// allows) it ends MaxIterations with it: a limit, not a breakdown, so an island's acceptance
+// judges that answer by its residual.
 //
 // Linear algebra. Problems of at most NewtonParams::denseMaxRows rows build J densely and
 // factor it with Eigen's PartialPivLU (O(n^3) per step, 0.3 ms at 108 rows); a solution that
@@ -182,7 +183,7 @@ struct NewtonParams {
   // Newton steps in a row without descent (each followed by the fallback) before the solve
   // stops. Default 3.
   int maxStalls = 3;
-  // Steps in a row without a new best iterate before the solve stops (Failed). Default 50.
+  // Steps in a row without a new best iterate before the solve stops (MaxIterations). Default 50.
   int maxStagnation = 50;
   // Merits before the current one that the line search's reference takes the largest of (the
   // non-monotone rule of "Step" above); 0: monotone Armijo. Default 1.
