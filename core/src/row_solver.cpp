@@ -69,10 +69,12 @@ constexpr const char* kStartChoice = "start";
 // body's velocity by about the errors of the rows on it (a landing ragdoll: 1-2x); an answer
 // along nearly dependent rows, exact to 1e-7, by thousands of times. Dimensionless.
 constexpr double kSpeedFactor = 10;
-// Stage 5's bound: an unacceptable answer is applied when its impulse energy is at most this
-// multiple of pgs's (keepSafe), 10x in speed: an exact answer asks more of the bodies than pgs's
-// few sweeps give, by a factor of a few; an exploded one by many orders. Dimensionless.
-constexpr double kEnergyFactor = 100;
+// Stage 5's bound: a judged answer is applied when its impulse energy is at most this multiple
+// of pgs's (keepSafe), 2x in speed: "no worse than the engine's own method at its cost". 100
+// (10x in speed) let an unsettled answer on Bullet's Bridge through that threw the planks in
+// the next step; 4 keeps every example within twice the stock run's fastest body (docs/
+// benchmarks.md). Dimensionless.
+constexpr double kEnergyFactor = 4;
 }  // namespace
 
 // What is kept per island: its assembled-problem solvers by name, when it was last solved, how
@@ -394,14 +396,30 @@ Result RowSolver::fallBack(const RowSystem& rows, const Vector& start, Vector& x
   return r;
 }
 
-// Stage 5 (safe application): x, r are the lowest-residual answer, and it is not acceptable, or
-// it is acceptable but throwsBodies() (an exact answer along nearly dependent rows). It is
-// applied only when the velocity change it makes (RowSystem::impulseEnergy) is within
-// kEnergyFactor of the one the engine's own method's answer from the same start makes, pgs at
-// the fallback's sweeps (under engineIterations SI's and QuickStep's count): an answer that
-// beats pgs on the residual but moves the bodies 10 times as fast is a diverged or exploded
-// iterate, and pgs's answer is applied instead. projectionAnswer: pgs's result when the fallback
-// was pgs or gs and lost on the residual (its x in xFallback_); else pgs runs here.
+// Stage 3's hand-over under auto: a dantzig answer on friction rows that is not acceptable
+// (its friction fixed point did not settle, or its regularised retry ended short) is continued
+// by newton from it, in what is left of the island's share: newton has the friction bounds'
+// exact Jacobian, where the fixed point re-solves with lagged bounds. The better answer stands.
+void RowSolver::continueWithNewton(const RowSystem& rows, Vector& x, Slot& island, IslandSolve& out,
+                                   Result& r, double share, double t0) {
+  if (x.size() != rows.size() || !x.allFinite()) return;
+  Options o = settings_.options;
+  if (share > 0) {
+    const double now = nowSeconds();
+    o = withBudget(o, std::max(share - (now - t0), settings_.minShare * settings_.timeBudget), now);
+  }
+  const Vector from = x;
+  Result n = run(rows, "newton", o, from, xFallback_, island, out);
+  if (!better(n, r)) return;
+  n.iterations += r.iterations;
+  n.message = "dantzig ended at " + shortNumber(r.residual) + " (" + r.message +
+              "); newton from its answer: " + n.message;
+  r = std::move(n);
+  x.swap(xFallback_);
+  out.choice = "newton";
+}
+
+// Stage 5's trigger for acceptable answers (kSpeedFactor).
 bool RowSolver::throwsBodies(const RowSystem& rows, const Vector& x) {
   if (x.size() != rows.size()) return false;
   const double limit = kSpeedFactor * rows.b.lpNorm<Eigen::Infinity>();
@@ -410,6 +428,14 @@ bool RowSolver::throwsBodies(const RowSystem& rows, const Vector& x) {
   return false;
 }
 
+// Stage 5 (safe application): x, r are the lowest-residual answer, and it is not acceptable, or
+// it is acceptable but throwsBodies() (an exact answer along nearly dependent rows). It is
+// applied only when the velocity change it makes (RowSystem::impulseEnergy) is within
+// kEnergyFactor of the one the engine's own method's answer from the same start makes, pgs at
+// the fallback's sweeps (under engineIterations SI's and QuickStep's count): an answer that
+// beats pgs on the residual but moves the bodies twice as fast is a diverged or exploded
+// iterate, and pgs's answer is applied instead. projectionAnswer: pgs's result when the fallback
+// was pgs or gs and lost on the residual (its x in xFallback_); else pgs runs here.
 void RowSolver::keepSafe(const RowSystem& rows, const Vector& start, Vector& x, Slot& island,
                          IslandSolve& out, Result& r, Result* projectionAnswer, double share,
                          double t0) {
@@ -510,6 +536,9 @@ IslandSolve RowSolver::solveScreened(const RowSystem& rows, const Vector& start,
     r = run(rows, out.requested, withBudget(settings_.options, share, t0), start, x, island, out);
   if (r.status == Status::InvalidInput || r.status == Status::Unsupported) x = start;
   out.choice = fromStart ? kStartChoice : out.requested;
+  if (autoChoice && !cone && !fromStart && out.problemClass == ProblemClass::Findex &&
+      equals(out.requested, "dantzig") && !acceptable(r, settings_.acceptResidual))
+    continueWithNewton(rows, x, island, out, r, share, t0);
   const bool islandMemory = autoChoice && !cone;  // pgsFirst and cutsInRow
   if (islandMemory) island.cutsInRow = r.status == Status::TimeLimit ? island.cutsInRow + 1 : 0;
   if (!acceptable(r, settings_.acceptResidual)) {

@@ -33,6 +33,10 @@
 //     rows and sparse above. Solver objects live per island key and name, so the sparse analyses
 //     of ldlt and dantzig (ordering, elimination tree) are redone only when that island's
 //     pattern changes, and RowPgs' buffers are reused.
+//     Under "auto", a dantzig answer on friction rows that is not acceptable (its friction
+//     fixed point did not settle in its passes, or its regularised retry ended short) is
+//     continued by newton from it in what is left of the island's share (newton has the
+//     friction bounds' exact Jacobian); the better answer goes on to stage 4.
 //     A start that already solves the rows far within the tolerance (residual <= min(1e-4
 //     tolerance, 1e-12)) is the answer of every primary but pgs (whose own first check finds it),
 //     with choice "start": one product through the rows instead of an assembly and a solver's
@@ -55,8 +59,8 @@
 //  5. apply safely: when the returned answer is still not acceptable, or is acceptable but
 //     changes some body's linear velocity by more than 10 ||b||_inf (an exact answer along nearly
 //     dependent rows: Bullet's ragdoll pile, 38,000 m/s at a residual of 2e-7), it is applied only
-//     if the velocity change it makes (RowSystem::impulseEnergy: 1/2 x^T A x) is at most 100 times
-//     (10x in speed) that of the engine's own method's answer from the same start, pgs at the
+//     if the velocity change it makes (RowSystem::impulseEnergy: 1/2 x^T A x) is at most 4 times
+//     (2x in speed) that of the engine's own method's answer from the same start, pgs at the
 //     fallback's sweeps (SI's and QuickStep's count under engineIterations); otherwise pgs's
 //     answer is applied (IslandSolve::energyGuard). A residual alone cannot tell a near miss
 //     from an exploded iterate (impulses along nearly dependent rows that solve them to the
@@ -321,6 +325,9 @@ class RowSolver {
              const Vector& start, Vector& x, Slot& island, IslandSolve& report);
   Result fallBack(const RowSystem& rows, const Vector& start, Vector& x, Slot& island,
                   IslandSolve& out, Result r, double share, double t0);
+  // Stage 3 under auto: an unacceptable dantzig answer on friction rows continued by newton.
+  void continueWithNewton(const RowSystem& rows, Vector& x, Slot& island, IslandSolve& out,
+                          Result& r, double share, double t0);
   // Stage 5: an unacceptable answer moving the bodies far more than pgs's is replaced by pgs's.
   // throwsBodies: an acceptable answer changes some body's linear velocity by more than 10
   // ||b||_inf (then keepSafe judges it too).
