@@ -439,31 +439,51 @@ bool RowSolver::throwsBodies(const RowSystem& rows, const Vector& x) {
 void RowSolver::keepSafe(const RowSystem& rows, const Vector& start, Vector& x, Slot& island,
                          IslandSolve& out, Result& r, Result* projectionAnswer, double share,
                          double t0) {
-  if (equals(out.choice, "pgs") || equals(out.choice, "gs") || x.size() != rows.size() ||
-      !std::isfinite(r.residual))
-    return;  // already pgs's answer, or none (the start is kept below)
-  Result p;
-  if (projectionAnswer) {
-    p = std::move(*projectionAnswer);
-  } else {
-    Options o = settings_.fallbackOptions;
-    if (share > 0) {
-      const double now = nowSeconds();
-      o = withBudget(o, std::max(share - (now - t0), settings_.minShare * settings_.timeBudget),
-                     now);
+  if (x.size() != rows.size() || !std::isfinite(r.residual)) return;  // the start is kept below
+  if (!equals(out.choice, "pgs") && !equals(out.choice, "gs")) {
+    Result p;
+    if (projectionAnswer) {
+      p = std::move(*projectionAnswer);
+    } else {
+      Options o = settings_.fallbackOptions;
+      if (share > 0) {
+        const double now = nowSeconds();
+        o = withBudget(o, std::max(share - (now - t0), settings_.minShare * settings_.timeBudget),
+                       now);
+      }
+      p = run(rows, "pgs", o, start, xFallback_, island, out);
     }
-    p = run(rows, "pgs", o, start, xFallback_, island, out);
+    if (xFallback_.size() != rows.size() || !xFallback_.allFinite()) return;
+    const double ex = rows.impulseEnergy(x), ep = rows.impulseEnergy(xFallback_);
+    if (ex > kEnergyFactor * ep) {
+      r.message += "; " + out.choice + "'s answer moves the bodies with " + shortNumber(ex) +
+                   " against pgs's " + shortNumber(ep) + " (impulse energy): pgs's applied";
+      p.message = r.message;
+      p.iterations += r.iterations;
+      r = std::move(p);
+      x.swap(xFallback_);
+      out.choice = "pgs";
+      out.friction = FrictionModel::Box;
+      out.energyGuard = true;
+    }
   }
-  if (xFallback_.size() != rows.size() || !xFallback_.allFinite()) return;
-  const double ex = rows.impulseEnergy(x), ep = rows.impulseEnergy(xFallback_);
-  if (ex <= kEnergyFactor * ep) return;
-  r.message += "; " + out.choice + "'s answer moves the bodies with " + shortNumber(ex) +
-               " against pgs's " + shortNumber(ep) + " (impulse energy): pgs's applied";
-  p.message = r.message;
-  p.iterations += r.iterations;
-  r = std::move(p);
-  x.swap(xFallback_);
-  out.choice = "pgs";
+  if (throwsBodies(rows, x)) holdStill(rows, start, x, out, r);
+}
+
+// Stage 5's last resort: the applied answer, pgs's included, still changes a body's velocity by
+// more than kSpeedFactor ||b||_inf (pgs diverging on rows it cannot settle): the start (the
+// engine's "no change") when it does not, else no impulses at all. Status Failed: nothing
+// solved the island.
+void RowSolver::holdStill(const RowSystem& rows, const Vector& start, Vector& x, IslandSolve& out,
+                          Result& r) {
+  const bool useStart =
+      start.size() == rows.size() && start.allFinite() && !throwsBodies(rows, start);
+  x = useStart ? start : Vector::Zero(rows.size());
+  r.status = Status::Failed;
+  r.message += std::string("; every answer throws a body (pgs's too): ") +
+               (useStart ? "the start" : "no impulses") + " applied";
+  applyAccuracy(r, startAccuracy(rows, x), settings_.options.tolerance);
+  out.choice = useStart ? kStartChoice : "none";
   out.friction = FrictionModel::Box;
   out.energyGuard = true;
 }
@@ -546,7 +566,7 @@ IslandSolve RowSolver::solveScreened(const RowSystem& rows, const Vector& start,
         policy.demotes(r, settings_.acceptResidual, island.cutsInRow))
       island.pgsFirst = policy.pgsAfterBreakdown;
     r = fallBack(rows, start, x, island, out, std::move(r), share, t0);
-  } else if (!fromStart && throwsBodies(rows, x)) {
+  } else if (!fromStart && !equals(out.choice, "pgs") && throwsBodies(rows, x)) {
     keepSafe(rows, start, x, island, out, r, nullptr, share, t0);
   }
   out.accepted = acceptable(r, settings_.acceptResidual);

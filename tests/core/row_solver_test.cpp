@@ -76,6 +76,31 @@ RowSystem boxOnGround(bool friction) {
   return s;
 }
 
+// Two bilateral rows pushing one point of a body along directions 1e-5 rad apart, whose rhs
+// disagree by 1e-3: nearly dependent rows (the ragdoll pile's and AllConstraints' islands).
+RowSystem nearlyDependentPair() {
+  RowSystem rows;
+  rows.bodies = {unitBody()};
+  const Eigen::Vector3d arm(0, 0.5, 0);
+  const double angle = 1e-5;
+  for (const Eigen::Vector3d& e :
+       {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(std::cos(angle), std::sin(angle), 0)})
+    addRow(rows, e, arm.cross(e), 0, -kInf, kInf, 0);
+  rows.b << 0.1, 0.1 + 1e-3;
+  return rows;
+}
+
+// Stage 5's tests: the exploding test solver as the primary, no fallback (keepSafe runs pgs for
+// the comparison, at pgsSweeps sweeps).
+RowSolverSettings explodingPrimary(int pgsSweeps) {
+  test::registerBrokenSolvers();
+  RowSolverSettings settings;
+  settings.solver = "test-explode";
+  settings.fallback = "";
+  settings.fallbackOptions.maxIterations = pgsSweeps;
+  return settings;
+}
+
 double rowResidual(const RowSystem& s, const Vector& x) { return residual(s.assemble(false), x); }
 
 TEST(RowSolver, ClassifiesRowsByTheirBounds) {
@@ -190,13 +215,9 @@ TEST(RowSolver, NothingUsableKeepsTheStart) {
 // Stage 5: an unacceptable answer that moves the bodies far more than pgs's is never applied
 // (with no fallback configured, pgs runs for the comparison); one of sane size is.
 TEST(RowSolver, AnExplodedAnswerIsNeverAppliedPgsIsInstead) {
-  test::registerBrokenSolvers();
   const RowSystem rows = boxOnGround(true);
   const Vector start = Vector::Zero(rows.size());
-  RowSolverSettings settings;
-  settings.solver = "test-explode";
-  settings.fallback = "";
-  settings.fallbackOptions.maxIterations = 10;
+  RowSolverSettings settings = explodingPrimary(10);
   RowSolver solver(settings);
   Vector x;
   const IslandSolve s = solver.solve(rows, start, x);
@@ -260,14 +281,7 @@ TEST(RowSolver, BridgeDriftedPointToPointPairsGetTheMinimumNormLeastSquaresAnswe
 // disagree by 1e-3: the exact answer (ldlt's, to 1e-11) is impulses of ~1e7 and a velocity change
 // ~1000 times ||b||. Stage 5 catches acceptable answers like it, and pgs's answer is applied.
 TEST(RowSolver, RagdollPileNearlyDependentRowsNeverThrowABody) {
-  RowSystem rows;
-  rows.bodies = {unitBody()};
-  const Eigen::Vector3d arm(0, 0.5, 0);
-  const double angle = 1e-5;
-  for (const Eigen::Vector3d& e :
-       {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(std::cos(angle), std::sin(angle), 0)})
-    addRow(rows, e, arm.cross(e), 0, -kInf, kInf, 0);
-  rows.b << 0.1, 0.1 + 1e-3;
+  const RowSystem rows = nearlyDependentPair();
   RowSolverSettings settings;
   settings.solver = "dantzig";
   RowSolver solver(settings);
@@ -303,6 +317,29 @@ TEST(RowSolver, BenchmarkDemoUnsettledFrictionIsHandedToNewton) {
   EXPECT_FALSE(s.fellBack);
   EXPECT_NE(s.result.message.find("newton from its answer"), std::string::npos) << s.result.message;
   EXPECT_NEAR(s.result.residual, rowResidual(rows, x), 1e-12);
+}
+
+// Bullet's AllConstraints with newton named: on an island of joint rows newton stopped at a
+// residual of 1.5 with a body at 900 m/s, and pgs's answer from the same start threw it as
+// well (pgs diverging on rows it cannot settle). Neither is applied: the start is (the engine's
+// "no change"), or no impulses when the start throws a body too; the status says Failed.
+TEST(RowSolver, AllConstraintsWhenEveryAnswerThrowsABodyNoneIsApplied) {
+  const RowSystem rows = nearlyDependentPair();
+  RowSolver solver(explodingPrimary(1));
+  Vector x;
+  // Impulses along the rows' near dependency: they throw the body (~100 m/s against ||b|| = 0.1)
+  // and one pgs sweep from them keeps them; the exploding primary adds 1e4 to each.
+  const Vector start = (Vector(2) << 1e7, -1e7).finished();
+  const IslandSolve s = solver.solve(rows, start, x);
+  EXPECT_TRUE(s.energyGuard) << s.result.message;
+  EXPECT_EQ(s.result.status, Status::Failed);
+  EXPECT_EQ(s.choice, "none") << s.result.message;  // the start throws the body too
+  EXPECT_EQ(x, Vector::Zero(rows.size()));
+  EXPECT_NE(s.result.message.find("no impulses applied"), std::string::npos) << s.result.message;
+  EXPECT_NEAR(s.result.residual, rowResidual(rows, x), 1e-12);
+  // From a zero start pgs's answer is sane: it is applied.
+  const IslandSolve k = solver.solve(rows, Vector::Zero(rows.size()), x);
+  EXPECT_EQ(k.choice, "pgs") << k.result.message;  // pgs's answer from zero is sane
 }
 
 TEST(RowSolver, AnAnswerAboveTheLimitFallsBackWhateverTheSolver) {

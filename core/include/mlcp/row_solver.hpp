@@ -62,7 +62,9 @@
 //     if the velocity change it makes (RowSystem::impulseEnergy: 1/2 x^T A x) is at most 4 times
 //     (2x in speed) that of the engine's own method's answer from the same start, pgs at the
 //     fallback's sweeps (SI's and QuickStep's count under engineIterations); otherwise pgs's
-//     answer is applied (IslandSolve::energyGuard). A residual alone cannot tell a near miss
+//     answer is applied (IslandSolve::energyGuard). When the applied answer still changes a
+//     body's velocity by more than 10 ||b||_inf (pgs diverging too), the start is applied if it
+//     does not, else no impulses, with status Failed. A residual alone cannot tell a near miss
 //     from an exploded iterate (impulses along nearly dependent rows that solve them to the
 //     last digit and throw the bodies); the velocity change can.
 //
@@ -332,6 +334,9 @@ class RowSolver {
   // throwsBodies: an acceptable answer changes some body's linear velocity by more than 10
   // ||b||_inf (then keepSafe judges it too).
   static bool throwsBodies(const RowSystem& rows, const Vector& x);
+  // Stage 5's last resort when pgs's answer throws a body too: the start, or no impulses.
+  void holdStill(const RowSystem& rows, const Vector& start, Vector& x, IslandSolve& out,
+                 Result& r);
   void keepSafe(const RowSystem& rows, const Vector& start, Vector& x, Slot& island,
                 IslandSolve& out, Result& r, Result* projectionAnswer, double share, double t0);
   void assemble(const RowSystem& rows, bool sparse);
