@@ -46,6 +46,13 @@ struct ToleranceRules {
   double clampRhs(double v) const { return std::max(v, 0.0); }
 };
 
+// Variable v of an LCP of size n (w_i = i, z_i = n + i, z0 = 2 n) as "w3", "z1", "z0" (1-based,
+// as in the seed notes).
+inline std::string variableLabel(int v, int n) {
+  if (v == 2 * n) return "z0";
+  return (v < n ? "w" : "z") + std::to_string(v % n + 1);
+}
+
 template <class T>
 class LemkeTableau {
  public:
@@ -65,11 +72,7 @@ class LemkeTableau {
   int z0() const { return 2 * n_; }  // variable index of z0 (w_i = i, z_i = n + i)
   int rhsColumn() const { return 2 * n_ + 1; }
   int complement(int v) const { return v < n_ ? v + n_ : v - n_; }
-  // "w3", "z1", "z0" (1-based, as in the seed notes).
-  std::string label(int v) const {
-    if (v == z0()) return "z0";
-    return (v < n_ ? "w" : "z") + std::to_string(v % n_ + 1);
-  }
+  std::string label(int v) const { return variableLabel(v, n_); }
   int basic(int row) const { return basis_[row]; }
   const T& at(int row, int col) const { return t_[static_cast<size_t>(row) * cols_ + col]; }
   T& at(int row, int col) { return t_[static_cast<size_t>(row) * cols_ + col]; }

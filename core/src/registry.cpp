@@ -25,7 +25,9 @@ std::vector<SolverInfo>& registered() {
        "semismooth Newton on the natural map (exact findex Jacobian), LU-factored: warm large "
        "islands, small nonsymmetric MLCPs",
        &make<NewtonSolver>},
-      {"lemke", "Lemke's lexicographic complementary pivoting, dense; boxes, findex by fixed point",
+      {"lemke",
+       "Lemke's lexicographic complementary pivoting (dense tableau, or a factored basis above "
+       "50 rows); boxes, findex by fixed point",
        &make<LemkeSolver>},
       {"ldlt", "sparse LDL^T (or LU) direct solve for problems without bounds; pattern reused",
        &make<LdltSolver>},

@@ -30,16 +30,37 @@
 // (Status::TimeLimit); either way the message says so and the start (or, with friction, the
 // last outer iteration's answer) is returned, never a half-pivoted tableau.
 //
-// Cost. Dense tableau of m x (2m + 2) doubles (A is converted with Problem::toDense()); each
-// pivot costs O(m^2), a solve typically O(m) pivots. Meant for small or medium dense problems:
-// problems above LemkeSolver::maxRows rows are refused (Status::Unsupported, x untouched)
-// rather than allocating a tableau of gigabytes.
+// Two implementations of the same pivots, chosen by size (LemkeSolver::denseRows):
+//   - Dense tableau (lemke_tableau.hpp): m x (2m + 2) doubles, a Gauss-Jordan pivot of O(m^2).
+//     The trace (traceLemke) always uses it, in exact fractions where it can.
+//   - Factored basis (lemke_revised.hpp), the revised method: the tableau is B^-1 [I, -M, -e | q]
+//     with B the basis matrix (the columns of the basic variables), so only B is kept, as a KLU
+//     factorization of the last refactorization times an eta file (product form: one column
+//     d = B^-1 a per pivot since then). A pivot solves B d = a for the entering column a, does
+//     the ratio test on d and x_B, and moves x_B by the ratio step. The lexicographic rule reads
+//     rows of B^-1 only for rows tied in the plain ratio, by solves B' r = e_i. Invariants:
+//     x_B = B^-1 q >= 0 up to round-off; the basis holds one of w_i, z_i for every i but one
+//     (and z0) until z0 leaves. Every LemkeSolver::refactorPeriod pivots B is factored again and
+//     x_B recomputed from q; a drift of the updated x_B above 1e-9 (relative) halves the period.
+//     M stays sparse (never an n x n dense array): memory O(nnz(M) + nnz(L + U) + period m), a
+//     pivot O(nnz(L + U) + period m) plus one solve with B' per tied row.
+// Choice by size: problems of up to denseRows rows (default 50) use the tableau, larger ones the
+// factored basis, except problems with free rows of up to kFreeRowsTableauRows (2000) rows: the
+// tableau eliminates their free rows by a dense Schur complement where the free block is
+// regular, and where it is singular retries on A + delta I; split into z+ - z- on the factored
+// basis, the singular bilateral islands of a plank bridge (78 rows, ODE) end on a ray. The
+// crossover is measured by tests/bench/lemke_bench.cpp (docs/benchmarks.md): on dense SPD matrices
+// the two are even at ~30 rows and the factored basis is ahead from ~100; on banded ones it is
+// ahead from ~100 rows and by 60x at 1000. KLU because it is the project's sparse LU
+// (linalg/sparse_lu.hpp), factors an unsymmetric B with threshold pivoting and keeps no BLAS state;
+// UMFPACK is not measured here. Problems above maxRows are refused (Status::Unsupported, x
+// untouched).
 //
-// Accuracy. The tableau is pivoted for complementarity, not for stability, so its final values
-// carry round-off. The solver therefore re-solves the final active set in the original
-// problem with an LU (partial pivoting) of the n x n system "w_i = 0 for rows strictly inside
-// their bounds, x_i = bound for the others" plus one step of iterative refinement, and returns
-// whichever of the two answers has the smaller residual.
+// Accuracy. Pivoting is for complementarity, not for stability, so the final values carry
+// round-off. The solver therefore re-solves the final active set in the original problem, the
+// n x n system "w_i = 0 for rows strictly inside their bounds, x_i = bound for the others", with
+// a dense LU (partial pivoting; tableau path) or KLU (factored path) plus one step of iterative
+// refinement, and returns whichever of the two answers has the smaller residual.
 //
 // Problems that are not standard LCPs become one by a change of variables (m >= n rows):
 //   - lo_i == hi_i (fixed):       x_i = lo_i, substituted into b; the row leaves the LCP. So does
@@ -51,11 +72,12 @@
 //                                 z1 >= 0 complementary to  w + z2 >= 0,
 //                                 z2 >= 0 complementary to  hi - lo - z1 >= 0.
 //     (x inside: z2 = 0 and w = 0; x = lo: w >= 0; x = hi: w = -z2 <= 0.)
-//   - (-inf, +inf) (equality):    eliminated by the Schur complement when the block A_FF of
-//                                 free rows is nonsingular: x_F = -A_FF^-1 (b_F + A_FK x_K),
-//                                 leaving A_KK - A_KF A_FF^-1 A_FK (SPD stays SPD, a P-matrix
-//                                 stays a P-matrix). Otherwise x = z+ - z-, both >= 0, with
-//                                 complementary rows w >= 0 and -w >= 0.
+//   - (-inf, +inf) (equality):    tableau path: eliminated by the Schur complement when the
+//                                 block A_FF of free rows is nonsingular: x_F = -A_FF^-1 (b_F +
+//                                 A_FK x_K), leaving A_KK - A_KF A_FF^-1 A_FK (SPD stays SPD, a
+//                                 P-matrix stays a P-matrix). Otherwise x = z+ - z-, both >= 0,
+//                                 with complementary rows w >= 0 and -w >= 0 (always so on the
+//                                 factored path, whose M stays as sparse as A).
 // The transformed matrix is positive semidefinite when A is, so the guarantees above carry over
 // for PSD A; for a P-matrix A with finite boxes the doubled matrix is no longer a P-matrix and
 // ray termination, though not expected, is reported as it is.
@@ -75,10 +97,15 @@
 // tolerance (Failed), or after Options::maxIterations outer steps (MaxIterations). The fixed
 // point need not converge (large mu, strongly coupled contacts); the status then says so.
 // Result::iterations counts pivots over all outer steps, and the one pivot limit bounds them
-// together, so a solve costs at most maxPivots pivots of O(m^2) whatever the passes do.
+// together, so a solve costs at most maxPivots pivots whatever the passes do. On the factored
+// path each pass after the first starts from the previous pass's final basis (each LCP variable,
+// keyed by its row and role, basic as it was), with the covering vector B0 e in place of e so
+// that z0's column reads -e in that basis; it need not be positive, which voids Lemke's
+// guarantees, so a warm attempt that ends on a ray, a singular basis or half its pivot share is
+// followed by a cold start from the slack basis. When the passes run out the message gives the
+// last pass's largest relative move of a bound.
 //
-// Warm start: a guess only seeds the friction bounds; pivoting always starts from the slack
-// basis.
+// Warm start: a guess only seeds the friction bounds; the first pass starts from the slack basis.
 #pragma once
 
 #include <iosfwd>
@@ -90,16 +117,24 @@ namespace mlcp {
 class LemkeSolver : public Solver {
  public:
   const char* name() const override { return "lemke"; }
-  // Largest problem accepted, in rows: 2000 rows make a tableau of up to 4000 x 8002 doubles
-  // (256 MB). Default 2000.
-  int maxRows = 2000;
+  // Problems of up to this many rows pivot on the dense tableau, larger ones on the factored
+  // basis (see "Choice by size" above). Default 50.
+  int denseRows = 50;
+  // Problems with free rows of up to this many rows keep the tableau (see "Choice by size").
+  static constexpr int kFreeRowsTableauRows = 2000;
+  // Factored basis: pivots between two factorizations of the basis matrix (halved when the
+  // updated basic values drift). Default 50.
+  int refactorPeriod = 50;
+  // Largest problem accepted, in rows (Status::Unsupported above it, x untouched). Default
+  // 5,000,000.
+  int maxRows = 5000000;
 
  protected:
   void run(const Problem& problem, Vector& x, Result& result) override;
 
  private:
   // The pivoting (with the friction passes) on A, the problem's matrix or a regularised one.
-  void pivot(const Problem& problem, const DenseMatrix& A, Vector& x, Result& result);
+  void pivot(const Problem& problem, const SparseMatrix& A, Vector& x, Result& result);
 };
 
 // Runs Lemke on a standard LCP (lo = 0, hi = +inf, no findex) and prints every tableau to out:

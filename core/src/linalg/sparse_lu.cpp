@@ -61,4 +61,11 @@ bool SparseLu::solve(Vector& y) {
   return y.allFinite();
 }
 
+bool SparseLu::solveTransposed(Vector& y) {
+  State& s = *s_;
+  if (!s.numeric || y.size() != s.n) return false;
+  if (!klu_solve(s.symbolic, s.numeric, s.n, 1, y.data(), &s.common)) return false;
+  return y.allFinite();
+}
+
 }  // namespace mlcp::linalg

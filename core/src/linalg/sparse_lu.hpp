@@ -36,6 +36,9 @@ class SparseLu {
   bool factor(const std::vector<double>& values);
   // y <- J^-1 y with the last factor. False when the factor is missing or a value is not finite.
   bool solve(Vector& y);
+  // y <- J^-T y with the last factor (the same factor, no second factorization). False like
+  // solve().
+  bool solveTransposed(Vector& y);
   // Symbolic analyses done by this object (for tests of the reuse).
   int analyses() const { return analyses_; }
 
