@@ -15,6 +15,8 @@ every answer carries the scaled natural-map residual, recomputed from the proble
     p = mlcp.Problem.load("problem.json")  # mlcp-problem/1 JSON, or a Siconos LCP .dat file
     run = mlcp.run("scenes/stack_10.json", "bullet", solver="dantzig", steps=100)
     run.residual.max(), run.solver_ms.mean()  # per-step measures, as `mlcp run` writes them
+    df = mlcp.sweep(["scenes/stack_10.json"], solvers=["pgs", "dantzig"], values=[5, 20])
+    mlcp.chart.work_precision(df)             # `mlcp sweep --csv`'s rows; mlcp.stability(...)
 
 Invalid input (a malformed problem or file, an unknown solver, engine or scene) raises
 ValueError with the message the `mlcp` program prints; a solver that did not converge is not an
@@ -29,9 +31,11 @@ from typing import Any, Dict, List, Optional
 
 import numpy as np
 
-from . import _mlcp
+from . import _mlcp, chart
+from .studies import stability, sweep
 
-__all__ = ["Problem", "Result", "Run", "solve", "run", "solvers", "engines"]
+__all__ = ["Problem", "Result", "Run", "solve", "run", "solvers", "engines", "sweep",
+           "stability"]
 
 
 def _vector(name: str, v: Any, n: int, default: Optional[float]) -> Optional[np.ndarray]:
@@ -176,10 +180,11 @@ class Problem:
         return np.asarray(f, dtype=np.int32) if f else np.full(self.n, -1, dtype=np.int32)
 
     def solve(self, solver: str = "auto", tol: float = 1e-10, guess: Any = None,
-              max_iter: int = 1000, relaxation: float = 1.0) -> Result:
-        """Solves with a registered solver (see solvers()); `guess` is the start point."""
+              max_iter: int = 1000, relaxation: float = 1.0, time_budget: float = 0.0) -> Result:
+        """Solves with a registered solver (see solvers()); `guess` is the start point; the
+        settings of `mlcp solve` (--tol, --max-iter, --relaxation, --time-budget)."""
         g = _vector("guess", guess, self.n, None)
-        return Result(**self._core.solve(solver, tol, max_iter, relaxation, g))
+        return Result(**self._core.solve(solver, tol, max_iter, relaxation, time_budget, g))
 
     def __repr__(self) -> str:
         storage = "sparse" if self.is_sparse else "dense"
@@ -188,12 +193,14 @@ class Problem:
 
 def solve(A: Any, b: Any = None, lo: Any = None, hi: Any = None, findex: Any = None,
           solver: str = "auto", tol: float = 1e-10, guess: Any = None, max_iter: int = 1000,
-          relaxation: float = 1.0) -> Result:
+          relaxation: float = 1.0, time_budget: float = 0.0) -> Result:
     """Solves w = A x + b, lo <= x <= hi (findex) with the named solver ("auto" chooses).
 
     A may also be a Problem (then b, lo, hi and findex are not given). tol is the target of the
     scaled natural-map residual, max_iter the sweep (or outer iteration) limit, relaxation the
-    SOR factor of gs/pgs. A result that did not reach tol says so in its status.
+    SOR factor of gs/pgs, time_budget the wall-clock limit in seconds (0: none; when it runs
+    out the best answer so far comes back as "time-limit"). A result that did not reach tol
+    says so in its status.
     """
     if isinstance(A, Problem):
         if b is not None or lo is not None or hi is not None or findex is not None:
@@ -201,7 +208,7 @@ def solve(A: Any, b: Any = None, lo: Any = None, hi: Any = None, findex: Any = N
         problem = A
     else:
         problem = Problem(A, b, lo, hi, findex)
-    return problem.solve(solver, tol, guess, max_iter, relaxation)
+    return problem.solve(solver, tol, guess, max_iter, relaxation, time_budget)
 
 
 _RUN_COLUMNS = ("solver_ms", "step_ms", "residual", "iterations", "status", "fallbacks", "choice",
@@ -218,6 +225,7 @@ class Run:
     solver: str  # the solver asked for
     time_step: float  # s
     finite: bool  # False: the body states became non-finite and the run stopped there
+    captured: List[str]  # with run(..., capture=STEP): the problem files written
     solver_ms: np.ndarray  # wall time of the constraint solves, ms
     step_ms: np.ndarray  # wall time of the whole step, ms
     residual: np.ndarray  # worst scaled residual of the step's problems (NaN: not measured)
@@ -259,24 +267,40 @@ class Run:
 
 def run(scene: "str | os.PathLike[str]", engine: str, solver: Optional[str] = None,
         steps: Optional[int] = None, iterations: Optional[int] = None,
-        tol: Optional[float] = None, warm_start: bool = True, fallback: Optional[str] = "pgs",
-        fallback_residual: Optional[float] = None, states: bool = False) -> Run:
+        tol: Optional[float] = None, warm_start: bool = True, engine_iterations: bool = False,
+        fallback: Optional[str] = "pgs", fallback_residual: Optional[float] = None,
+        time_budget: Optional[float] = None, pivoting_steps: Optional[int] = None,
+        friction: Optional[str] = None, friction_directions: Optional[int] = None,
+        csv: "str | os.PathLike[str] | None" = None,
+        trajectory: "str | os.PathLike[str] | None" = None, capture: Optional[int] = None,
+        capture_dir: "str | os.PathLike[str]" = ".", states: bool = False) -> Run:
     """Steps a scene file (mlcp-scene/1) in an engine ("bullet" or "ode", see engines()).
 
-    solver: a core solver name (through our adapters) or an engine's stock one ("bullet-si",
-    "ode-world", ...); None, steps, iterations and tol None: the scene's own settings; fallback:
-    the core solver run when an answer is rejected (None: none); fallback_residual: the scaled
-    residual above which an answer is rejected (None: 1e-3). The same rules as `mlcp run`.
-    states: also record every body's position, orientation and velocity after each step.
+    The settings of `mlcp run`, snake_case, with its defaults (`mlcp run --help`); None: the
+    scene's own value (solver, steps, iterations, tol, friction, friction_directions) or the
+    adapters' default (fallback_residual 1e-3, time_budget 0.05 s, pivoting_steps 40/120).
+    fallback None or "none": no fallback; friction "box" or "cone"; csv and trajectory: files to
+    write as `mlcp run --csv/--trajectory` does; capture: the step whose islands are written to
+    capture_dir (listed in Run.captured). states: also record every body's position,
+    orientation and velocity after each step.
     """
     for name, value in (("steps", steps), ("iterations", iterations), ("tol", tol),
-                        ("fallback_residual", fallback_residual)):
+                        ("fallback_residual", fallback_residual), ("time_budget", time_budget),
+                        ("pivoting_steps", pivoting_steps),
+                        ("friction_directions", friction_directions), ("capture", capture)):
         if value is not None and not value >= 0:
             raise ValueError(f"{name} must be >= 0, not {value}")
-    d = _mlcp.run(os.fspath(scene), engine, solver or "", -1 if steps is None else int(steps),
-                  -1 if iterations is None else int(iterations), -1.0 if tol is None else tol,
-                  bool(warm_start), fallback or "",
-                  -1.0 if fallback_residual is None else fallback_residual, bool(states))
+
+    def number(v: Any, cast: Any) -> Any:
+        return -1 if v is None else cast(v)
+
+    d = _mlcp.run(os.fspath(scene), engine, solver or "", number(steps, int),
+                  number(iterations, int), number(tol, float), bool(warm_start),
+                  bool(engine_iterations), fallback or "", number(fallback_residual, float),
+                  number(time_budget, float), number(pivoting_steps, int), friction or "",
+                  number(friction_directions, int), os.fspath(csv) if csv else "",
+                  os.fspath(trajectory) if trajectory else "", number(capture, int),
+                  os.fspath(capture_dir), bool(states))
     d["status"] = np.array(d["status"], dtype=str)
     d["choice"] = np.array(d["choice"], dtype=str)
     return Run(**d)
@@ -290,3 +314,4 @@ def solvers() -> List[str]:
 def engines() -> List[str]:
     """The engines this build can run scenes in ("bullet", "ode")."""
     return list(_mlcp.engine_names())
+

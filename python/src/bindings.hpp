@@ -10,5 +10,7 @@ namespace mlcp::python {
 void bindProblems(nanobind::module_& m);
 // run, engine_names (runs.cpp).
 void bindRuns(nanobind::module_& m);
+// sweep_plan, sweep_run, stability_cells, stability_cell and their CSV columns (studies.cpp).
+void bindStudies(nanobind::module_& m);
 
 }  // namespace mlcp::python

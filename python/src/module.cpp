@@ -5,4 +5,5 @@ NB_MODULE(_mlcp, m) {
   m.doc() = "mlcp's C++ core (use the mlcp package, not this module)";
   mlcp::python::bindProblems(m);
   mlcp::python::bindRuns(m);
+  mlcp::python::bindStudies(m);
 }

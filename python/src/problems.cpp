@@ -93,7 +93,7 @@ nb::tuple csr(Problem& p) {
 }
 
 nb::dict solve(const Problem& p, const std::string& name, double tol, int maxIter,
-               double relaxation, const OptVector& guess) {
+               double relaxation, double timeBudget, const OptVector& guess) {
   std::string error;
   std::unique_ptr<Solver> solver = makeSolver(name, &error);
   if (!solver) throw nb::value_error(error.c_str());
@@ -101,6 +101,7 @@ nb::dict solve(const Problem& p, const std::string& name, double tol, int maxIte
   opt.tolerance = tol;
   opt.maxIterations = maxIter;
   opt.relaxation = relaxation;
+  opt.timeBudget = timeBudget;
   Vector x;
   Result r;
   {
@@ -164,7 +165,7 @@ void bindProblems(nb::module_& m) {
           nb::rv_policy::reference_internal)
       .def_prop_ro("csr", &csr)
       .def("solve", &solve, nb::arg("solver"), nb::arg("tol"), nb::arg("max_iter"),
-           nb::arg("relaxation"), nb::arg("guess").none());
+           nb::arg("relaxation"), nb::arg("time_budget"), nb::arg("guess").none());
   m.def("solver_names", &solverNames);
 }
 

@@ -1,15 +1,19 @@
 """Shared paths and helpers of the mlcp package's tests (run by ctest as python_pytest, which sets
-PYTHONPATH to the build's python folder and MLCP_SOURCE_DIR / MLCP_BUILD_DIR)."""
+PYTHONPATH to the build's python folder and MLCP_SOURCE_DIR / MLCP_BUILD_DIR; or as
+`python -m pytest python/tests` with the package pip-installed, the mlcp program among the
+interpreter's scripts)."""
 
 import os
 import pathlib
 import subprocess
+import sys
+import sysconfig
 
 import numpy as np
 import pytest
 
 SOURCE = pathlib.Path(os.environ.get("MLCP_SOURCE_DIR", pathlib.Path(__file__).parents[2]))
-BUILD = pathlib.Path(os.environ.get("MLCP_BUILD_DIR", SOURCE / "build"))
+BUILD = pathlib.Path(os.environ["MLCP_BUILD_DIR"]) if "MLCP_BUILD_DIR" in os.environ else None
 SCENES = SOURCE / "scenes"
 DATA = SOURCE / "tests" / "data"
 
@@ -30,9 +34,20 @@ def natural_map_residual(A, b, lo, hi, x, findex=None):
     return np.max(np.abs(r)) / (1.0 + np.max(np.abs(b)))
 
 
+def cli_path():
+    """The mlcp program: the build's (MLCP_BUILD_DIR), else the one pip installed next to this
+    interpreter, else build/bin/mlcp of the source tree."""
+    if BUILD is not None:
+        return BUILD / "bin" / "mlcp"
+    for scripts in (sysconfig.get_path("scripts"), pathlib.Path(sys.executable).parent):
+        if (pathlib.Path(scripts) / "mlcp").exists():
+            return pathlib.Path(scripts) / "mlcp"
+    return SOURCE / "build" / "bin" / "mlcp"
+
+
 def cli(*args):
     """Runs the mlcp program; returns (exit code, stdout, stderr)."""
-    exe = BUILD / "bin" / "mlcp"
+    exe = cli_path()
     if not exe.exists():
         pytest.fail(f"{exe} not built (set MLCP_BUILD_DIR)")
     p = subprocess.run([str(exe), *map(str, args)], capture_output=True, text=True, timeout=60)

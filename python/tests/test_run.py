@@ -89,3 +89,52 @@ def test_bad_run_raises_the_cli_message(scene, engine, solver):
 def test_negative_steps_refused():
     with pytest.raises(ValueError, match="steps"):
         mlcp.run(SCENES / "stack_10.json", "ode", steps=-1)
+
+
+def test_cli_run_settings_are_taken(tmp_path):
+    """friction, friction_directions, time_budget, pivoting_steps, engine_iterations: the CSV
+    written by the Python run equals the CLI's with the same settings."""
+    settings = dict(solver="lemke", friction="cone", friction_directions=8, time_budget=0.0,
+                    pivoting_steps=0, steps=5)
+    run = mlcp.run(SCENES / "stack_10.json", "bullet", csv=tmp_path / "py.csv", **settings)
+    assert run.finite and np.all(run.residual < 1e-6)
+    code, _, err = cli("run", SCENES / "stack_10.json", "--engine", "bullet", "--solver", "lemke",
+                       "--friction", "cone", "--friction-directions", 8, "--time-budget", 0,
+                       "--pivoting-steps", 0, "--steps", 5, "--csv", tmp_path / "cli.csv")
+    assert code == 0, err
+    with open(tmp_path / "cli.csv") as a, open(tmp_path / "py.csv") as b:
+        theirs, ours = list(csv.DictReader(a)), list(csv.DictReader(b))
+    assert [r["iterations"] for r in ours] == [r["iterations"] for r in theirs]
+    assert [r["energy"] for r in ours] == [r["energy"] for r in theirs]
+    box = mlcp.run(SCENES / "stack_10.json", "bullet", solver="lemke", steps=5)
+    assert not np.array_equal(box.iterations, run.iterations)  # the cone is another problem
+    # The engine's fixed sweeps: 7 on the stack's one island, checked once, no fallback.
+    fixed = mlcp.run(SCENES / "stack_10.json", "ode", solver="pgs", iterations=7, steps=40,
+                     engine_iterations=True)
+    free = mlcp.run(SCENES / "stack_10.json", "ode", solver="pgs", iterations=7, steps=40)
+    assert np.all(fixed.iterations == 7) and np.all(fixed.fallbacks == 0)
+    assert free.iterations.sum() > fixed.iterations.sum()  # short of 1e-6: the fallback ran
+
+
+def test_capture_writes_the_step_problems(tmp_path):
+    run = mlcp.run(SCENES / "stack_10.json", "ode", solver="dantzig", steps=4, capture=2,
+                   capture_dir=tmp_path / "cap")
+    assert run.captured and all(f.endswith(".json") for f in run.captured)
+    problem = mlcp.Problem.load(run.captured[0])
+    assert problem.n > 0 and mlcp.solve(problem, solver="dantzig").converged
+    with pytest.raises(ValueError, match="is not one of the 4 steps"):
+        mlcp.run(SCENES / "stack_10.json", "ode", steps=4, capture=4, capture_dir=tmp_path)
+
+
+@pytest.mark.parametrize("option, value, kwargs", [
+    ("--friction-directions", 2, dict(solver="lemke", friction="cone", friction_directions=2)),
+    ("--friction", "cone", dict(solver="pgs", friction="cone")),
+])
+def test_bad_run_settings_raise(option, value, kwargs):
+    with pytest.raises(ValueError) as e:
+        mlcp.run(SCENES / "stack_10.json", "bullet", steps=1, **kwargs)
+    if option == "--friction":  # refused by the engine: the CLI says the same
+        assert str(e.value) == cli_error("run", SCENES / "stack_10.json", "--engine", "bullet",
+                                         "--solver", "pgs", "--friction", "cone", "--steps", 1)
+    with pytest.raises(ValueError, match="friction: 'disc' is not box or cone"):
+        mlcp.run(SCENES / "stack_10.json", "bullet", steps=1, friction="disc")

@@ -38,7 +38,7 @@ def test_every_public_name_is_stubbed():
 
 def test_function_signatures_match():
     stubs = stub_tree()
-    for name in ("solve", "run", "solvers", "engines"):
+    for name in ("solve", "run", "solvers", "engines", "sweep", "stability"):
         assert stub_params(stubs[name]) == runtime_params(getattr(mlcp, name)), name
 
 

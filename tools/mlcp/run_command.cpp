@@ -21,18 +21,8 @@ namespace {
 struct RunArgs {
   std::string scene;
   std::string engine;
-  std::string solver;  // "" : the scene's default
-  int steps = -1;      // -1 : the scene's
-  int iterations = -1;
-  double tolerance = -1;
-  bool noWarmStart = false;
-  bool engineIterations = false;
-  std::string fallback = "pgs";
-  double fallbackResidual = -1;
-  double timeBudget = -1;  // -1: the adapters' default
-  int pivotingSteps = -1;  // -1: NewtonParams' defaults
-  std::string friction;    // "" : the scene's
-  int frictionDirections = -1;
+  RunOptions options;
+  int steps = -1;  // -1 : the scene's
   std::string csv;
   std::string trajectory;
   int capture = -1;  // -1: no capture
@@ -47,22 +37,11 @@ int runScene(const RunArgs& args) {
     std::cerr << "mlcp run: " << e.what() << "\n";
     return kInvalidInput;
   }
-  scene::RunSettings run = scene::RunSettings::fromScene(s);
-  if (!args.solver.empty()) run.solver = args.solver;
-  if (args.iterations >= 0) run.iterations = args.iterations;
-  if (args.tolerance >= 0) run.tolerance = args.tolerance;
-  if (args.noWarmStart) run.warmStart = false;
-  run.engineIterations = args.engineIterations;
-  run.fallback = args.fallback == "none" ? "" : args.fallback;
-  if (args.fallbackResidual >= 0) run.fallbackResidual = args.fallbackResidual;
-  if (args.timeBudget >= 0) run.timeBudget = args.timeBudget;
-  run.pivotingSteps = args.pivotingSteps;
-  if (!args.friction.empty()) parseFrictionModel(args.friction, run.friction);  // checked by CLI11
-  if (args.frictionDirections >= 0) run.frictionDirections = args.frictionDirections;
   const int steps = args.steps >= 0 ? args.steps : s.settings.steps;
-
+  scene::RunSettings run;
   std::unique_ptr<scene::World> world;
   try {
+    run = runSettings(s, args.options);
     world = makeWorld(args.engine, s, run);
   } catch (const std::invalid_argument& e) {
     std::cerr << "mlcp run: " << e.what() << "\n";
@@ -88,23 +67,10 @@ int runScene(const RunArgs& args) {
     trajectory << kTrajectoryCsvHeader << "\n" << std::setprecision(17);
   }
   if (args.capture >= 0) {
-    if (args.capture >= steps) {
-      std::cerr << "mlcp run: --capture " << args.capture << " is not one of the " << steps
-                << " steps run (0 to " << steps - 1 << ")\n";
-      return kInvalidInput;
-    }
-    std::error_code ec;
-    const bool existed = std::filesystem::is_directory(args.captureDir, ec);
-    std::filesystem::create_directories(args.captureDir, ec);
-    if (ec) {
-      std::cerr << "mlcp run: cannot create " << args.captureDir << ": " << ec.message() << "\n";
-      return kInvalidInput;
-    }
-    // Asked of an unstepped copy first, so that a world that cannot capture fails at once.
-    if (!makeWorld(args.engine, s, run)->captureNextStep(args.captureDir)) {
-      if (!existed) std::filesystem::remove(args.captureDir, ec);
-      std::cerr << "mlcp run: this engine/solver cannot capture (" << args.engine << " with "
-                << run.solver << ")\n";
+    const std::string error =
+        prepareCapture(args.engine, s, run, args.capture, steps, args.captureDir);
+    if (!error.empty()) {
+      std::cerr << "mlcp run: " << error << "\n";
       return kInvalidInput;
     }
     if (args.capture == 0) world->captureNextStep(args.captureDir);
@@ -156,42 +122,44 @@ Runner addRunCommand(CLI::App& app) {
           "scene file, engine or solver.");
   cmd->add_option("scene", args->scene, "scene file (.json, mlcp-scene/1)")->required();
   cmd->add_option("--engine", args->engine, "engine: " + engineNames())->required();
-  cmd->add_option("--solver", args->solver,
+  cmd->add_option("--solver", args->options.solver,
                   "a core solver name (through our adapters) or a stock one: bullet-si, "
                   "bullet-nncg, bullet-mlcp-pgs, bullet-mlcp-dantzig, bullet-mlcp-lemke, "
                   "ode-world, ode-quick (default: the scene's solver.name)");
   cmd->add_option("--steps", args->steps, "steps to take (default: the scene's settings.steps)")
       ->check(nonNegativeNumber());
-  cmd->add_option("--iterations", args->iterations,
+  cmd->add_option("--iterations", args->options.iterations,
                   "sweeps / outer iterations per solve (default: the scene's solver.iterations)")
       ->check(nonNegativeNumber());
-  cmd->add_option("--tol", args->tolerance,
+  cmd->add_option("--tol", args->options.tolerance,
                   "tolerance of the scaled residual (default: the scene's solver.tolerance)")
       ->check(nonNegativeNumber());
-  cmd->add_flag("--no-warm-start", args->noWarmStart, "start every solve from zero");
-  cmd->add_flag("--engine-iterations", args->engineIterations,
+  cmd->add_flag_function(
+      "--no-warm-start", [args](std::int64_t) { args->options.warmStart = false; },
+      "start every solve from zero");
+  cmd->add_flag("--engine-iterations", args->options.engineIterations,
                 "pgs/gs run exactly --iterations sweeps, checked once at the end, as the "
                 "engine's own solver does (the adapters' default for a drop-in)");
-  cmd->add_option("--fallback", args->fallback,
+  cmd->add_option("--fallback", args->options.fallback,
                   "core solver run when an answer is rejected, or none (default pgs)");
-  cmd->add_option("--fallback-residual", args->fallbackResidual,
+  cmd->add_option("--fallback-residual", args->options.fallbackResidual,
                   "scaled residual above which an answer is rejected (default 1e-3)")
       ->check(nonNegativeNumber());
-  cmd->add_option("--time-budget", args->timeBudget,
+  cmd->add_option("--time-budget", args->options.timeBudget,
                   "wall-clock budget of one step's solves in seconds, 0 for none (core solvers "
                   "only; default 0.05): islands solved after it ran out get a minimal share and "
                   "answers stopped by it report time-limit")
       ->check(nonNegativeNumber());
-  cmd->add_option("--pivoting-steps", args->pivotingSteps,
+  cmd->add_option("--pivoting-steps", args->options.pivotingSteps,
                   "most block steps of newton's pivoting phase after damped steps that end short "
                   "(core solvers only), 0 to turn it off (default 40, 120 on an engine's rows)")
       ->check(CLI::Range(0, 1000000));
-  cmd->add_option("--friction", args->friction,
+  cmd->add_option("--friction", args->options.friction,
                   "friction model: box (the engines' own) or cone (the polyhedral cone's LCP; "
                   "core solvers that take an LCP: auto, lemke, dantzig) (default: the scene's "
                   "solver.friction, box)")
       ->check(CLI::IsMember({"box", "cone"}));
-  cmd->add_option("--friction-directions", args->frictionDirections,
+  cmd->add_option("--friction-directions", args->options.frictionDirections,
                   "friction directions per contact of the cone, 3 to 64 (default: the scene's "
                   "solver.friction_directions, 4)")
       ->check(CLI::Range(kMinConeDirections, kMaxConeDirections));

@@ -1,10 +1,13 @@
 #include "scene_runs.hpp"
 
 #include <algorithm>
+#include <filesystem>
 #include <ostream>
 #include <stdexcept>
 
 #include "csv_rows.hpp"
+#include "mlcp/friction_model.hpp"
+#include "mlcp/input_limits.hpp"
 
 #ifdef MLCP_HAVE_BULLET
 #include "mlcp/bullet/scene_loader.hpp"
@@ -43,6 +46,42 @@ std::unique_ptr<scene::World> makeWorld(const std::string& engine, const scene::
   (void)s;
   (void)run;
   throw std::invalid_argument("unknown engine '" + engine + "' (known: " + engineNames() + ")");
+}
+
+scene::RunSettings runSettings(const scene::Scene& s, const RunOptions& o) {
+  scene::RunSettings run = scene::RunSettings::fromScene(s);
+  if (!o.solver.empty()) run.solver = o.solver;
+  if (o.iterations >= 0) run.iterations = o.iterations;
+  if (o.tolerance >= 0) run.tolerance = o.tolerance;
+  if (!o.warmStart) run.warmStart = false;
+  run.engineIterations = o.engineIterations;
+  run.fallback = o.fallback == "none" ? "" : o.fallback;
+  if (o.fallbackResidual >= 0) run.fallbackResidual = o.fallbackResidual;
+  if (o.timeBudget >= 0) run.timeBudget = o.timeBudget;
+  run.pivotingSteps = o.pivotingSteps;
+  if (!o.friction.empty() && !parseFrictionModel(o.friction, run.friction))
+    throw std::invalid_argument("friction: '" + io::capped(o.friction, 24) +
+                                "' is not box or cone");
+  if (o.frictionDirections >= 0) run.frictionDirections = o.frictionDirections;
+  return run;
+}
+
+std::string prepareCapture(const std::string& engine, const scene::Scene& s,
+                           const scene::RunSettings& run, int step, int steps,
+                           const std::string& folder) {
+  if (step >= steps)
+    return "--capture " + std::to_string(step) + " is not one of the " + std::to_string(steps) +
+           " steps run (0 to " + std::to_string(steps - 1) + ")";
+  std::error_code ec;
+  const bool existed = std::filesystem::is_directory(folder, ec);
+  std::filesystem::create_directories(folder, ec);
+  if (ec) return "cannot create " + folder + ": " + ec.message();
+  // Asked of an unstepped copy first, so that a world that cannot capture fails at once.
+  if (!makeWorld(engine, s, run)->captureNextStep(folder)) {
+    if (!existed) std::filesystem::remove(folder, ec);
+    return "this engine/solver cannot capture (" + engine + " with " + run.solver + ")";
+  }
+  return "";
 }
 
 const char* const kStepCsvHeader =

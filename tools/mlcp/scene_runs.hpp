@@ -22,6 +22,33 @@ std::vector<std::string> engineList();
 std::unique_ptr<scene::World> makeWorld(const std::string& engine, const scene::Scene& s,
                                         const scene::RunSettings& run);
 
+// The settings `mlcp run` (and the Python module's mlcp.run) lays over a scene's own: a negative
+// number or an empty string keeps the scene's value or the adapters' default.
+struct RunOptions {
+  std::string solver;  // "" : the scene's solver.name
+  int iterations = -1;
+  double tolerance = -1;
+  bool warmStart = true;
+  bool engineIterations = false;
+  std::string fallback = "pgs";  // "none" or "": no fallback
+  double fallbackResidual = -1;  // -1: 1e-3
+  double timeBudget = -1;        // s; -1: the adapters' default (0.05), 0: none
+  int pivotingSteps = -1;        // -1: NewtonParams' defaults
+  std::string friction;          // "" : the scene's; "box" or "cone"
+  int frictionDirections = -1;   // -1: the scene's
+};
+
+// The scene's run settings with `o` laid over them; throws std::invalid_argument for a friction
+// model other than box or cone (the engines check the rest when the world is made).
+scene::RunSettings runSettings(const scene::Scene& s, const RunOptions& o);
+
+// Makes ready to capture each island's problem at step `step` of `steps` into `folder` (created
+// if missing), asking an unstepped copy of the world whether it can: "" when it can, else the
+// message `mlcp run --capture` prints.
+std::string prepareCapture(const std::string& engine, const scene::Scene& s,
+                           const scene::RunSettings& run, int step, int steps,
+                           const std::string& folder);
+
 // The per-step CSV columns of `mlcp run` (see mlcp/scene/world.hpp for each measure).
 extern const char* const kStepCsvHeader;
 // One CSV row for the world's last step; `solver` is the name the run was asked for.

@@ -1,11 +1,7 @@
 // mlcp stability: a grid of stack runs per engine and solver, each cell classified stable /
-// drifting / collapsed / exploded / solver-failure (the thresholds and the measures are in
-// stability.hpp). Two grids:
-//   mass   x = mass_ratio (top box / bottom box), y = height (boxes); scene "stack_mass_ratio"
-//   step   x = time_step (s), y = iterations; scene "stack_time_step", a stack of --step-height
-//          boxes with the top/bottom mass ratio --step-ratio
-// Every cell runs the same simulated time (--seconds), so a smaller time step takes more
-// steps. One CSV row per cell, in the format `tools/chart.py heatmap` reads.
+// drifting / collapsed / exploded / solver-failure (the grids: stability_grid.hpp; the
+// thresholds and the measures: stability.hpp). One CSV row per cell, in the format
+// `tools/chart.py heatmap` reads.
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -18,49 +14,19 @@
 #include "commands.hpp"
 #include "progress.hpp"
 #include "scene_runs.hpp"
-#include "stability.hpp"
+#include "stability_grid.hpp"
 
 namespace mlcp::cli {
 
 namespace {
 
 struct StabilityArgs {
-  std::vector<std::string> engines;
-  std::vector<std::string> solvers{"pgs",       "dantzig",  "bullet-si", "bullet-mlcp-dantzig",
-                                   "ode-world", "ode-quick"};
-  std::string grids = "mass,step";
-  std::vector<double> ratios{1, 10, 100, 1000};
-  std::vector<int> heights{2, 4, 8, 16};
-  std::vector<double> timeSteps{1.0 / 240, 1.0 / 120, 1.0 / 60, 1.0 / 30};
-  std::vector<int> iterationCounts{2, 5, 10, 20, 50};
-  int stepHeight = 6;
-  double stepRatio = 10;
-  double seconds = 2;
-  int iterations = 20;
-  double massTimeStep = 1.0 / 60;
-  double cfm = kStackCfm;
-  std::string fallback = "none";
-  bool quick = false;
+  StabilityGrid grid;
   std::string csv;
   std::string chart;
-  StabilityThresholds thresholds;
 };
 
-struct Cell {
-  std::string engine, solver, scene, xName, yName;
-  double x = 0, y = 0;
-  scene::Scene built;
-  scene::RunSettings run;
-};
-
-// Stock names run only in their own engine.
-bool runsIn(const std::string& solver, const std::string& engine) {
-  for (const std::string& e : engineList())
-    if (solver.rfind(e + "-", 0) == 0) return e == engine;
-  return true;
-}
-
-std::string label(const Cell& c) {
+std::string label(const StabilityCell& c) {
   std::ostringstream s;
   s << c.engine << '/' << c.solver << ' ' << c.xName << '=' << c.x << ' ' << c.yName << '=' << c.y;
   return s.str();
@@ -70,7 +36,7 @@ std::string label(const Cell& c) {
 // largest y down, columns x ascending, e.g.
 //   stack_mass_ratio bullet/pgs  height 16: DDCC | 8: DDCC | 4: SDCC | 2: SSCC  (mass_ratio 1 10
 //   100 1000)
-void printMaps(const std::vector<Cell>& cells, const std::string& letters) {
+void printMaps(const std::vector<StabilityCell>& cells, const std::string& letters) {
   std::size_t i = 0;
   while (i < cells.size()) {
     std::size_t end = i;
@@ -97,66 +63,16 @@ void printMaps(const std::vector<Cell>& cells, const std::string& letters) {
 }
 
 int runStability(StabilityArgs args) {
-  if (args.quick) {
-    args.ratios = {1, 100};
-    args.heights = {2, 6};
-    args.timeSteps = {1.0 / 120, 1.0 / 30};
-    args.iterationCounts = {3, 20};
-    args.seconds = 1;
-  }
-  if (args.engines.empty()) args.engines = engineList();
   if (!args.chart.empty() && args.csv.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(args.chart, ec);
     args.csv = args.chart + "/stability.csv";
   }
-  const bool massGrid = args.grids.find("mass") != std::string::npos;
-  const bool stepGrid = args.grids.find("step") != std::string::npos;
-  if (!massGrid && !stepGrid) {
-    std::cerr << "mlcp stability: --grids must name mass, step or both (got '" << args.grids
-              << "')\n";
-    return kInvalidInput;
-  }
-
-  scene::RunSettings base;
-  base.iterations = args.iterations;
-  base.fallback = args.fallback == "none" ? "" : args.fallback;
-  std::vector<Cell> cells;
+  std::vector<StabilityCell> cells;
   try {
-    for (const std::string& engine : args.engines)
-      for (const std::string& solver : args.solvers) {
-        if (!runsIn(solver, engine)) continue;
-        scene::RunSettings run = base;
-        run.solver = solver;
-        makeWorld(engine, stackScene("check", 1, 1, 0.01), run);  // unknown names throw here
-        if (massGrid)
-          for (int h : args.heights)
-            for (double r : args.ratios)
-              cells.push_back(
-                  {engine, solver, "stack_mass_ratio", "mass_ratio", "height", r, double(h),
-                   stackScene("stack_mass_ratio", h, r, args.massTimeStep, args.cfm), run});
-        if (stepGrid)
-          for (int it : args.iterationCounts)
-            for (double dt : args.timeSteps) {
-              Cell c{engine,
-                     solver,
-                     "stack_time_step",
-                     "time_step",
-                     "iterations",
-                     dt,
-                     double(it),
-                     stackScene("stack_time_step", args.stepHeight, args.stepRatio, dt, args.cfm),
-                     run};
-              c.run.iterations = it;
-              cells.push_back(std::move(c));
-            }
-      }
+    cells = stabilityCells(args.grid);
   } catch (const std::invalid_argument& e) {
     std::cerr << "mlcp stability: " << e.what() << "\n";
-    return kInvalidInput;
-  }
-  if (cells.empty()) {
-    std::cerr << "mlcp stability: no cell to run (no solver of --solvers runs in --engines)\n";
     return kInvalidInput;
   }
 
@@ -169,30 +85,17 @@ int runStability(StabilityArgs args) {
     }
   }
   std::ostream& csv = args.csv.empty() ? std::cout : file;
-  csv << "engine,solver,x_name,x_value,y_name,y_value,outcome,scene,steps,max_speed,"
-         "max_displacement,top_displacement,max_penetration,failed_steps,fallback_steps,"
-         "worst_residual,mean_solver_ms,reason\n"
-      << std::setprecision(9);
+  csv << kStabilityCsvHeader << "\n" << std::setprecision(9);
 
   std::map<Outcome, int> counts;
   std::string letters;  // one per cell, in cell order
   Progress progress("stability", int(cells.size()));
-  for (const Cell& c : cells) {
+  for (const StabilityCell& c : cells) {
     progress.start(label(c));
-    auto world = makeWorld(c.engine, c.built, c.run);
-    CellTracker tracker(world->scene());
-    const int steps = std::max(1, int(std::lround(args.seconds / c.built.settings.timeStep)));
-    const RunSummary sum = runWorld(
-        *world, steps, [&](const scene::World& w, int) { tracker.observe(w.states(), w.last()); });
-    const CellMeasures& m = tracker.measures();
-    const Classification k = classify(m, args.thresholds);
-    ++counts[k.outcome];
-    letters.push_back("SDCEF"[static_cast<int>(k.outcome)]);
-    csv << c.engine << ',' << c.solver << ',' << c.xName << ',' << c.x << ',' << c.yName << ','
-        << c.y << ',' << toString(k.outcome) << ',' << c.scene << ',' << m.steps << ','
-        << m.maxSpeed << ',' << m.maxDisplacementRatio << ',' << m.topDisplacement << ','
-        << m.maxPenetration << ',' << m.failedSteps << ',' << m.fallbackSteps << ','
-        << sum.worstResidual << ',' << sum.meanSolverMs << ',' << k.reason << "\n";
+    const StabilityResult r = runStabilityCell(args.grid, c);
+    ++counts[r.classification.outcome];
+    letters.push_back("SDCEF"[static_cast<int>(r.classification.outcome)]);
+    writeStabilityCsv(csv, c, r);
     progress.done();
   }
   progress.finish();
@@ -238,52 +141,53 @@ Runner addStabilityCommand(CLI::App& app) {
           "reason. Exit 0: the grid ran (and --chart drew it); 1: --chart failed; 2: bad "
           "arguments.";
   CLI::App* cmd = app.add_subcommand("stability", help.str());
-  cmd->add_option("--engines", args->engines,
+  cmd->add_option("--engines", args->grid.engines,
                   "engines, comma separated (default: all built: " + engineNames() + ")")
       ->delimiter(',');
-  cmd->add_option("--solvers", args->solvers,
+  cmd->add_option("--solvers", args->grid.solvers,
                   "solvers, comma separated; stock names (bullet-*, ode-*) run in their own "
                   "engine only")
       ->delimiter(',')
       ->capture_default_str();
-  cmd->add_option("--grids", args->grids, "mass, step or mass,step")->capture_default_str();
-  cmd->add_option("--ratios", args->ratios, "mass grid: top/bottom mass ratios")
+  cmd->add_option("--grids", args->grid.grids, "mass, step or mass,step")->capture_default_str();
+  cmd->add_option("--ratios", args->grid.ratios, "mass grid: top/bottom mass ratios")
       ->delimiter(',')
       ->capture_default_str();
-  cmd->add_option("--heights", args->heights, "mass grid: stack heights (boxes, >= 1)")
-      ->delimiter(',')
-      ->check(positiveNumber())
-      ->capture_default_str();
-  cmd->add_option("--time-steps", args->timeSteps, "step grid: time steps (s)")
+  cmd->add_option("--heights", args->grid.heights, "mass grid: stack heights (boxes, >= 1)")
       ->delimiter(',')
       ->check(positiveNumber())
       ->capture_default_str();
-  cmd->add_option("--iteration-counts", args->iterationCounts, "step grid: iterations per solve")
+  cmd->add_option("--time-steps", args->grid.timeSteps, "step grid: time steps (s)")
+      ->delimiter(',')
+      ->check(positiveNumber())
+      ->capture_default_str();
+  cmd->add_option("--iteration-counts", args->grid.iterationCounts,
+                  "step grid: iterations per solve")
       ->delimiter(',')
       ->check(nonNegativeNumber())
       ->capture_default_str();
-  cmd->add_option("--step-height", args->stepHeight, "step grid: stack height (boxes)")
+  cmd->add_option("--step-height", args->grid.stepHeight, "step grid: stack height (boxes)")
       ->check(positiveNumber())
       ->capture_default_str();
-  cmd->add_option("--step-ratio", args->stepRatio, "step grid: top/bottom mass ratio")
+  cmd->add_option("--step-ratio", args->grid.stepRatio, "step grid: top/bottom mass ratio")
       ->check(positiveNumber())
       ->capture_default_str();
-  cmd->add_option("--cfm", args->cfm,
+  cmd->add_option("--cfm", args->grid.cfm,
                   "world cfm of the stacks (the scenes' 1e-5 is a contact spring that a heavy "
                   "stack compresses by centimetres)")
       ->check(nonNegativeNumber())
       ->capture_default_str();
-  cmd->add_option("--seconds", args->seconds, "simulated time per cell (s)")
+  cmd->add_option("--seconds", args->grid.seconds, "simulated time per cell (s)")
       ->check(positiveNumber())
       ->capture_default_str();
-  cmd->add_option("--iterations", args->iterations, "mass grid: iterations per solve")
+  cmd->add_option("--iterations", args->grid.iterations, "mass grid: iterations per solve")
       ->check(nonNegativeNumber())
       ->capture_default_str();
-  cmd->add_option("--fallback", args->fallback,
+  cmd->add_option("--fallback", args->grid.fallback,
                   "core solver run when our adapters reject an answer, or none: each solver "
                   "alone, so that the map shows where it breaks")
       ->capture_default_str();
-  cmd->add_flag("--quick", args->quick,
+  cmd->add_flag("--quick", args->grid.quick,
                 "a 2 x 2 grid of each kind and 1 s per cell (for tests; overrides the grid "
                 "options)");
   cmd->add_option("--csv", args->csv,
@@ -292,22 +196,22 @@ Runner addStabilityCommand(CLI::App& app) {
   cmd->add_option("--chart", args->chart,
                   "also draw the heat maps into this folder (tools/chart.py heatmap through "
                   "the venv, as mlcp chart does)");
-  cmd->add_option("--max-speed", args->thresholds.maxSpeed, "exploded above this speed (m/s)")
+  cmd->add_option("--max-speed", args->grid.thresholds.maxSpeed, "exploded above this speed (m/s)")
       ->check(positiveNumber())
       ->capture_default_str();
-  cmd->add_option("--failure-share", args->thresholds.failureShare,
+  cmd->add_option("--failure-share", args->grid.thresholds.failureShare,
                   "solver-failure above this share of failed or fallback steps")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
-  cmd->add_option("--collapse-fraction", args->thresholds.collapseFraction,
+  cmd->add_option("--collapse-fraction", args->grid.thresholds.collapseFraction,
                   "collapsed when a box moved more than this fraction of its edge")
       ->check(positiveNumber())
       ->capture_default_str();
-  cmd->add_option("--collapse-penetration", args->thresholds.collapsePenetration,
+  cmd->add_option("--collapse-penetration", args->grid.thresholds.collapsePenetration,
                   "collapsed above this penetration (m)")
       ->check(positiveNumber())
       ->capture_default_str();
-  cmd->add_option("--drift", args->thresholds.drift,
+  cmd->add_option("--drift", args->grid.thresholds.drift,
                   "drifting when the top box moved more than this (m)")
       ->check(positiveNumber())
       ->capture_default_str();
