@@ -184,6 +184,11 @@ void NewtonSolver::run(const Problem& pb, Vector& x, Result& result) {
       os << "converged after " << step << " Newton step" << (step == 1 ? "" : "s");
       break;
     }
+    if (outOfTime()) {
+      result.status = Status::TimeLimit;
+      os << "time budget spent after " << step << " Newton steps, residual " << res;
+      break;
+    }
     if (step >= opt.maxIterations) {
       result.status = Status::MaxIterations;
       os << step << " Newton steps, residual " << res;
@@ -195,11 +200,6 @@ void NewtonSolver::run(const Problem& pb, Vector& x, Result& result) {
       result.status = Status::MaxIterations;
       os << "no progress in " << params_.maxStagnation << " Newton steps, residual "
          << wk.best.inf / scale;
-      break;
-    }
-    if (outOfTime()) {
-      result.status = Status::TimeLimit;
-      os << "time budget spent after " << step << " Newton steps, residual " << res;
       break;
     }
     result.iterations = step + 1;

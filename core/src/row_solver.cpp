@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 #include <string_view>
@@ -85,6 +86,9 @@ struct RowSolver::Slot {
   std::uint64_t lastUse = 0;
   int pgsFirst = 0;
   int cutsInRow = 0;
+  // More solves by the large-island solver under the engine-relative cap: set after an uncapped
+  // one ended short of the tolerance.
+  int cappedSolves = 0;
 };
 
 namespace {
@@ -125,6 +129,9 @@ RowSolver::RowSolver(const RowSolverSettings& settings) : settings_(settings) {
   setTimeBudget(settings_.timeBudget);
   if (!(settings_.minShare > 0 && settings_.minShare <= 1))
     throw std::invalid_argument("mlcp::RowSolver: minShare must be in (0, 1]");
+  if (!(settings_.engineCostFactor == 0 ||
+        (settings_.engineCostFactor >= 1 && std::isfinite(settings_.engineCostFactor))))
+    throw std::invalid_argument("mlcp::RowSolver: engineCostFactor must be 0 or finite and >= 1");
   if (const std::string why =
           frictionSettingsError(settings_.friction, settings_.frictionDirections, settings_.solver);
       !why.empty())
@@ -230,7 +237,10 @@ Result RowSolver::run(const RowSystem& rows, const std::string& name, const Opti
   if (equals(name, "pgs")) {
     rowPgs_.options() = o;
     x = start;
+    const bool timed = rows.size() >= kTimedPgsRows;
+    const double t0 = timed ? nowSeconds() : 0;
     Result r = rowPgs_.solve(rows, x);
+    if (timed) notePgsCost(rows.size(), r.iterations, nowSeconds() - t0);
     if (r.status == Status::TimeLimit) keepStartIfBetter(rows, start, x, r, o.tolerance);
     return r;
   }
@@ -257,6 +267,33 @@ Result RowSolver::run(const RowSystem& rows, const std::string& name, const Opti
   return solver->solveWithGuess(assembled_, start, x);
 }
 
+void RowSolver::notePgsCost(int rows, int sweeps, double seconds) {
+  if (rows <= 0 || sweeps != engineSweeps_ || !(seconds > 0)) return;
+  const double sample = seconds / rows;
+  rowSeconds_ = rowSeconds_ > 0 ? 0.8 * rowSeconds_ + 0.2 * sample : sample;
+}
+
+double RowSolver::engineShare(const RowSystem& rows, const Vector& start) {
+  if (!(settings_.engineCostFactor > 0) || engineSweeps_ <= 0 || !(settings_.timeBudget > 0))
+    return 0;
+  if (!(rowSeconds_ > 0) && rows.size() >= kTimedPgsRows && start.size() == rows.size()) {
+    // No pgs timed yet: one solve of this island at the engine's sweeps measures the cost.
+    Options o = settings_.fallbackOptions;
+    useEngineIterations(o, engineSweeps_);
+    o.warmStart = true;
+    rowPgs_.options() = o;
+    calibrationX_ = start;
+    const double t0 = nowSeconds();
+    const Result r = rowPgs_.solve(rows, calibrationX_);
+    notePgsCost(rows.size(), r.iterations, nowSeconds() - t0);
+  }
+  if (!(rowSeconds_ > 0)) return 0;
+  // A factor of 1 leaves the primary no time (a share of a nanosecond: it stops before its
+  // first step, and the island goes to pgs).
+  const double engine = rowSeconds_ * rows.size();
+  return std::max((settings_.engineCostFactor - 1) * engine, 1e-9);
+}
+
 namespace {
 Accuracy startAccuracy(const RowSystem& rows, const Vector& start) {
   return accuracy(start, rows.slack(start), rows.lo, rows.hi, rows.findex,
@@ -264,12 +301,13 @@ Accuracy startAccuracy(const RowSystem& rows, const Vector& start) {
 }
 }  // namespace
 
-bool RowSolver::startSolves(const RowSystem& rows, const Vector& start, double tolerance, Vector& x,
-                            Result& r) {
+bool RowSolver::startSolves(const RowSystem& rows, const Vector& start, double tolerance,
+                            bool withinTolerance, Vector& x, Result& r) {
   if (start.size() != rows.size()) return false;  // the solver reports the wrong size
   const Accuracy a = startAccuracy(rows, start);
-  if (!a.finite || !(a.residual <= std::min(kExactStart * tolerance, kExactStartLimit)))
-    return false;
+  const double limit =
+      withinTolerance ? tolerance : std::min(kExactStart * tolerance, kExactStartLimit);
+  if (!a.finite || !(a.residual <= limit)) return false;
   x = start;
   r = Result{};
   r.status = Status::Converged;
@@ -355,7 +393,7 @@ Result RowSolver::fallBack(const RowSystem& rows, const Vector& start, Vector& x
   const std::string why = out.requested + " rejected (" + toString(r.status) + ", residual " +
                           shortNumber(r.residual) + (r.message.empty() ? "" : ": ") + r.message +
                           ")";
-  if (!settings_.fallback.empty()) {
+  if (!settings_.fallback.empty() && !primaryWasFallback_) {
     out.fellBack = true;
     Options o = settings_.fallbackOptions;
     if (share > 0) {
@@ -380,7 +418,7 @@ Result RowSolver::fallBack(const RowSystem& rows, const Vector& start, Vector& x
     if (!acceptable(r, settings_.acceptResidual))
       keepSafe(rows, start, x, island, out, r, projection && !won ? &f : nullptr, share, t0);
   } else {
-    r.message = why + "; no fallback";
+    r.message = why + (primaryWasFallback_ ? "; it was the fallback's own run" : "; no fallback");
     keepSafe(rows, start, x, island, out, r, nullptr, share, t0);
   }
   if (!std::isfinite(r.residual)) {
@@ -511,6 +549,7 @@ IslandSolve RowSolver::solveScreened(const RowSystem& rows, const Vector& start,
   solveStart_ = t0;
   ++calls_;
   haveAssembled_ = false;
+  primaryWasFallback_ = false;
   coneNote_.clear();
   IslandSolve out;
   const int n = rows.size();
@@ -525,7 +564,7 @@ IslandSolve RowSolver::solveScreened(const RowSystem& rows, const Vector& start,
     out.result.message = "no constraint rows";
     return out;
   }
-  const double share = islandBudget(t0);
+  double share = islandBudget(t0);
   const bool autoChoice = equals(settings_.solver, "auto");
   const Policy& policy = settings_.policy;
   Slot& island = slot(key);
@@ -536,6 +575,9 @@ IslandSolve RowSolver::solveScreened(const RowSystem& rows, const Vector& start,
   if (!capturePrefix_.empty()) cone ? capture(cone_.problem()) : capture(rows);
 
   Result r;
+  // pgs that auto runs for cost (a demoted island, a spent budget) runs as the fallback does: the
+  // engine's sweeps, the engine's cost.
+  bool enginePgs = false, capped = false;
   if (cone) {
     r = solveCone(start, x, island, out, share, t0);
   } else if (autoChoice) {
@@ -543,17 +585,29 @@ IslandSolve RowSolver::solveScreened(const RowSystem& rows, const Vector& start,
     const Choice c = policy.choose(out.problemClass, n, settings_.options.tolerance, true, spent,
                                    hasFreeRows(rows.lo, rows.hi));
     out.requested = c.solver;
+    enginePgs = spent && equals(out.requested, "pgs");
     if (island.pgsFirst > 0 && !equals(out.requested, "ldlt") && !equals(out.requested, "pgs")) {
       --island.pgsFirst;
       out.requested = "pgs";
+      enginePgs = true;
+    }
+    if (out.requested == policy.largeIslandSolver && island.cappedSolves > 0) {
+      const double cap = engineShare(rows, start);
+      capped = cap > 0;
+      if (capped) --island.cappedSolves;
+      if (capped && cap < share) share = cap;
     }
   } else {
     out.requested = settings_.solver;
   }
   const bool fromStart = !cone && !equals(out.requested, "pgs") &&
-                         startSolves(rows, start, settings_.options.tolerance, x, r);
+                         startSolves(rows, start, settings_.options.tolerance, capped, x, r);
   if (!cone && !fromStart)
-    r = run(rows, out.requested, withBudget(settings_.options, share, t0), start, x, island, out);
+    r = run(rows, out.requested,
+            withBudget(enginePgs ? settings_.fallbackOptions : settings_.options, share, t0), start,
+            x, island, out);
+  // The same solver with the same options from the same start gives the same answer: not rerun.
+  primaryWasFallback_ = enginePgs && settings_.fallback == out.requested;
   if (r.status == Status::InvalidInput || r.status == Status::Unsupported) x = start;
   out.choice = fromStart ? kStartChoice : out.requested;
   if (autoChoice && !cone && !fromStart && out.problemClass == ProblemClass::Findex &&
@@ -561,6 +615,14 @@ IslandSolve RowSolver::solveScreened(const RowSystem& rows, const Vector& start,
     continueWithNewton(rows, x, island, out, r, share, t0);
   const bool islandMemory = autoChoice && !cone;  // pgsFirst and cutsInRow
   if (islandMemory) island.cutsInRow = r.status == Status::TimeLimit ? island.cutsInRow + 1 : 0;
+  // A capped solve that spent its share before its first step (assembly and set-up alone cost
+  // more than the cap) cannot improve on pgs within the engine's cost: the island runs pgs for
+  // the next pgsAfterBreakdown solves, as after a breakdown.
+  const bool setupOverCap = capped && r.status == Status::TimeLimit && r.iterations == 0;
+  if (islandMemory && !capped && !fromStart && out.requested == policy.largeIslandSolver &&
+      r.status != Status::Converged)
+    island.cappedSolves = policy.pgsAfterBreakdown;
+  if (islandMemory && setupOverCap) island.pgsFirst = policy.pgsAfterBreakdown;
   if (!acceptable(r, settings_.acceptResidual)) {
     if (islandMemory && !equals(out.requested, "pgs") && !equals(out.requested, "ldlt") &&
         policy.demotes(r, settings_.acceptResidual, island.cutsInRow))

@@ -487,6 +487,53 @@ TEST(RowSolver, CaptureWritesEachIslandsProblem) {
   std::filesystem::remove_all(dir);
 }
 
+// Bullet's BasicDemo: on its resting pile newton's solves end short of 1e-6 and cost 20-40x SI's
+// step under the 50 ms budget alone. An island whose uncapped newton solve ended short runs its
+// next newton solves under the engine-relative cap; a factor of 1 leaves newton no time (it
+// stops before its first step), and the island then runs pgs at the engine's sweeps.
+TEST(RowSolver, BasicDemoPileMissedByNewtonRunsUnderTheEngineCostCap) {
+  RowSystem rows = boxOnGround(true);
+  const RowSystem corners = rows;
+  for (int copy = 1; copy < 6; ++copy)  // 72 rows on one body: redundant contacts
+    for (int i = 0; i < corners.size(); ++i)
+      addRow(rows, corners.rows[i].jA.head<3>(), corners.rows[i].jA.tail<3>(), corners.b[i],
+             corners.lo[i], corners.hi[i], corners.cfm[i],
+             corners.findex[i] < 0 ? -1 : corners.findex[i] + corners.size() * copy);
+  Vector start;
+  RowSolver().solve(rows, Vector::Zero(rows.size()), start);
+  start.array() += 1e-6;  // near the answer: newton's answer below is acceptable, not converged
+  const double startResidual = rowResidual(rows, start);
+  ASSERT_GT(startResidual, 1e-6);
+  ASSERT_LT(startResidual, 1e-4);
+  RowSolverSettings settings;
+  settings.policy.smallContactRows = settings.policy.smallIslandRows = 4;  // newton's island
+  settings.options.maxIterations = 0;  // newton ends short at once, deterministically
+  settings.newton.pivotingSteps = settings.newton.bodyPivotingSteps = 0;
+  settings.engineCostFactor = 1;
+  RowSolver solver(settings);
+  solver.setEngineSweeps(10);
+  Vector x;
+  const IslandSolve first = solver.solve(rows, start, x, 7);
+  EXPECT_EQ(first.requested, "newton");
+  EXPECT_EQ(first.result.status, Status::MaxIterations) << first.result.message;
+  EXPECT_TRUE(first.accepted);
+  const IslandSolve capped = solver.solve(rows, start, x, 7);
+  EXPECT_EQ(capped.requested, "newton");
+  EXPECT_EQ(capped.result.status, Status::TimeLimit) << capped.result.message;
+  EXPECT_NE(capped.result.message.find("after 0 Newton steps"), std::string::npos)
+      << capped.result.message;
+  EXPECT_NEAR(capped.result.residual, rowResidual(rows, x), 1e-12);
+  const IslandSolve demoted = solver.solve(rows, start, x, 7);
+  EXPECT_EQ(demoted.requested, "pgs") << demoted.result.message;
+  EXPECT_FALSE(demoted.fellBack);  // the fallback's own run is not repeated
+  // Without the engine's sweeps there is no cap: the same second solve runs newton unbounded.
+  RowSolver uncapped(settings);
+  uncapped.solve(rows, start, x, 7);
+  const IslandSolve second = uncapped.solve(rows, start, x, 7);
+  EXPECT_EQ(second.requested, "newton");
+  EXPECT_EQ(second.result.status, Status::MaxIterations) << second.result.message;
+}
+
 TEST(RowSolver, UnknownNamesAreClearErrors) {
   RowSolverSettings settings;
   settings.solver = "nope";
@@ -503,6 +550,13 @@ TEST(RowSolver, UnknownNamesAreClearErrors) {
   EXPECT_NO_THROW(RowSolver{settings});
   settings.acceptResidual = -1;
   EXPECT_THROW(RowSolver{settings}, std::invalid_argument);
+  settings.acceptResidual = 1e-3;
+  for (double factor : {0.5, -1.0, kInf, std::nan("")}) {
+    settings.engineCostFactor = factor;
+    EXPECT_THROW(RowSolver{settings}, std::invalid_argument) << factor;
+  }
+  settings.engineCostFactor = 0;
+  EXPECT_NO_THROW(RowSolver{settings});
 }
 
 TEST(ChoiceCounts, CountsInNameOrder) {

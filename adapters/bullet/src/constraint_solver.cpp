@@ -169,6 +169,7 @@ btScalar ConstraintSolver::solveGroupCacheFriendlyIterations(
       current_.status = Status::MaxIterations;
     }
   } else {
+    rows_->setEngineSweeps(info.m_numIterations);
     if (settings_.engineIterations) {
       // pgs/gs as SI runs them: a fixed sweep count, the residual checked once, at the end.
       for (auto [name, options] : {std::pair(&settings_.solver, &rows_->options()),

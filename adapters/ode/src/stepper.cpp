@@ -194,8 +194,10 @@ void Stepper::Impl::beginStep(dxWorld* world) {
     return o;
   };
   stepOptions = engine(options.options, options.solver);
-  if (RowSolver* rows = primary.solver.get())
+  if (RowSolver* rows = primary.solver.get()) {
     rows->fallbackOptions() = engine(options.fallbackOptions, options.fallback);
+    rows->setEngineSweeps(dWorldGetQuickStepNumIterations(world));
+  }
 }
 
 void Stepper::Impl::stepIsland(const dxStepperProcessingCallContext* context) {

@@ -40,16 +40,17 @@
 //     A start that already solves the rows far within the tolerance (residual <= min(1e-4
 //     tolerance, 1e-12)) is the answer of every primary but pgs (whose own first check finds it),
 //     with choice "start": one product through the rows instead of an assembly and a solver's
-//     set-up. Such starts are common in real content: touching bodies that nothing presses
-//     together (Bullet's BasicDemo block in free fall: every contact's answer is 0). A start only
-//     within the tolerance is solved again, so that exact answers stay exact and do not lag.
-//     With friction "cone" (RowSolverSettings::friction, friction_model.hpp) an island with
-//     friction rows is solved instead as the polyhedral cone's standard LCP (RowSolver::solveCone:
-//     FrictionCone built from the rows, the start mapped into it, the requested solver or for
-//     "auto" the policy's choice for an LCP with zero diagonal entries, lemke; its residual
-//     recomputed on that LCP), and the answer mapped back to the rows' impulses. The pgs-first
-//     memory of stage 2 is the box's: the cone runs on every solve (pgs cannot take its LCP,
-//     and one rejected lemke answer would otherwise cost the island the cone for 30 steps).
+//     set-up.
+//     Such starts are common in real content: touching bodies that nothing presses together
+//     (Bullet's BasicDemo block in free fall: every contact's answer is 0). A start only within the
+//     tolerance is solved again, so that exact answers stay exact and do not lag. With friction
+//     "cone" (RowSolverSettings::friction, friction_model.hpp) an island with friction rows is
+//     solved instead as the polyhedral cone's standard LCP (RowSolver::solveCone: FrictionCone
+//     built from the rows, the start mapped into it, the requested solver or for "auto" the
+//     policy's choice for an LCP with zero diagonal entries, lemke; its residual recomputed on that
+//     LCP), and the answer mapped back to the rows' impulses. The pgs-first memory of stage 2 is
+//     the box's: the cone runs on every solve (pgs cannot take its LCP, and one rejected lemke
+//     answer would otherwise cost the island the cone for 30 steps).
 //  4. verify and fall back, by the one fallback rule of policy.hpp: an answer is acceptable when
 //     its status is not a breakdown and its residual, recomputed from the rows by residual.hpp,
 //     is finite and <= acceptResidual; an unacceptable one sends the island to the fallback
@@ -79,6 +80,25 @@
 // residual. The budget therefore bounds a step by about timeBudget + (islands after the budget
 // ran out) * minShare * timeBudget, plus what cannot be interrupted: assembly and one
 // factorization (ldlt's, a dantzig block step's).
+//
+// The engine-relative cap. An island that auto hands to the large-island solver (newton) and
+// whose last uncapped solve by it ended short of the tolerance (a pile whose exact answer takes
+// many factorizations) is, for its next Policy::pgsAfterBreakdown such solves, also bounded by
+// what the engine's own solver would spend on it: its primary gets (engineCostFactor - 1) times
+// the estimated cost of engineSweeps sweeps of pgs on its rows, and the fallback, when the
+// primary's answer is not acceptable, is pgs at the engine's sweeps (SI's and QuickStep's
+// method at their cost), so the island costs about engineCostFactor times the engine's solver
+// and its answer is the better of the two. The cost per row is measured on this machine: a
+// running mean over the RowPgs solves at the engine's sweeps of islands of at least
+// kTimedPgsRows rows, from one calibration solve of the first such island when no pgs has run
+// yet. A capped solve that spends its share before its first step (assembly and set-up alone
+// cost more) sends the island to pgs, as a breakdown does; a start within the tolerance is the
+// answer of a capped island. Why: a drop-in default must cost about what the engine's solver
+// costs; a fixed 50 ms cap let BasicDemo's pile cost 20-40x SI a step, because newton's steps on
+// a singular pile end short of 1e-6 (newton.hpp). Islands that newton solves exactly stay
+// uncapped: a 16-box stack at mass ratio 1000 needs its exact answers, at tens of times pgs's
+// cost but well under a millisecond, and collapses under pgs's. The cap needs timeBudget > 0 and
+// the engine's sweeps (setEngineSweeps: both adapters give them every step).
 //
 // Invariants: x always has rows.size() finite entries on return; IslandSolve::result.residual is
 // the residual of that x; the settings' names are checked at construction.
@@ -137,6 +157,12 @@ inline constexpr int kDefaultDenseMaxRows = 64;
 // dantzig can stall above it (ODE's tank-track rows stop at 1.6e-7) and every step then runs
 // its full pivot and friction-pass limits (330x dWorldStep's time there).
 inline constexpr double kDefaultIslandTolerance = 1e-6;
+// What an island auto hands to the large-island solver may cost, as a multiple of the engine's
+// own solver's estimated cost on it (see "The engine-relative cap"). Dimensionless.
+inline constexpr double kDefaultEngineCostFactor = 3;
+// Smallest island whose RowPgs solve is timed for the cost per row, in rows: below it
+// the fixed costs of a solve dominate the sample.
+inline constexpr int kTimedPgsRows = 64;
 // Sweep limit of a pgs/gs fallback when the engine's iteration count is not used
 // (RowSolverSettings::engineIterations false): 100 sweeps, 10x Bullet's and 5x ODE QuickStep's
 // default cost, is what a rejected answer may cost at most by default (core's 1000 would cost
@@ -182,6 +208,10 @@ struct RowSolverSettings {
   // Wall-clock budget of one engine step's solves, in seconds (see above); 0 for none. Options'
   // own timeBudget, when set, still bounds each solve. Default kDefaultTimeBudget (0.05 s).
   double timeBudget = kDefaultTimeBudget;
+  // The engine-relative cap (see above): an island handed to the large-island solver costs at
+  // most about this multiple of the engine's own solver's cost on it, >= 1; 0 turns the cap off
+  // (timeBudget alone). Default kDefaultEngineCostFactor (3).
+  double engineCostFactor = kDefaultEngineCostFactor;
   // The smallest share of timeBudget an island's solve (and its fallback) gets, in (0, 1].
   // Default kDefaultMinShare (0.05: 2.5 ms of a 50 ms budget, ~50 pgs sweeps of 1000 rows).
   double minShare = kDefaultMinShare;
@@ -267,8 +297,8 @@ class RowSolver {
  public:
   // Throws std::invalid_argument naming the known solvers for an unknown solver or fallback
   // name, for a negative or NaN acceptResidual, timeBudget or minShare
-  // outside (0, 1], and for frictionDirections outside [3, 64] or the cone with a primary that
-  // cannot take its LCP.
+  // outside (0, 1], engineCostFactor neither 0 nor finite and >= 1, and for frictionDirections
+  // outside [3, 64] or the cone with a primary that cannot take its LCP.
   explicit RowSolver(const RowSolverSettings& settings = RowSolverSettings());
   ~RowSolver();
   RowSolver(const RowSolver&) = delete;
@@ -282,6 +312,10 @@ class RowSolver {
   // std::invalid_argument for a negative or non-finite value.
   void setTimeBudget(double seconds);
 
+  // The engine's own solver's sweeps per step (Bullet's m_numIterations, QuickStep's
+  // iterations): the unit of the engine-relative cap. 0 (the default) leaves every island to
+  // timeBudget alone.
+  void setEngineSweeps(int sweeps) { engineSweeps_ = sweeps > 0 ? sweeps : 0; }
   // Opens an engine step: the budget's clock starts at the next solve() and runs over every
   // solve until the next beginStep(). Without it every solve is a step of its own.
   void beginStep() {
@@ -340,6 +374,10 @@ class RowSolver {
   void keepSafe(const RowSystem& rows, const Vector& start, Vector& x, Slot& island,
                 IslandSolve& out, Result& r, Result* projectionAnswer, double share, double t0);
   void assemble(const RowSystem& rows, bool sparse);
+  // The engine-relative cap's share for this island in seconds, 0 when it does not apply.
+  double engineShare(const RowSystem& rows, const Vector& start);
+  // Adds a timed RowPgs solve to the running cost per row (solves at the engine's sweeps only).
+  void notePgsCost(int rows, int sweeps, double seconds);
   // Stage 3 with friction "cone": builds the cone's LCP (false: the rows do not fit, the reason
   // goes to out's message and the box runs), then solves it.
   bool buildCone(const RowSystem& rows, const Vector& start, IslandSolve& out);
@@ -347,8 +385,10 @@ class RowSolver {
                    double t0);
   // Whether the start already solves the rows far within the tolerance (see stage 3); then x and r
   // are that answer.
-  static bool startSolves(const RowSystem& rows, const Vector& start, double tolerance, Vector& x,
-                          Result& r);
+  // withinTolerance: the start need only meet the tolerance (an island under the engine-relative
+  // cap, where a solve that would change it by less costs several times the engine's solver).
+  static bool startSolves(const RowSystem& rows, const Vector& start, double tolerance,
+                          bool withinTolerance, Vector& x, Result& r);
   // A time-limited answer x is replaced by the start when the start's residual is lower.
   static void keepStartIfBetter(const RowSystem& rows, const Vector& start, Vector& x, Result& r,
                                 double tolerance);
@@ -371,6 +411,10 @@ class RowSolver {
   bool stepOpen_ = false;     // beginStep() was called: solves share a step's budget
   bool stepPending_ = false;  // the next solve starts the step's clock
   double stepStart_ = 0;
+  int engineSweeps_ = 0;   // setEngineSweeps()
+  double rowSeconds_ = 0;  // the running cost of a row in pgs at the engine's sweeps, 0: unknown
+  Vector calibrationX_;
+  bool primaryWasFallback_ = false;  // this island's primary ran as its fallback would
   FrictionCone cone_;
   Vector coneStart_, coneX_;
   std::string coneNote_;  // why the last island kept the box ("" when the cone was built)
