@@ -4,7 +4,7 @@
 #include <cstdlib>
 #include <cstring>
 
-#include "rows/cpu_dispatch.hpp"
+#include "projection/cpu_dispatch.hpp"
 
 namespace mlcp {
 

@@ -1,11 +1,11 @@
 #include "mlcp/registry.hpp"
 
-#include "mlcp/dantzig.hpp"
-#include "mlcp/fallback.hpp"
-#include "mlcp/ldlt.hpp"
-#include "mlcp/lemke.hpp"
-#include "mlcp/newton.hpp"
-#include "mlcp/pgs.hpp"
+#include "mlcp/island/fallback.hpp"
+#include "mlcp/solvers/dantzig.hpp"
+#include "mlcp/solvers/ldlt.hpp"
+#include "mlcp/solvers/lemke.hpp"
+#include "mlcp/solvers/newton.hpp"
+#include "mlcp/solvers/pgs.hpp"
 
 namespace mlcp {
 

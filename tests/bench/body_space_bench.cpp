@@ -18,10 +18,10 @@
 // libblas.so.3 the process loaded (printed).
 //
 // A second table does the same for the row-space systems of newton's pivoting phase
-// (core/src/block_pivoting.hpp) when body space does not apply (cfm = 0 at rho = 0): K = A_CC with
-// each sliding row's column c_t A_{C,t} added to its normal's column, in the AMD order of A that
-// block pivoting inherits, factored by the library's SymmetricPatternLu (LU without pivoting on
-// the symmetric pattern; LDL^T without the sliding rows) against CHOLMOD (without the sliding
+// (core/src/newton/block_pivoting.hpp) when body space does not apply (cfm = 0 at rho = 0): K =
+// A_CC with each sliding row's column c_t A_{C,t} added to its normal's column, in the AMD order of
+// A that block pivoting inherits, factored by the library's SymmetricPatternLu (LU without pivoting
+// on the symmetric pattern; LDL^T without the sliding rows) against CHOLMOD (without the sliding
 // rows), KLU and UMFPACK on the same matrix.
 #include <suitesparse/cholmod.h>
 #include <suitesparse/klu.h>
@@ -37,10 +37,10 @@
 #include <string>
 #include <vector>
 
-#include "../core/src/linalg/body_space.hpp"            // BodySpaceSystem (internal)
-#include "../core/src/linalg/symmetric_pattern_lu.hpp"  // (internal)
 #include "common/contact_scenes.hpp"
-#include "mlcp/newton.hpp"
+#include "linalg/body_space.hpp"            // BodySpaceSystem (internal)
+#include "linalg/symmetric_pattern_lu.hpp"  // (internal)
+#include "mlcp/solvers/newton.hpp"
 
 namespace {
 

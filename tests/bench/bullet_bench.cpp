@@ -34,6 +34,7 @@
 
 #include "mlcp/cpu.hpp"
 #include "mlcp/solver.hpp"
+#include "mlcp/solvers/row_pgs.hpp"
 #include "scenes.hpp"
 
 namespace {

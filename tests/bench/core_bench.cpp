@@ -20,9 +20,9 @@
 
 #include "../common/contact_scenes.hpp"
 #include "mlcp/io.hpp"
-#include "mlcp/pgs.hpp"
 #include "mlcp/registry.hpp"
 #include "mlcp/residual.hpp"
+#include "mlcp/solvers/pgs.hpp"
 
 namespace {
 

@@ -1,5 +1,5 @@
-// Lemke's dense tableau against its factored basis (mlcp/lemke.hpp) in one run: standard LCPs
-// with a banded SPD matrix and a known solution (banded_lcp.hpp) of several sizes, dense SPD
+// Lemke's dense tableau against its factored basis (mlcp/solvers/lemke.hpp) in one run: standard
+// LCPs with a banded SPD matrix and a known solution (banded_lcp.hpp) of several sizes, dense SPD
 // ones (tests/common/generators.hpp, B B' + 0.1 n I) for the crossover on dense data, and findex
 // contact problems (tests/common/generators.hpp: J J^T of a random J, friction pyramids with
 // mu = 0.6). Each solve is cold and timed alone (wall clock, the best of --repeat runs); a
@@ -19,8 +19,8 @@
 
 #include "bench/banded_lcp.hpp"
 #include "common/generators.hpp"
-#include "mlcp/lemke.hpp"
 #include "mlcp/residual.hpp"
+#include "mlcp/solvers/lemke.hpp"
 
 namespace {
 

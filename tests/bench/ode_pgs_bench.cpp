@@ -57,6 +57,7 @@
 #include "mlcp/cpu.hpp"
 #include "mlcp/ode/stepper.hpp"
 #include "mlcp/residual.hpp"
+#include "mlcp/solvers/row_pgs.hpp"
 #include "ode/feedback_lambda.hpp"
 #include "ode/ode_scenes.hpp"
 

@@ -1,5 +1,5 @@
 // Degenerate rows Bullet's own constraints build: the drop-in screens them row by row
-// (mlcp/row_screen.hpp) and solves the rest of the island, as Bullet's SI copes with them.
+// (mlcp/island/row_screen.hpp) and solves the rest of the island, as Bullet's SI copes with them.
 #include <BulletDynamics/ConstraintSolver/btGearConstraint.h>
 #include <BulletDynamics/ConstraintSolver/btGeneric6DofSpring2Constraint.h>
 #include <gtest/gtest.h>

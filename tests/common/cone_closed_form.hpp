@@ -21,7 +21,7 @@
 #include <cmath>
 #include <string>
 
-#include "mlcp/row_solver.hpp"
+#include "mlcp/island/row_solver.hpp"
 
 namespace mlcp::test {
 

@@ -25,7 +25,7 @@
 #include <random>
 #include <vector>
 
-#include "mlcp/rows.hpp"
+#include "mlcp/island/rows.hpp"
 
 namespace mlcp::test {
 

@@ -5,7 +5,7 @@
 
 #include <vector>
 
-#include "mlcp/rows.hpp"
+#include "mlcp/island/rows.hpp"
 
 namespace mlcp::test {
 

@@ -5,7 +5,8 @@
 
 #include <gtest/gtest.h>
 
-#include "mlcp/rows.hpp"
+#include "mlcp/island/rows.hpp"
+#include "mlcp/solvers/row_pgs.hpp"
 
 namespace mlcp::test {
 

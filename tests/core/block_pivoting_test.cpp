@@ -1,20 +1,21 @@
-// Block principal pivoting (core/src/block_pivoting.hpp, newton's pivoting phase), its sparse
-// factorizations (SymmetricPatternLu, the bordered updates, Woodbury on the sliding rows) and
-// body space (linalg/body_space.hpp), on engine-like contact scenes
+// Block principal pivoting (core/src/newton/block_pivoting.hpp, newton's pivoting phase), its
+// sparse factorizations (SymmetricPatternLu, the bordered updates, Woodbury on the sliding rows)
+// and body space (linalg/body_space.hpp), on engine-like contact scenes
 // (tests/common/contact_scenes.hpp) and generated families. Answers are checked with
 // mlcp::accuracy() and against dantzig's incremental pivoting.
-#include "../core/src/block_pivoting.hpp"  // BlockPivoting, SymmetricPatternLu (internal)
+#include "newton/block_pivoting.hpp"  // BlockPivoting, SymmetricPatternLu (internal)
 
 #include <gtest/gtest.h>
 
-#include "../core/src/linalg/body_space.hpp"  // BodySpaceSystem (internal)
 #include "common/contact_scenes.hpp"
 #include "common/expect_solved.hpp"
 #include "common/generators.hpp"
-#include "mlcp/dantzig.hpp"
-#include "mlcp/pgs.hpp"
+#include "linalg/body_space.hpp"  // BodySpaceSystem (internal)
+#include "mlcp/island/rows.hpp"
 #include "mlcp/residual.hpp"
-#include "mlcp/rows.hpp"
+#include "mlcp/solvers/dantzig.hpp"
+#include "mlcp/solvers/pgs.hpp"
+#include "projection/pgs_sweep.hpp"  // pgsSweep (internal)
 
 namespace mlcp {
 namespace {

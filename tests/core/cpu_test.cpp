@@ -13,13 +13,14 @@
 #include <type_traits>
 #include <vector>
 
-#include "../core/src/rows/cpu_dispatch.hpp"  // MLCP_CPU_DISPATCH (internal)
-#include "../core/src/rows/row_simd.hpp"      // the products (internal)
 #include "common/contact_scenes.hpp"
 #include "common/cpu_path_guard.hpp"
 #include "common/row_source.hpp"
-#include "mlcp/newton.hpp"
-#include "mlcp/rows.hpp"
+#include "mlcp/island/rows.hpp"
+#include "mlcp/solvers/newton.hpp"
+#include "mlcp/solvers/row_pgs.hpp"
+#include "projection/cpu_dispatch.hpp"  // MLCP_CPU_DISPATCH (internal)
+#include "projection/row_simd.hpp"      // the products (internal)
 
 namespace mlcp {
 namespace {

@@ -1,24 +1,24 @@
 // dantzig specifics: the seed example, random P-matrix / SPD / boxed / mixed / findex problems
 // against known solutions, FixedOnce versus Exact friction, infeasible and singular problems,
 // warm start, workspace reuse, sparse input. Every answer is checked with mlcp::accuracy().
-#include "mlcp/dantzig.hpp"
+#include "mlcp/solvers/dantzig.hpp"
 
 #include <gtest/gtest.h>
 
 #include <random>
 #include <sstream>
 
-#include "../core/src/dantzig_small.hpp"      // the tiny dense path (internal)
-#include "../core/src/linalg/body_space.hpp"  // BodySpaceSystem (internal)
 #include "common/contact_scenes.hpp"
 #include "common/expect_solved.hpp"
 #include "common/generators.hpp"
+#include "linalg/body_space.hpp"  // BodySpaceSystem (internal)
 #include "mlcp/io.hpp"
-#include "mlcp/ldlt.hpp"
-#include "mlcp/pgs.hpp"
+#include "mlcp/island/rows.hpp"
 #include "mlcp/registry.hpp"
 #include "mlcp/residual.hpp"
-#include "mlcp/rows.hpp"
+#include "mlcp/solvers/ldlt.hpp"
+#include "mlcp/solvers/pgs.hpp"
+#include "pivoting/dantzig_small.hpp"  // the tiny dense path (internal)
 
 namespace mlcp {
 namespace {
@@ -312,7 +312,7 @@ TEST(Dantzig, EmptyProblem) {
   EXPECT_TRUE(s.solve(p, x).converged());
 }
 
-// ---- the path for tiny dense islands (core/src/dantzig_small.hpp) ----
+// ---- the path for tiny dense islands (core/src/pivoting/dantzig_small.hpp) ----
 
 // A small boxed / linear / standard problem with an exactly symmetric SPD A.
 KnownProblem smallProblem(Generator& g, int n, int kind) {
@@ -329,7 +329,7 @@ TEST(DantzigSmall, AnswersAreTheGeneralPathsOrDeclined) {
   Generator g(31);
   int taken = 0, declined = 0;
   for (int trial = 0; trial < 240; ++trial) {
-    const KnownProblem kp = smallProblem(g, 1 + trial % detail::kSmallDenseRows, trial % 3);
+    const KnownProblem kp = smallProblem(g, 1 + trial % kPlainLoopRows, trial % 3);
     const Problem& p = kp.problem;
     ASSERT_TRUE(detail::smallDenseApplies(p));
     Problem sparse = p;
@@ -368,7 +368,7 @@ TEST(DantzigSmall, AnswersAreTheGeneralPathsOrDeclined) {
 TEST(DantzigSmall, GrowthInTheFactorsIsRefined) {
   Generator g(33);
   for (int trial = 0; trial < 40; ++trial) {
-    const int n = 2 + trial % (detail::kSmallDenseRows - 1);
+    const int n = 2 + trial % (kPlainLoopRows - 1);
     DenseMatrix A = DenseMatrix::Zero(n, n);
     const double tiny = std::pow(10.0, -4.0 - trial % 5);
     A(0, 0) = A(1, 1) = tiny;

@@ -1,5 +1,5 @@
 // ldlt, fallback chains and auto: the fallback happens, is counted and reported.
-#include "mlcp/fallback.hpp"
+#include "mlcp/island/fallback.hpp"
 
 #include <gtest/gtest.h>
 
@@ -9,10 +9,10 @@
 
 #include "common/broken_solvers.hpp"
 #include "common/generators.hpp"
-#include "mlcp/ldlt.hpp"
-#include "mlcp/pgs.hpp"
 #include "mlcp/registry.hpp"
 #include "mlcp/residual.hpp"
+#include "mlcp/solvers/ldlt.hpp"
+#include "mlcp/solvers/pgs.hpp"
 
 namespace mlcp {
 namespace {

@@ -2,14 +2,14 @@
 // an incline sticks exactly below its critical slope and slides above it, a block pushed along
 // the ground loses the speed the cone's friction predicts, in every direction of the polygon.
 // Every answer is lemke's on the cone LCP, checked here row by row as a standard LCP.
-#include "mlcp/friction_cone.hpp"
+#include "island/friction_cone.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "common/cube_on_ground.hpp"
-#include "mlcp/lemke.hpp"
+#include "mlcp/solvers/lemke.hpp"
 
 namespace mlcp {
 namespace {

@@ -1,7 +1,7 @@
 // LdltSolver's dense path: the envelope LDL^T on banded and full SPD matrices agrees with the
 // sparse path, a zero leading pivot goes to the pivoting LDL^T, an inconsistent singular system
 // is not reported Converged. Every answer is checked with residual.hpp.
-#include "mlcp/ldlt.hpp"
+#include "mlcp/solvers/ldlt.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// Lemke on its factored basis (core/src/lemke_revised.hpp): against constructed solutions,
+// Lemke on its factored basis (core/src/pivoting/lemke_revised.hpp): against constructed solutions,
 // against the dense tableau on random small problems (degenerate ones included, for the
 // lexicographic rule), the Siconos corpus, large banded LCPs the tableau cannot hold, and
 // findex problems with the friction passes' warm start. LemkeSolver::denseRows = 0 forces the
@@ -11,8 +11,8 @@
 #include "bench/banded_lcp.hpp"
 #include "common/generators.hpp"
 #include "mlcp/io.hpp"
-#include "mlcp/lemke.hpp"
 #include "mlcp/residual.hpp"
+#include "mlcp/solvers/lemke.hpp"
 
 namespace mlcp {
 namespace {

@@ -1,7 +1,7 @@
 // Lemke: the seed's worked example and its tableaux, the seed's LP, infeasible and degenerate
 // problems, random problems with known solutions, boxed / equality / findex problems and the
 // Siconos corpus. Every answer is judged by mlcp::accuracy, recomputed here.
-#include "mlcp/lemke.hpp"
+#include "mlcp/solvers/lemke.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,16 +1,16 @@
-// NewtonSolver (mlcp/newton.hpp): answers checked by residual.hpp and against dantzig's
+// NewtonSolver (mlcp/solvers/newton.hpp): answers checked by residual.hpp and against dantzig's
 // incremental pivoting and lemke, the sparse LU path and its symbolic-analysis reuse, friction
 // islands warm-started, nonsymmetric problems, the limits.
-#include "mlcp/newton.hpp"
+#include "mlcp/solvers/newton.hpp"
 
 #include <gtest/gtest.h>
 
 #include "common/contact_scenes.hpp"
 #include "common/generators.hpp"
-#include "mlcp/dantzig.hpp"
 #include "mlcp/io.hpp"
-#include "mlcp/lemke.hpp"
 #include "mlcp/residual.hpp"
+#include "mlcp/solvers/dantzig.hpp"
+#include "mlcp/solvers/lemke.hpp"
 
 namespace mlcp {
 namespace {
@@ -66,12 +66,12 @@ TEST(Newton, AgreesWithDantzigOnGeneratedProblems) {
   }
 }
 
-// Large enough for the sparse LU (n > denseMaxRows), frictionless: the same answer as the
+// Large enough for the sparse LU (n > denseFactorMaxRows), frictionless: the same answer as the
 // incremental pivoting to the tolerance's order.
 TEST(Newton, PyramidSparseMatchesDantzig) {
   for (double mu : {0.0}) {
     const Problem p = pyramidProblem(6, mu, 0.3);
-    ASSERT_GT(p.size(), NewtonParams().denseMaxRows);
+    ASSERT_GT(p.size(), NewtonParams().denseFactorMaxRows);
     NewtonSolver newton;
     DantzigSolver dantzig;
     newton.options().tolerance = dantzig.options().tolerance = 1e-10;
@@ -125,7 +125,7 @@ TEST(Newton, RowsFactorInBodySpaceWithTheSparseLusIterates) {
     for (int step = 0; step < 4; ++step) {
       pyramid.nextStep(1e-3);
       const Problem p = pyramid.rows().assemble(true);
-      ASSERT_GT(p.size(), with.params().denseMaxRows);
+      ASSERT_GT(p.size(), with.params().denseFactorMaxRows);
       const Vector gx = x, gy = y;
       with.useRows(&pyramid.rows());
       const Result r = with.solveWithGuess(p, gx, x);
@@ -164,7 +164,7 @@ TEST(Newton, BodySpaceStateDoesNotOutliveItsProblem) {
   EXPECT_GT(newton.bodyFactorizations(), 0);
   test::BoxPyramid small(pyramidSpec(2, 0.6));
   const Problem q = small.rows().assemble(true);
-  ASSERT_LE(q.size(), newton.params().denseMaxRows);
+  ASSERT_LE(q.size(), newton.params().denseFactorMaxRows);
   const Result r = newton.solve(q, x);
   ASSERT_TRUE(r.converged()) << r.message;
   EXPECT_LE(accuracy(q, x).residual, newton.options().tolerance);
@@ -255,7 +255,7 @@ TEST(Newton, FrictionPyramidStepLimitIsHonest) {
 TEST(Newton, WarmFrictionPyramidConvergesWhereLaggedBoundsStalled) {
   Vector last;
   const Problem p = nextStepAfterAnswer(last);
-  ASSERT_GT(p.size(), NewtonParams().denseMaxRows);  // the sparse path
+  ASSERT_GT(p.size(), NewtonParams().denseFactorMaxRows);  // the sparse path
   NewtonSolver newton;
   newton.options().tolerance = 1e-6;
   newton.options().maxIterations = 10;
@@ -372,7 +372,7 @@ TEST(Newton, PivotingPhaseFinishesWhatTheDampedStepsLeftShort) {
   spec.levels = 5;
   test::BoxPyramid pyramid(spec);
   const Problem p = pyramid.rows().assemble(true);
-  ASSERT_GT(p.size(), NewtonParams().denseMaxRows);  // the sparse path
+  ASSERT_GT(p.size(), NewtonParams().denseFactorMaxRows);  // the sparse path
   for (const bool rows : {false, true}) {
     NewtonSolver newton;
     newton.options().tolerance = 1e-6;

@@ -1,5 +1,5 @@
 // linalg/ordering.hpp: CHOLMOD's fill-reducing order of a symmetric graph.
-#include "../core/src/linalg/ordering.hpp"  // fillReducingOrder (internal)
+#include "linalg/ordering.hpp"  // fillReducingOrder (internal)
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 // gs and pgs specifics: refusals, divergence, SOR, warm start, history, time budget.
-#include "mlcp/pgs.hpp"
+#include "mlcp/solvers/pgs.hpp"
 
 #include <gtest/gtest.h>
 

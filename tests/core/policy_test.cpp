@@ -1,6 +1,6 @@
 // The policy (policy.hpp): auto's choices per class and size, the one fallback rule in the
 // registry's chains and in RowSolver alike, the per-step time budget, lemke's limits.
-#include "mlcp/policy.hpp"
+#include "mlcp/island/policy.hpp"
 
 #include <gtest/gtest.h>
 
@@ -10,13 +10,13 @@
 #include "common/contact_scenes.hpp"
 #include "common/generators.hpp"
 #include "common/timing_slack.hpp"
-#include "mlcp/dantzig.hpp"
-#include "mlcp/fallback.hpp"
-#include "mlcp/lemke.hpp"
-#include "mlcp/pgs.hpp"
+#include "mlcp/island/fallback.hpp"
+#include "mlcp/island/row_solver.hpp"
 #include "mlcp/registry.hpp"
 #include "mlcp/residual.hpp"
-#include "mlcp/row_solver.hpp"
+#include "mlcp/solvers/dantzig.hpp"
+#include "mlcp/solvers/lemke.hpp"
+#include "mlcp/solvers/pgs.hpp"
 
 namespace mlcp {
 namespace {

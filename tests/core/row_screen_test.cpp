@@ -1,14 +1,14 @@
 // RowScreen: each reason a row is screened for, the compaction (findex renumbered, inert rows
 // answered 0), and RowSolver solving the rest of an island around a degenerate row.
-#include "mlcp/row_screen.hpp"
+#include "mlcp/island/row_screen.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
 
+#include "mlcp/island/row_solver.hpp"
 #include "mlcp/residual.hpp"
-#include "mlcp/row_solver.hpp"
 
 namespace mlcp {
 namespace {

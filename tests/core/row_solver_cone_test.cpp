@@ -13,11 +13,11 @@
 #include "common/broken_solvers.hpp"
 #include "common/cone_closed_form.hpp"
 #include "common/cube_on_ground.hpp"
-#include "mlcp/friction_cone.hpp"
+#include "island/friction_cone.hpp"
 #include "mlcp/io.hpp"
-#include "mlcp/lemke.hpp"
+#include "mlcp/island/row_solver.hpp"
 #include "mlcp/residual.hpp"
-#include "mlcp/row_solver.hpp"
+#include "mlcp/solvers/lemke.hpp"
 
 namespace mlcp {
 namespace {

@@ -1,6 +1,6 @@
 // RowSolver: classification and auto's choice on small row systems, the verified fallback with
 // injected broken primaries, workspace reuse per island, the capture hook.
-#include "mlcp/row_solver.hpp"
+#include "mlcp/island/row_solver.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -10,10 +10,10 @@
 #include <filesystem>
 
 #include "common/broken_solvers.hpp"
-#include "mlcp/dantzig.hpp"
 #include "mlcp/io.hpp"
-#include "mlcp/ldlt.hpp"
 #include "mlcp/residual.hpp"
+#include "mlcp/solvers/dantzig.hpp"
+#include "mlcp/solvers/ldlt.hpp"
 
 namespace mlcp {
 namespace {
@@ -367,7 +367,7 @@ TEST(RowSolver, AnAnswerAboveTheLimitFallsBackWhateverTheSolver) {
 
 TEST(RowSolver, KeepsTheLdltAnalysisPerIsland) {
   RowSolverSettings settings;
-  settings.denseMaxRows = 0;  // the sparse path, whose analysis is kept
+  settings.denseAssemblyMaxRows = 0;  // the sparse path, whose analysis is kept
   RowSolver solver(settings);
   RowSystem rows = ballJoint();
   Vector x;
@@ -389,7 +389,7 @@ TEST(RowSolver, KeepsTheLdltAnalysisPerIsland) {
 // slot): two patterns alternating keep one sparse analysis each; a mix-up would redo them.
 TEST(RowSolver, AlternatingIslandsKeepTheirOwnWorkspaces) {
   RowSolverSettings settings;
-  settings.denseMaxRows = 0;
+  settings.denseAssemblyMaxRows = 0;
   RowSolver solver(settings);
   const RowSystem three = ballJoint();
   RowSystem two = ballJoint();

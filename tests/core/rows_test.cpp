@@ -1,6 +1,6 @@
 // The factored row form: assembly matches J M^-1 J^T + diag(cfm) built densely by hand, and
 // row PGS reaches the same answer as pgs on the assembled problem.
-#include "mlcp/rows.hpp"
+#include "mlcp/island/rows.hpp"
 
 #include <gtest/gtest.h>
 
@@ -9,8 +9,9 @@
 #include <random>
 
 #include "common/row_source.hpp"
-#include "mlcp/pgs.hpp"
 #include "mlcp/residual.hpp"
+#include "mlcp/solvers/pgs.hpp"
+#include "mlcp/solvers/row_pgs.hpp"
 
 namespace mlcp {
 namespace {

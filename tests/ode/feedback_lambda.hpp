@@ -20,7 +20,7 @@
 
 #include <Eigen/Dense>
 
-#include "mlcp/rows.hpp"
+#include "mlcp/island/rows.hpp"
 
 namespace mlcp::ode::test {
 

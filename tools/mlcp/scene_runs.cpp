@@ -6,8 +6,8 @@
 #include <stdexcept>
 
 #include "csv_rows.hpp"
-#include "mlcp/friction_model.hpp"
 #include "mlcp/input_limits.hpp"
+#include "mlcp/island/friction_model.hpp"
 
 #ifdef MLCP_HAVE_BULLET
 #include "mlcp/bullet/scene_loader.hpp"

@@ -4,7 +4,7 @@
 
 #include "commands.hpp"
 #include "mlcp/io.hpp"
-#include "mlcp/lemke.hpp"
+#include "mlcp/solvers/lemke.hpp"
 
 namespace mlcp::cli {
 

@@ -7,7 +7,8 @@
 #include <cstdint>
 
 #include "mlcp/bullet/constraint_solver.hpp"
-#include "mlcp/row_screen.hpp"
+#include "mlcp/island/row_screen.hpp"
+#include "mlcp/solvers/row_pgs.hpp"
 
 namespace mlcp::bullet {
 

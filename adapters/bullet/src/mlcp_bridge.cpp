@@ -33,7 +33,7 @@ bool MlcpBridge::solveMLCP(const btMatrixXu& A, const btVectorXu& b, btVectorXu&
     start_[i] = x[i];
     if (i < limitDependency.size()) problem_.findex[i] = limitDependency[i];
   }
-  if (n > denseMaxRows) {
+  if (n > denseAssemblyMaxRows) {
     std::vector<Eigen::Triplet<double>> t;
     for (int r = 0; r < n; ++r)
       for (int c = 0; c < n; ++c)

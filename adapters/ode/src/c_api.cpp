@@ -186,7 +186,7 @@ int mlcp_ode_stepper_set_accept_residual(mlcp_ode_stepper* s, double residual) {
 int mlcp_ode_stepper_set_dense_max_rows(mlcp_ode_stepper* s, int rows) {
   return rebuild("mlcp_ode_stepper_set_dense_max_rows", s, [&](Settings& settings) {
     require(rows >= 0, "rows must be >= 0");
-    settings.denseMaxRows = rows;
+    settings.denseAssemblyMaxRows = rows;
   });
 }
 

@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
+#include "mlcp/island/row_solver.hpp"
+#include "mlcp/island/rows.hpp"
 #include "mlcp/ode/stepper.hpp"
-#include "mlcp/row_solver.hpp"
-#include "mlcp/rows.hpp"
 #include "mlcp/solver.hpp"
 #include "ode_internal.hpp"
 

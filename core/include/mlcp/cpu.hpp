@@ -11,9 +11,9 @@
 // they give the same answers bit for bit (tests/core/cpu_test.cpp, and a Bullet pyramid stepped
 // under both in tests/bullet/plumbing_test.cpp); only the time differs. The AVX2 code uses the
 // VEX encodings throughout and 4-wide vectors for the sweep's and the check's 12-wide row
-// products and velocity updates (core/src/rows/row_simd.hpp), and for the 6 x 6 block products of
-// the factorization. AVX2 is chosen for these loops alone because they are where fixed-sweep pgs
-// and newton's large steps spend their time; building the whole library for
+// products and velocity updates (core/src/projection/row_simd.hpp), and for the 6 x 6 block
+// products of the factorization. AVX2 is chosen for these loops alone because they are where
+// fixed-sweep pgs and newton's large steps spend their time; building the whole library for
 // x86-64-v3 gains about what this dispatch gains (docs/decisions.md). docs/benchmarks.md has
 // the times of both paths (bullet_bench --pgs-vs-si, MLCP_CPU_PATH=baseline).
 //
@@ -23,7 +23,7 @@
 // comparisons; the solvers read it once per loop, so change it between solves). Builds without
 // the dispatch (another compiler or architecture, or CMake's -DMLCP_CPU_DISPATCH=OFF, which
 // defines MLCP_NO_CPU_DISPATCH) always run the baseline. The variants and the choice between
-// them are internal (core/src/rows/cpu_dispatch.hpp).
+// them are internal (core/src/projection/cpu_dispatch.hpp).
 #pragma once
 
 namespace mlcp {

@@ -1,7 +1,7 @@
 #include "linalg/block_update.hpp"
 
-#include "rows/cpu_dispatch.hpp"
-#include "rows/row_simd.hpp"
+#include "projection/cpu_dispatch.hpp"
+#include "projection/row_simd.hpp"
 
 namespace mlcp::detail {
 

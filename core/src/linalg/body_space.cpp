@@ -6,7 +6,7 @@
 #include <cmath>
 
 #include "linalg/ordering.hpp"
-#include "mlcp/pgs.hpp"
+#include "projection/pgs_sweep.hpp"
 
 namespace mlcp::detail {
 

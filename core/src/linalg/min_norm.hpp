@@ -29,17 +29,13 @@
 #include <algorithm>
 
 #include "mlcp/problem.hpp"
+#include "mlcp/thresholds.hpp"
 
 namespace mlcp::linalg {
 
 // Steps of the iteration above at most. Dimensionless.
 inline constexpr int kMinNormSteps = 40;
-// The rank decision: delta = kMinNormShift * max(1, max |A_ii|). Dimensionless. An eigenvalue
-// lambda of A asks for an impulse of rhs_lambda / lambda and a velocity change of about
-// rhs_lambda / sqrt(lambda m): directions 1e-6 below the stiffest one (a drifted loop's nearly
-// dependent rows) are where an exact answer would throw bodies, and they are left out, as a
-// CFM of that size (ODE's default 1e-5 / h is ~6e-4 of a unit mass's diagonal) would damp them.
-inline constexpr double kMinNormShift = 1e-6;
+// The rank decision: delta = kMinNormShift (thresholds.hpp) * max(1, max |A_ii|).
 
 // delta for a matrix whose largest |A_ii| is maxDiagonal.
 inline double minNormShift(double maxDiagonal) {

@@ -35,9 +35,8 @@
 #include <string>
 #include <vector>
 
-#include "mlcp/friction_cone.hpp"
-#include "mlcp/friction_model.hpp"
 #include "mlcp/io.hpp"
+#include "mlcp/island/friction_model.hpp"
 
 namespace mlcp::scene {
 
@@ -232,7 +231,7 @@ struct SolverDefaults {
   double tolerance = 1e-6;
   // Start each step from the previous step's impulses. Default true.
   bool warmStart = true;
-  // Friction model of contacts, "box" or "cone" (mlcp/friction_model.hpp). Default Box.
+  // Friction model of contacts, "box" or "cone" (mlcp/island/friction_model.hpp). Default Box.
   FrictionModel friction = FrictionModel::Box;
   // Friction directions per contact of the cone, in [3, 64]. Default 4.
   int frictionDirections = kDefaultConeDirections;

@@ -29,7 +29,7 @@
 #include <string>
 #include <vector>
 
-#include "mlcp/row_solver.hpp"
+#include "mlcp/island/row_solver.hpp"
 #include "mlcp/scene/scene.hpp"
 
 namespace mlcp::scene {
@@ -58,9 +58,9 @@ struct RunSettings {
   // Default "pgs" (the adapters' default, with the core's default options).
   std::string fallback = "pgs";
   // Largest accepted scaled residual, the same rule in both engines (mlcp::acceptable in
-  // mlcp/row_solver.hpp: an answer that is not finite, is Failed, or whose recomputed residual
-  // is above this goes to the fallback; the better answer is kept). Default 1e-3, the adapters'
-  // mlcp::kDefaultAcceptResidual; +inf accepts any finite answer.
+  // mlcp/island/row_solver.hpp: an answer that is not finite, is Failed, or whose recomputed
+  // residual is above this goes to the fallback; the better answer is kept). Default 1e-3, the
+  // adapters' mlcp::kDefaultAcceptResidual; +inf accepts any finite answer.
   double fallbackResidual = kDefaultAcceptResidual;
   // pgs/gs run exactly `iterations` sweeps, the residual checked once at the end, as the
   // engine's own solver runs its iteration count (RowSolverSettings::engineIterations, the
@@ -73,8 +73,8 @@ struct RunSettings {
   // Most block steps of newton's pivoting phase (RowSolverSettings::newton: pivotingSteps and
   // bodyPivotingSteps), 0 to turn it off; -1 for NewtonParams' defaults (40, 120 with the rows).
   int pivotingSteps = -1;
-  // Friction model of contacts (mlcp/friction_model.hpp; core solvers only: a stock solver with
-  // Cone is refused). Default Box.
+  // Friction model of contacts (mlcp/island/friction_model.hpp; core solvers only: a stock solver
+  // with Cone is refused). Default Box.
   FrictionModel friction = FrictionModel::Box;
   // Friction directions per contact of the cone, in [3, 64]. Default kDefaultConeDirections (4).
   int frictionDirections = kDefaultConeDirections;

@@ -41,11 +41,12 @@
 //     against ~0.1 on bullet_bench's 55-box pyramid), and newton (with its pivoting phase) then
 //     settles in a few steps instead of tens. Right after a switch from SI no start helps: the
 //     stack moves from SI's approximate state to the exact answers' for ~20-40 steps.
-//  5. solve and 6. check — mlcp::RowSolver (mlcp/row_solver.hpp), shared with the ODE adapter:
+//  5. solve and 6. check — mlcp::RowSolver (mlcp/island/row_solver.hpp), shared with the ODE
+//  adapter:
 //     it classifies the island (bilateral only, frictionless contacts, boxed, friction), runs
 //     the named solver or `auto`'s choice ("pgs" on the rows, others on an assembled A, dense up
-//     to Settings::denseMaxRows rows), accepts the answer only when it is finite, not Failed
-//     and its recomputed residual is <= Settings::acceptResidual, and otherwise runs the
+//     to Settings::denseAssemblyMaxRows rows), accepts the answer only when it is finite, not
+//     Failed and its recomputed residual is <= Settings::acceptResidual, and otherwise runs the
 //     fallback from the same start and keeps the better answer. StepStats counts the choices,
 //     the fallbacks and the answers rejected even after the fallback.
 //  7. store impulses — per row delta = x - appliedImpulse goes through btSolverBody::
@@ -111,10 +112,11 @@
 #include <vector>
 
 #include "mlcp/bullet/islands.hpp"
+#include "mlcp/island/row_solver.hpp"
+#include "mlcp/island/rows.hpp"
 #include "mlcp/result.hpp"
-#include "mlcp/row_solver.hpp"
-#include "mlcp/rows.hpp"
 #include "mlcp/solver.hpp"
+#include "mlcp/solvers/row_pgs.hpp"
 
 class btDiscreteDynamicsWorld;
 
@@ -137,8 +139,8 @@ enum class CfmModel {
 };
 
 // The island solver's settings (mlcp::RowSolverSettings: solver "auto", options with tolerance
-// 1e-6, fallback "pgs" with at most 100 sweeps, acceptResidual 1e-3, denseMaxRows 64,
-// engineIterations; documented in mlcp/row_solver.hpp, the shape the ODE adapter's settings
+// 1e-6, fallback "pgs" with at most 100 sweeps, acceptResidual 1e-3, denseAssemblyMaxRows 64,
+// engineIterations; documented in mlcp/island/row_solver.hpp, the shape the ODE adapter's settings
 // share), plus Bullet's own. `solver` may also be "si": Bullet's own sequential impulse
 // iterations. engineIterations (default true) gives pgs/gs btContactSolverInfo::m_numIterations
 // sweeps, as SI and the stock MLCP solvers run. options.warmStart is governed by warmStart below.

@@ -40,7 +40,8 @@
 #include <utility>
 #include <vector>
 
-#include "mlcp/rows.hpp"
+#include "mlcp/island/rows.hpp"
+#include "mlcp/solvers/row_pgs.hpp"
 
 namespace mlcp::bullet {
 
@@ -88,9 +89,9 @@ struct Island {
   // components: Bullet's body update is not M^-1 J^T there (constraint_solver.hpp), so a
   // per-body write-back would differ from Bullet's.
   bool perRowWriteBack = false;
-  // A row's b is beyond reach (mlcp/row_screen.hpp: Bullet's 6-dof limit at 1e30): the packed
-  // pgs, which screens nothing, leaves the island to RowSolver, whose screening fixes the row.
-  // Set by view().
+  // A row's b is beyond reach (mlcp/island/row_screen.hpp: Bullet's 6-dof limit at 1e30): the
+  // packed pgs, which screens nothing, leaves the island to RowSolver, whose screening fixes the
+  // row. Set by view().
   bool beyondReach = false;
 };
 

@@ -8,7 +8,7 @@
 // The stock solver hands over a dense A (it builds one for every island), Bullet's b (minus
 // ours: converted here), lo/hi (contacts [0, 1e10]), limitDependency (= findex) and x holding
 // the applied impulses (used as the warm start). The answer is checked by the drop-in's rule
-// (mlcp::acceptable, mlcp/row_solver.hpp); returning false makes btMLCPSolver count a
+// (mlcp::acceptable, mlcp/island/row_solver.hpp); returning false makes btMLCPSolver count a
 // fallback and run its SI iterations. For large problems prefer the drop-in
 // mlcp::bullet::ConstraintSolver: it never builds the dense matrix and splits islands.
 #pragma once
@@ -18,9 +18,9 @@
 #include <memory>
 #include <string>
 
+#include "mlcp/island/row_solver.hpp"
 #include "mlcp/problem.hpp"
 #include "mlcp/result.hpp"
-#include "mlcp/row_solver.hpp"
 #include "mlcp/solver.hpp"
 
 namespace mlcp::bullet {
@@ -28,15 +28,16 @@ namespace mlcp::bullet {
 class MlcpBridge : public btMLCPSolverInterface {
  public:
   // Throws std::invalid_argument (listing the valid names) for an unknown solver name.
-  // Default options: islandOptions() (tolerance 1e-6, mlcp/row_solver.hpp), as the drop-in's.
+  // Default options: islandOptions() (tolerance 1e-6, mlcp/island/row_solver.hpp), as the
+  // drop-in's.
   explicit MlcpBridge(const std::string& solver, const Options& options = islandOptions());
 
   Solver& solver() { return *solver_; }
   // Largest accepted scaled residual (dimensionless). Default mlcp::kDefaultAcceptResidual.
   double acceptResidual = kDefaultAcceptResidual;
   // Problems with more rows than this are converted to sparse storage (dropping A's zeros).
-  // Default mlcp::kDefaultDenseMaxRows (64).
-  int denseMaxRows = kDefaultDenseMaxRows;
+  // Default mlcp::kDenseAssemblyRows (64).
+  int denseAssemblyMaxRows = kDenseAssemblyRows;
   // pgs/gs take their sweep count from the numIterations argument (as the stock PGS does),
   // checked once at the end, instead of the options' limit (RowSolverSettings::engineIterations
   // says why). Default true.

@@ -6,8 +6,8 @@
  *     mlcp_ode_stepper_destroy(s);
  *
  * Everything the C++ stepper's settings hold (mlcp::ode::Settings, with the defaults documented
- * in mlcp/row_solver.hpp and stepper.hpp) can be set here, except the diagnostics whose output
- * is a C++ object (reference, keepProblems, Options::recordHistory).
+ * in mlcp/island/row_solver.hpp and stepper.hpp) can be set here, except the diagnostics whose
+ * output is a C++ object (reference, keepProblems, Options::recordHistory).
  *
  * Errors. No C++ exception leaves these functions. Every function that can fail returns
  * MLCP_ODE_OK (1) on success and MLCP_ODE_ERROR (0) on failure (create: NULL), and then
@@ -38,7 +38,7 @@ typedef struct mlcp_ode_stepper mlcp_ode_stepper;
 #define MLCP_ODE_FRICTION_EXACT 0
 #define MLCP_ODE_FRICTION_FIXED_ONCE 1
 
-/* Friction model of contacts (mlcp::FrictionModel, mlcp/friction_model.hpp): ODE's own box
+/* Friction model of contacts (mlcp::FrictionModel, mlcp/island/friction_model.hpp): ODE's own box
  * (dContactApprox1 pyramid, the default), or the polyhedral cone's LCP with k directions per
  * contact (friction within mu N in every direction; core solvers that take an LCP only). */
 #define MLCP_ODE_FRICTION_MODEL_BOX 0
@@ -100,7 +100,7 @@ int mlcp_ode_stepper_set_friction_model(mlcp_ode_stepper* stepper, int model, in
 int mlcp_ode_stepper_reset_warm_start(mlcp_ode_stepper* stepper);
 
 /* Wall-clock budget of one step's island solves in seconds, 0 for none (default 0.05; see
- * mlcp/row_solver.hpp): when it runs out a solve returns its best answer so far, never worse
+ * mlcp/island/row_solver.hpp): when it runs out a solve returns its best answer so far, never worse
  * than its start. MLCP_ODE_ERROR for a negative or non-finite value (unchanged then). */
 int mlcp_ode_set_time_budget(mlcp_ode_stepper* stepper, double seconds);
 

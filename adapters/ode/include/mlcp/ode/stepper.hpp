@@ -31,11 +31,11 @@
 //   4. warm start: lambda of the last step per joint (per contact: the nearest last-step
 //      contact of the same body pair, within Settings::contactMatchDistance), when the solver can
 //      use it;
-//   5. solve: mlcp::RowSolver (mlcp/row_solver.hpp), shared with the Bullet adapter: it
+//   5. solve: mlcp::RowSolver (mlcp/island/row_solver.hpp), shared with the Bullet adapter: it
 //      classifies the island, runs the named solver or `auto`'s choice ("pgs" on the rows,
-//      others on an assembled A, dense up to denseMaxRows rows), accepts the answer only when it
-//      is finite, not Failed and its recomputed residual is <= acceptResidual, and otherwise
-//      runs the fallback from the same start and keeps the better answer;
+//      others on an assembled A, dense up to denseAssemblyMaxRows rows), accepts the answer only
+//      when it is finite, not Failed and its recomputed residual is <= acceptResidual, and
+//      otherwise runs the fallback from the same start and keeps the better answer;
 //   6. store impulses: constraint force J^T lambda per body and joint feedback exactly as
 //      dxStepIsland fills it, v += h M^-1 (f_ext + J^T lambda), dxStepBody, zero accumulators.
 //
@@ -56,16 +56,16 @@
 #include <string>
 #include <vector>
 
+#include "mlcp/island/row_solver.hpp"
+#include "mlcp/island/rows.hpp"
 #include "mlcp/result.hpp"
-#include "mlcp/row_solver.hpp"
-#include "mlcp/rows.hpp"
 
 namespace mlcp::ode {
 
 // The stepper's settings: the island solver's (mlcp::RowSolverSettings, the shape the Bullet
 // adapter's settings share: solver "auto", options with tolerance 1e-6, fallback "pgs" with at
-// most 100 sweeps, acceptResidual 1e-3, denseMaxRows 64, engineIterations; documented in
-// mlcp/row_solver.hpp), plus ODE's own. `solver` may also name one of ODE's own solvers
+// most 100 sweeps, acceptResidual 1e-3, denseAssemblyMaxRows 64, engineIterations; documented in
+// mlcp/island/row_solver.hpp), plus ODE's own. `solver` may also name one of ODE's own solvers
 // ("ode-step", "ode-quickstep", "ode-lcp"; they never fall back). options.warmStart is ignored:
 // warmStart below decides. engineIterations (default true) gives pgs/gs the world's QuickStep
 // settings at every step: dWorldGetQuickStepNumIterations sweeps (20 by default) with
@@ -113,7 +113,7 @@ struct IslandStats {
   // friction rows or the fallback's box answer was applied). With Cone, residual is the cone
   // LCP's.
   FrictionModel friction = FrictionModel::Box;
-  // Degenerate rows screened before the solve, by reason (mlcp/row_screen.hpp): inert ones
+  // Degenerate rows screened before the solve, by reason (mlcp/island/row_screen.hpp): inert ones
   // applied no force (lambda 0), the rest of the island was solved without them.
   ScreenCounts screened;
   bool warmStarted = false;

@@ -1,0 +1,56 @@
+// mlcp/island/fallback.hpp: a verified fallback chain (registry "a>b>c") and the registry's `auto`.
+//
+// FallbackSolver runs its solvers in order under the fallback rule of policy.hpp: each answer
+// is checked by the Solver base class (residual recomputed, NaN/Inf caught); the first
+// acceptable one (here: converged, residual <= Options::tolerance) is returned, otherwise the
+// next solver starts again from the caller's start point, and when none is acceptable the best
+// answer any of them found (lowest finite residual) is returned with its own status and a
+// message listing every attempt. Result::fallbacks counts the answers passed over and
+// Result::solver names the solver whose answer is returned. Options set on the chain are passed
+// to every member; a time budget is the chain's, shared by its members (each does at least one
+// bounded chunk of work before it reads the clock, so a late member still improves on the
+// start).
+//
+// AutoSolver classifies the problem, asks Policy (policy.hpp) for a solver and its fallback and
+// runs that two-member chain. The choice and its reason open Result::message. Solvers missing
+// from the registry are skipped.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mlcp/island/policy.hpp"
+#include "mlcp/solver.hpp"
+
+namespace mlcp {
+
+class FallbackSolver : public Solver {
+ public:
+  explicit FallbackSolver(std::vector<std::unique_ptr<Solver>> chain);
+  const char* name() const override { return name_.c_str(); }
+  const std::vector<std::unique_ptr<Solver>>& chain() const { return chain_; }
+
+ protected:
+  void run(const Problem& problem, Vector& x, Result& result) override;
+
+ private:
+  std::vector<std::unique_ptr<Solver>> chain_;
+  std::string name_;
+};
+
+class AutoSolver : public Solver {
+ public:
+  const char* name() const override { return "auto"; }
+  // The rules; change them between solves (e.g. policy.largeIslandSolver = "newton").
+  Policy policy;
+
+ protected:
+  void run(const Problem& problem, Vector& x, Result& result) override;
+
+ private:
+  // Chains are kept per choice so that solver workspaces (and ldlt's analysis) are reused.
+  std::vector<std::pair<std::string, std::unique_ptr<Solver>>> cache_;
+};
+
+}  // namespace mlcp

@@ -1,0 +1,91 @@
+// mlcp/island/rows.hpp: constraint rows in the factored form physics engines hand over.
+//
+// Engines do not build A. They give, per constraint row i, two 6-wide Jacobian blocks
+// J_iA, J_iB (linear part first, then angular) on two bodies A and B, and per body its
+// inverse mass and world-frame inverse inertia. With M^-1 the block-diagonal inverse mass
+// matrix, the MLCP is
+//
+//     w = (J M^-1 J^T + diag(cfm)) x + b,   lo <= x <= hi,   findex as in problem.hpp,
+//
+// in the canonical form of problem.hpp (engines' rhs is -b: the adapters convert). Keeping
+// this form lets PGS run on rows and body velocities with O(nnz J) work per sweep and no A at
+// all (RowPgs below); pivoting methods get A from assemble(), sparse by the body graph (only
+// rows sharing a body couple), dense only when asked.
+//
+// Bodies with invMass == 0 and a zero invInertia are static; a row's body index -1 means "the
+// world" (its block is ignored).
+#pragma once
+
+#include <Eigen/Dense>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mlcp/problem.hpp"
+#include "mlcp/residual.hpp"
+#include "mlcp/result.hpp"
+
+namespace mlcp {
+
+using Vector6 = Eigen::Matrix<double, 6, 1>;
+
+struct BodyInverseMass {
+  double invMass = 0;                                    // 1 / mass, 0 for static bodies
+  Eigen::Matrix3d invInertia = Eigen::Matrix3d::Zero();  // world frame
+};
+
+struct ConstraintRow {
+  int bodyA = -1, bodyB = -1;    // indices into RowSystem::bodies, -1 = world
+  Vector6 jA = Vector6::Zero();  // [linear; angular] Jacobian on body A
+  Vector6 jB = Vector6::Zero();  // [linear; angular] Jacobian on body B
+};
+
+class RowSystem {
+ public:
+  std::vector<BodyInverseMass> bodies;
+  std::vector<ConstraintRow> rows;
+  Vector b, lo, hi, cfm;    // per row; cfm >= 0 is added to A's diagonal
+  std::vector<int> findex;  // per row or empty
+
+  int size() const { return static_cast<int>(rows.size()); }
+  // "" when well formed, otherwise the first thing wrong (sizes, body indices, NaN/Inf, and
+  // every rule of Problem::validate for b, lo, hi, findex).
+  std::string validate() const;
+
+  // A = J M^-1 J^T + diag(cfm) with the bounds copied: the same MLCP as a Problem.
+  Problem assemble(bool sparse) const;
+  // The same into `into`, reusing its vectors, A's storage (Problem::swapA) and the scratch's
+  // buffers: a per-step caller (RowSolver) allocates nothing once the sizes have been seen.
+  // Sparse A: a new pattern is written row by row in place (each row the merge of its bodies'
+  // row lists, O(nnz A), no sort) and remembered; when the rows join the same bodies as in the
+  // last sparse assembly with this scratch and `into` still holds that pattern (index arrays
+  // compared), only the values are written, through each product's slot (found once per
+  // pattern, at its second assembly: islands whose contacts change every step never pay for
+  // it). Both sum in the dense path's order: the same bits in every storage.
+  // The buffers and the remembered pattern of the call above (core/src/island/assembly.hpp),
+  // opaque here: one per island that is assembled every step.
+  class AssembleScratch {
+   public:
+    AssembleScratch();
+    AssembleScratch(AssembleScratch&&) noexcept;
+    AssembleScratch& operator=(AssembleScratch&&) noexcept;
+    ~AssembleScratch();
+    struct Buffers;
+
+   private:
+    friend class RowSystem;
+    std::unique_ptr<Buffers> buffers_;
+  };
+  void assemble(bool sparse, Problem& into, AssembleScratch& scratch) const;
+  // w = A x + b computed through body velocities, O(nnz J).
+  Vector slack(const Vector& x) const;
+  // e(x) = 1/2 x^T A x = 1/2 x^T (w - b), O(nnz J): the kinetic energy of the velocity change
+  // M^-1 J^T x the impulses make (plus the cfm's share), whatever the bodies' velocities. An
+  // exploded answer (impulses along nearly dependent rows, 1e9 times a drifted loop's error)
+  // shows as an e many orders above a sane one's.
+  double impulseEnergy(const Vector& x) const;
+  // Body velocity changes M^-1 J^T x, 6 per body ([linear; angular]).
+  std::vector<Vector6> bodyVelocities(const Vector& x) const;
+};
+
+}  // namespace mlcp

@@ -1,0 +1,283 @@
+#include "mlcp/island/rows.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <limits>
+#include <sstream>
+#include <type_traits>
+
+#include "mlcp/residual.hpp"
+#include "mlcp/solver.hpp"
+#include "projection/row_checks.hpp"
+
+namespace mlcp {
+
+namespace {
+
+// M^-1 j for one body: [invMass * linear; invInertia * angular].
+inline Vector6 applyInverseMass(const BodyInverseMass& body, const Vector6& j) {
+  Vector6 out;
+  out.head<3>() = body.invMass * j.head<3>();
+  out.tail<3>() = body.invInertia * j.tail<3>();
+  return out;
+}
+
+// A problem with the same b, bounds and findex and no matrix yet: validation of those fields is
+// Problem's job, so rows reuse it instead of repeating the rules.
+Problem boundsOnly(const RowSystem& s) {
+  Problem p;
+  p.b = s.b;
+  p.lo = s.lo;
+  p.hi = s.hi;
+  p.findex = s.findex;
+  return p;
+}
+
+using detail::arraysAndBodiesValid;
+using detail::RowRef;
+using detail::systemRow;
+
+bool rowsValid(const RowSystem& s) {
+  const unsigned slots = static_cast<unsigned>(s.bodies.size()) + 1;  // -1 .. nb - 1
+  if (!s.findex.empty() && static_cast<int>(s.findex.size()) != s.size()) return false;
+  for (int i = 0; i < s.size(); ++i) {
+    const RowRef r = systemRow(s, i, nullptr);
+    if (!detail::rowValid(r, s.rows[i].jA.data(), s.rows[i].jB.data(), i, s.size(), slots) ||
+        (r.findex >= 0 && s.findex[r.findex] >= 0))
+      return false;
+  }
+  return true;
+}
+
+using Touching = std::vector<std::vector<std::pair<int, const Vector6*>>>;  // per body
+
+// Row i of the sparse A (RowSystem::assemble): every row j sharing a body with i, in increasing
+// j, A_ij = [i == j] cfm_i + sum over the bodies k of i (increasing k) of
+// J_jk . (M_k^-1 J_ik), summed in the dense path's order (cfm, then body by body, and within a
+// body i's sides in the order A, B and j's in touching order), so that both storages hold the
+// same bits. Count only (Fill false): returns the entries; Fill: writes them at the row's start.
+template <bool Fill>
+int mergeRow(const RowSystem& s, int i, const Touching& touching, SparseMatrix* A) {
+  const ConstraintRow& r = s.rows[i];
+  // i's sides in increasing body order (A before B on one body).
+  struct Side {
+    const std::vector<std::pair<int, const Vector6*>>* list = nullptr;
+    Vector6 m = Vector6::Zero();  // M_k^-1 J_ik
+    std::size_t at = 0;
+  } side[2];
+  int sides = 0;
+  auto addSide = [&](int body, const Vector6& j) {
+    if (body < 0) return;
+    side[sides].list = &touching[body];
+    if (Fill) side[sides].m = applyInverseMass(s.bodies[body], j);
+    ++sides;
+  };
+  const bool swap = r.bodyA >= 0 && r.bodyB >= 0 && r.bodyB < r.bodyA;
+  addSide(swap ? r.bodyB : r.bodyA, swap ? r.jB : r.jA);
+  addSide(swap ? r.bodyA : r.bodyB, swap ? r.jA : r.jB);
+  int* inner = Fill ? A->innerIndexPtr() + A->outerIndexPtr()[i] : nullptr;
+  double* value = Fill ? A->valuePtr() + A->outerIndexPtr()[i] : nullptr;
+  int count = 0;
+  bool diagonal = false;
+  constexpr int kNone = std::numeric_limits<int>::max();
+  for (;;) {
+    int j = diagonal ? kNone : i;
+    for (int s = 0; s < sides; ++s)
+      if (side[s].at < side[s].list->size()) j = std::min(j, (*side[s].list)[side[s].at].first);
+    if (j == kNone) break;
+    double v = 0;
+    if (j == i) {
+      v = s.cfm[i];
+      diagonal = true;
+    }
+    for (int s = 0; s < sides; ++s) {
+      const auto& list = *side[s].list;
+      for (; side[s].at < list.size() && list[side[s].at].first == j; ++side[s].at)
+        if (Fill) v += list[side[s].at].second->dot(side[s].m);
+    }
+    if (Fill) {
+      inner[count] = j;
+      value[count] = v;
+    }
+    ++count;
+  }
+  return count;
+}
+
+}  // namespace
+
+struct RowSystem::AssembleScratch::Buffers {
+  Touching touching;  // per body, the rows touching it (row order) and their Jacobian there
+  std::vector<int> patternBodies;               // bodies.size(), then bodyA, bodyB per row
+  std::vector<int> patternOuter, patternInner;  // the pattern's compressed index arrays
+  std::vector<int> valueSlot;  // per product, in assembly order: its index in A's values
+  DenseMatrix dense;           // empty between calls: A's storage is taken from `into`
+  SparseMatrix sparse;
+};
+
+RowSystem::AssembleScratch::AssembleScratch() : buffers_(std::make_unique<Buffers>()) {}
+RowSystem::AssembleScratch::AssembleScratch(AssembleScratch&&) noexcept = default;
+RowSystem::AssembleScratch& RowSystem::AssembleScratch::operator=(AssembleScratch&&) noexcept =
+    default;
+RowSystem::AssembleScratch::~AssembleScratch() = default;
+
+std::string RowSystem::validate() const {
+  const int n = size();
+  std::ostringstream os;
+  if (b.size() != n || lo.size() != n || hi.size() != n || cfm.size() != n) {
+    os << "row arrays disagree: " << n << " rows, b " << b.size() << ", lo " << lo.size() << ", hi "
+       << hi.size() << ", cfm " << cfm.size();
+    return os.str();
+  }
+  const int nb = static_cast<int>(bodies.size());
+  for (int k = 0; k < nb; ++k) {
+    const BodyInverseMass& body = bodies[k];
+    if (!detail::bodyValid(body)) {
+      os << "body " << k << " has an invalid inverse mass or inertia";
+      return os.str();
+    }
+  }
+  if (rowsValid(*this)) return "";
+  for (int i = 0; i < n; ++i) {
+    const ConstraintRow& r = rows[i];
+    if (r.bodyA < -1 || r.bodyA >= nb || r.bodyB < -1 || r.bodyB >= nb) {
+      os << "row " << i << " names body " << r.bodyA << "/" << r.bodyB << " of " << nb;
+      return os.str();
+    }
+    if (!r.jA.allFinite() || !r.jB.allFinite()) {
+      os << "row " << i << " has a non-finite Jacobian";
+      return os.str();
+    }
+    if (!std::isfinite(cfm[i]) || cfm[i] < 0) {
+      os << "row " << i << " has cfm " << cfm[i] << " (must be finite and >= 0)";
+      return os.str();
+    }
+  }
+  // Problem::validate checks b, bounds and findex and says what is wrong; give it a shell.
+  Problem shell = boundsOnly(*this);
+  shell.setA(SparseMatrix(n, n));
+  return shell.validate();
+}
+
+std::vector<Vector6> RowSystem::bodyVelocities(const Vector& x) const {
+  std::vector<Vector6> v(bodies.size(), Vector6::Zero());
+  for (int i = 0; i < size(); ++i) {
+    const ConstraintRow& r = rows[i];
+    if (r.bodyA >= 0) v[r.bodyA] += applyInverseMass(bodies[r.bodyA], r.jA) * x[i];
+    if (r.bodyB >= 0) v[r.bodyB] += applyInverseMass(bodies[r.bodyB], r.jB) * x[i];
+  }
+  return v;
+}
+
+Vector RowSystem::slack(const Vector& x) const {
+  const std::vector<Vector6> v = bodyVelocities(x);
+  Vector w(size());
+  for (int i = 0; i < size(); ++i) {
+    const ConstraintRow& r = rows[i];
+    double wi = cfm[i] * x[i] + b[i];
+    if (r.bodyA >= 0) wi += r.jA.dot(v[r.bodyA]);
+    if (r.bodyB >= 0) wi += r.jB.dot(v[r.bodyB]);
+    w[i] = wi;
+  }
+  return w;
+}
+
+double RowSystem::impulseEnergy(const Vector& x) const { return 0.5 * x.dot(slack(x) - b); }
+
+Problem RowSystem::assemble(bool sparse) const {
+  Problem p;
+  AssembleScratch scratch;
+  assemble(sparse, p, scratch);
+  return p;
+}
+
+void RowSystem::assemble(bool sparse, Problem& p, AssembleScratch& cache) const {
+  AssembleScratch::Buffers& scratch = *cache.buffers_;
+  const int n = size();
+  // Rows touching each body: only rows sharing a body couple in J M^-1 J^T.
+  auto& touching = scratch.touching;
+  if (touching.size() < bodies.size()) touching.resize(bodies.size());
+  for (std::size_t k = 0; k < bodies.size(); ++k) touching[k].clear();
+  for (int i = 0; i < n; ++i) {
+    if (rows[i].bodyA >= 0) touching[rows[i].bodyA].push_back({i, &rows[i].jA});
+    if (rows[i].bodyB >= 0) touching[rows[i].bodyB].push_back({i, &rows[i].jB});
+  }
+  // Every entry of A as (row, column, value) in one fixed order: diag(cfm), then per body the
+  // products of the rows touching it. Dense and sparse storage sum them in this order.
+  auto forEachProduct = [&](auto&& add) {
+    for (int i = 0; i < n; ++i) add(i, i, cfm[i]);
+    for (std::size_t k = 0; k < bodies.size(); ++k) {
+      for (const auto& [i, ji] : touching[k]) {
+        const Vector6 mji = applyInverseMass(bodies[k], *ji);
+        for (const auto& [j, jj] : touching[k]) add(i, j, jj->dot(mji));
+      }
+    }
+  };
+  p.b = b;
+  p.lo = lo;
+  p.hi = hi;
+  p.findex = findex;
+  if (!sparse) {
+    DenseMatrix& A = scratch.dense;
+    p.swapA(A);  // A now holds the problem's previous dense storage
+    A.setZero(n, n);
+    forEachProduct([&](int i, int j, double v) { A(i, j) += v; });
+    p.swapA(A);
+    return;
+  }
+  // The pattern depends only on which bodies each row joins; `into` must still hold it (its
+  // index arrays are compared, so a matrix set by anyone else is never refilled by mistake).
+  auto& key = scratch.patternBodies;
+  const bool samePattern = [&] {
+    const SparseMatrix& held = p.sparseA();
+    if (!p.isSparse() || held.rows() != n || held.cols() != n || !held.isCompressed() ||
+        key.size() != 1 + 2 * static_cast<std::size_t>(n) ||
+        key[0] != static_cast<int>(bodies.size()) ||
+        held.nonZeros() != static_cast<Eigen::Index>(scratch.patternInner.size()))
+      return false;
+    for (int i = 0; i < n; ++i)
+      if (key[1 + 2 * i] != rows[i].bodyA || key[2 + 2 * i] != rows[i].bodyB) return false;
+    return std::equal(scratch.patternOuter.begin(), scratch.patternOuter.end(),
+                      held.outerIndexPtr()) &&
+           std::equal(scratch.patternInner.begin(), scratch.patternInner.end(),
+                      held.innerIndexPtr());
+  }();
+  SparseMatrix& A = scratch.sparse;
+  p.swapA(A);  // A now holds the problem's previous sparse matrix (its storage is reused)
+  if (samePattern) {
+    // The second assembly on a pattern finds where each product lands (row-major: a search of
+    // the row's sorted columns), the next ones only write values.
+    auto& slots = scratch.valueSlot;
+    if (slots.empty())
+      forEachProduct([&](int i, int j, double) {
+        const int* first = A.innerIndexPtr() + A.outerIndexPtr()[i];
+        const int* last = A.innerIndexPtr() + A.outerIndexPtr()[i + 1];
+        slots.push_back(static_cast<int>(std::lower_bound(first, last, j) - A.innerIndexPtr()));
+      });
+    double* values = A.valuePtr();
+    std::fill_n(values, A.nonZeros(), 0.0);
+    const int* slot = slots.data();
+    forEachProduct([&](int, int, double v) { values[*slot++] += v; });
+  } else {
+    // A new pattern: each row written in place, its columns the merge of its bodies' row lists.
+    A.resize(n, n);
+    int* outer = A.outerIndexPtr();
+    outer[0] = 0;
+    for (int i = 0; i < n; ++i)
+      outer[i + 1] = outer[i] + mergeRow<false>(*this, i, touching, nullptr);
+    A.resizeNonZeros(outer[n]);
+    for (int i = 0; i < n; ++i) mergeRow<true>(*this, i, touching, &A);
+    scratch.valueSlot.clear();
+    scratch.patternOuter.assign(A.outerIndexPtr(), A.outerIndexPtr() + n + 1);
+    scratch.patternInner.assign(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros());
+    key.resize(1 + 2 * static_cast<std::size_t>(n));
+    key[0] = static_cast<int>(bodies.size());
+    for (int i = 0; i < n; ++i) {
+      key[1 + 2 * i] = rows[i].bodyA;
+      key[2 + 2 * i] = rows[i].bodyB;
+    }
+  }
+  p.swapA(A);
+}
+
+}  // namespace mlcp

@@ -1,0 +1,549 @@
+#include "mlcp/solvers/lemke.hpp"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <sstream>
+
+#include "linalg/sparse_lu.hpp"
+#include "mlcp/residual.hpp"
+#include "pivoting/lemke_revised.hpp"
+#include "pivoting/lemke_tableau.hpp"
+
+namespace mlcp {
+
+namespace {
+
+using detail::LemkeEnd;
+using detail::LemkeOutcome;
+using detail::LemkeTableau;
+using detail::ToleranceRules;
+
+enum class RowState { AtLo, AtHi, Inside };
+
+// How one LCP variable y_a relates to its row of the (reduced) problem; see lemke.hpp.
+enum class Role { Lower, Upper, BoxX, BoxW, FreePlus, FreeMinus };
+
+// The coefficient of y_a in x_row, which is also the coefficient of w_row in the LCP row a.
+double sign(Role r) {
+  switch (r) {
+    case Role::Lower:
+    case Role::BoxX:
+    case Role::FreePlus: return 1;
+    case Role::Upper:
+    case Role::FreeMinus: return -1;
+    case Role::BoxW: return 0;
+  }
+  return 0;
+}
+
+struct LcpVar {
+  int row;  // index into StandardForm::kept
+  Role role;
+};
+
+using detail::ColumnMatrix;
+using Triplets = std::vector<Eigen::Triplet<double>>;
+
+// A boxed problem without findex written as the standard LCP w = M y + q (lemke.hpp).
+struct StandardForm {
+  std::vector<int> fixed, eliminated, kept;  // original row indices
+  std::vector<bool> split;                   // per kept row: a free row split as z+ - z-
+  DenseMatrix G;                             // x_eliminated = G x_kept + g
+  Vector g;
+  std::vector<LcpVar> vars;
+  Vector offset;  // x_kept = offset + sum_a sign_a y_a
+  ColumnMatrix M;
+  Vector q;
+};
+
+bool isFree(double lo, double hi) { return lo == -kInf && hi == kInf; }
+
+// Relative width below which a box [lo, hi] is treated as the point lo (see toStandard).
+constexpr double kNarrowBox = 1e-13;
+
+// A(rows, cols) as a dense block.
+DenseMatrix denseBlock(const SparseMatrix& A, const std::vector<int>& rows,
+                       const std::vector<int>& cols) {
+  std::vector<int> at(A.cols(), -1);
+  for (size_t c = 0; c < cols.size(); ++c) at[cols[c]] = static_cast<int>(c);
+  DenseMatrix D = DenseMatrix::Zero(rows.size(), cols.size());
+  for (size_t r = 0; r < rows.size(); ++r)
+    for (SparseMatrix::InnerIterator it(A, rows[r]); it; ++it)
+      if (at[it.col()] >= 0) D(r, at[it.col()]) = it.value();
+  return D;
+}
+
+// A(idx, idx), sparse.
+SparseMatrix sparseBlock(const SparseMatrix& A, const std::vector<int>& idx) {
+  std::vector<int> at(A.cols(), -1);
+  for (size_t c = 0; c < idx.size(); ++c) at[idx[c]] = static_cast<int>(c);
+  Triplets t;
+  for (size_t r = 0; r < idx.size(); ++r)
+    for (SparseMatrix::InnerIterator it(A, idx[r]); it; ++it)
+      if (at[it.col()] >= 0) t.emplace_back(static_cast<int>(r), at[it.col()], it.value());
+  SparseMatrix B(idx.size(), idx.size());
+  B.setFromTriplets(t.begin(), t.end());
+  return B;
+}
+
+// eliminateFree: free rows leave by the Schur complement when their block is nonsingular (dense
+// G: the tableau's path); otherwise they are split.
+StandardForm toStandard(const SparseMatrix& A, const Vector& b, const Vector& lo, const Vector& hi,
+                        bool eliminateFree) {
+  StandardForm f;
+  const int n = static_cast<int>(b.size());
+  // Boxes narrower than round-off relative to the scale of x (the largest finite bound, or
+  // ||b|| / max|A_ij|) count as fixed: friction bounds from a normal value of 1e-30 would
+  // otherwise be ratio-test ties that noise decides (it led to false rays).
+  double aMax = 0;
+  for (int i = 0; i < n; ++i)
+    for (SparseMatrix::InnerIterator it(A, i); it; ++it)
+      aMax = std::max(aMax, std::abs(it.value()));
+  double xScale = aMax > 0 ? b.lpNorm<Eigen::Infinity>() / aMax : 0.0;
+  for (int i = 0; i < n; ++i)
+    for (double v : {lo[i], hi[i]})
+      if (std::isfinite(v)) xScale = std::max(xScale, std::abs(v));
+  const double narrow = kNarrowBox * xScale;
+  std::vector<int> freeRows;
+  std::vector<bool> isFixed(n, false);
+  for (int i = 0; i < n; ++i) {
+    if (hi[i] - lo[i] <= narrow) {
+      f.fixed.push_back(i);
+      isFixed[i] = true;
+    } else if (isFree(lo[i], hi[i])) {
+      freeRows.push_back(i);
+    } else {
+      f.kept.push_back(i);
+    }
+  }
+  Vector b1 = b;
+  if (!f.fixed.empty())
+    for (int r = 0; r < n; ++r)
+      for (SparseMatrix::InnerIterator it(A, r); it; ++it)
+        if (isFixed[it.col()]) b1[r] += it.value() * lo[it.col()];
+
+  SparseMatrix Ar;
+  Vector br;
+  bool eliminate = false;
+  if (eliminateFree && !freeRows.empty()) {
+    Eigen::FullPivLU<DenseMatrix> lu(denseBlock(A, freeRows, freeRows));
+    eliminate = lu.isInvertible() && lu.rcond() > 1e-13;
+    if (eliminate) {
+      f.eliminated = freeRows;
+      const DenseMatrix AKF = denseBlock(A, f.kept, freeRows);
+      // (Eigen's solve binds a null pointer for a right-hand side with no columns.)
+      f.G = f.kept.empty() ? DenseMatrix(freeRows.size(), 0)
+                           : DenseMatrix(-lu.solve(denseBlock(A, freeRows, f.kept)));
+      f.g = -lu.solve(Vector(b1(freeRows)));
+      Ar = (denseBlock(A, f.kept, f.kept) + AKF * f.G).sparseView();
+      br = b1(f.kept) + AKF * f.g;
+    }
+  }
+  if (!eliminate) {
+    // Free rows stay and are split, x = z+ - z-.
+    f.kept.insert(f.kept.end(), freeRows.begin(), freeRows.end());
+    std::sort(f.kept.begin(), f.kept.end());
+    Ar = sparseBlock(A, f.kept);
+    br = b1(f.kept);
+  }
+
+  const int k = static_cast<int>(f.kept.size());
+  f.offset = Vector::Zero(k);
+  f.split.assign(k, false);
+  std::vector<std::vector<int>> varsOf(k);  // LCP variables of each kept row
+  for (int r = 0; r < k; ++r) {
+    const int i = f.kept[r];
+    auto add = [&](Role role) {
+      varsOf[r].push_back(static_cast<int>(f.vars.size()));
+      f.vars.push_back({r, role});
+    };
+    if (isFree(lo[i], hi[i])) {
+      f.split[r] = true;
+      add(Role::FreePlus);
+      add(Role::FreeMinus);
+    } else if (hi[i] == kInf) {
+      f.offset[r] = lo[i];
+      add(Role::Lower);
+    } else if (lo[i] == -kInf) {
+      f.offset[r] = hi[i];
+      add(Role::Upper);
+    } else {
+      f.offset[r] = lo[i];
+      add(Role::BoxX);
+      add(Role::BoxW);
+    }
+  }
+
+  const int m = static_cast<int>(f.vars.size());
+  const Vector w0 = Ar * f.offset + br;  // w of the reduced problem at y = 0
+  Triplets t;
+  t.reserve(Ar.nonZeros() * 2 + m);
+  for (int r = 0; r < k; ++r)
+    for (SparseMatrix::InnerIterator it(Ar, r); it; ++it)
+      for (int a : varsOf[r])
+        for (int c : varsOf[it.col()]) {
+          const double v = sign(f.vars[a].role) * it.value() * sign(f.vars[c].role);
+          if (v != 0) t.emplace_back(a, c, v);
+        }
+  f.q.resize(m);
+  for (int a = 0; a < m; ++a) {
+    const LcpVar& va = f.vars[a];
+    f.q[a] = sign(va.role) * w0[va.row];
+    // BoxX and BoxW are adjacent: BoxX's row is w + z2, BoxW's row is hi - lo - z1.
+    if (va.role == Role::BoxX) t.emplace_back(a, a + 1, 1.0);
+    if (va.role == Role::BoxW) {
+      const int i = f.kept[va.row];
+      t.emplace_back(a, a - 1, -1.0);
+      f.q[a] = hi[i] - lo[i];
+    }
+  }
+  f.M.resize(m, m);
+  f.M.setFromTriplets(t.begin(), t.end());
+  return f;
+}
+
+// x of the original problem from the LCP unknowns y.
+Vector toOriginal(const StandardForm& f, const Vector& y, const Vector& lo) {
+  Vector x(lo.size());
+  Vector xk = f.offset;
+  for (size_t a = 0; a < f.vars.size(); ++a) xk[f.vars[a].row] += sign(f.vars[a].role) * y[a];
+  for (int i : f.fixed) x[i] = lo[i];
+  for (size_t r = 0; r < f.kept.size(); ++r) x[f.kept[r]] = xk[r];
+  if (!f.eliminated.empty()) {
+    const Vector xe = f.G * xk + f.g;
+    for (size_t r = 0; r < f.eliminated.size(); ++r) x[f.eliminated[r]] = xe[r];
+  }
+  return x;
+}
+
+// Which rows the final complementary basis holds at a bound and which strictly inside.
+std::vector<RowState> rowStates(const StandardForm& f, const std::vector<bool>& yBasic, int n) {
+  std::vector<RowState> s(n, RowState::Inside);  // eliminated and split rows: w = 0
+  for (int i : f.fixed) s[i] = RowState::AtLo;
+  for (size_t a = 0; a < f.vars.size(); ++a) {
+    const int i = f.kept[f.vars[a].row];
+    switch (f.vars[a].role) {
+      case Role::Lower: s[i] = yBasic[a] ? RowState::Inside : RowState::AtLo; break;
+      case Role::Upper: s[i] = yBasic[a] ? RowState::Inside : RowState::AtHi; break;
+      case Role::BoxX:
+        // BoxW basic means its complementary slack hi - x is zero.
+        s[i] = !yBasic[a] ? RowState::AtLo : (yBasic[a + 1] ? RowState::AtHi : RowState::Inside);
+        break;
+      default: break;
+    }
+  }
+  return s;
+}
+
+// Solves the active set in the original problem: (A x + b)_i = 0 for inside rows, x_i on its
+// bound for the others; a friction row's bound is the linear equation x_i = mu_i sgn(x_j) x_j
+// (the true coupled bound, x being the current answer). LU with partial pivoting (dense), or
+// KLU (sparse, the factored-basis path), plus one step of iterative refinement. Empty when the
+// system is singular.
+std::optional<Vector> resolveActiveSet(const Problem& p, const SparseMatrix& A,
+                                       const std::vector<RowState>& states, const Vector& x,
+                                       bool sparse) {
+  const int n = p.size();
+  Triplets t;
+  t.reserve(A.nonZeros() + 2 * n);
+  Vector rhs(n);
+  for (int i = 0; i < n; ++i) {
+    if (states[i] == RowState::Inside) {
+      for (SparseMatrix::InnerIterator it(A, i); it; ++it) t.emplace_back(i, it.col(), it.value());
+      rhs[i] = -p.b[i];
+      continue;
+    }
+    const double bound = states[i] == RowState::AtLo ? p.lo[i] : p.hi[i];
+    t.emplace_back(i, i, 1.0);
+    const int j = p.findex.empty() ? -1 : p.findex[i];
+    if (j < 0) {
+      rhs[i] = bound;
+    } else {
+      const double s = x[j] > 0 ? 1 : (x[j] < 0 ? -1 : 0);
+      t.emplace_back(i, j, -bound * s);
+      rhs[i] = 0;
+    }
+  }
+  SparseMatrix K(n, n);
+  K.setFromTriplets(t.begin(), t.end());
+  Vector sol;
+  if (!sparse) {
+    const DenseMatrix Kd(K);
+    Eigen::PartialPivLU<DenseMatrix> lu(Kd);
+    sol = lu.solve(rhs);
+    sol += lu.solve(Vector(rhs - Kd * sol));
+  } else {
+    K.makeCompressed();
+    const std::vector<int> rowStart(K.outerIndexPtr(), K.outerIndexPtr() + n + 1);
+    const std::vector<int> columns(K.innerIndexPtr(), K.innerIndexPtr() + K.nonZeros());
+    const std::vector<double> values(K.valuePtr(), K.valuePtr() + K.nonZeros());
+    linalg::SparseLu lu;
+    sol = rhs;
+    if (!lu.analyze(n, rowStart, columns) || !lu.factor(values) || !lu.solve(sol))
+      return std::nullopt;
+    Vector correction = rhs - K * sol;
+    if (lu.solve(correction)) sol += correction;
+  }
+  if (!sol.allFinite()) return std::nullopt;
+  return sol;
+}
+
+struct LcpSolution {
+  LemkeOutcome outcome;
+  Vector y;
+  std::vector<bool> yBasic;
+  std::string rayLabel;
+  bool singular = false;
+};
+
+// The dense tableau (lemke_tableau.hpp).
+template <class Stop>
+LcpSolution solveDense(const StandardForm& f, const ToleranceRules& rules, int maxPivots,
+                       Stop stop) {
+  const int m = static_cast<int>(f.q.size());
+  const DenseMatrix Md(f.M);
+  std::vector<double> M(static_cast<size_t>(m) * m), q(m);
+  for (int i = 0; i < m; ++i) {
+    q[i] = f.q[i];
+    for (int j = 0; j < m; ++j) M[static_cast<size_t>(i) * m + j] = Md(i, j);
+  }
+  LemkeTableau<double> tab(m, M, q);
+  struct Adapter {
+    Stop& s;
+    void pivoted(int, int, int, int) {}
+    bool stop() { return s(); }
+  } observer{stop};
+  LcpSolution sol;
+  sol.outcome = detail::runLemke(tab, rules, maxPivots, observer);
+  sol.y = Vector::Zero(m);
+  sol.yBasic.assign(m, false);
+  for (int r = 0; r < m; ++r) {
+    const int v = tab.basic(r);
+    if (v >= m && v < 2 * m) {
+      sol.y[v - m] = std::max(tab.rhs(r), 0.0);
+      sol.yBasic[v - m] = true;
+    }
+  }
+  if (sol.outcome.end == LemkeEnd::Ray) sol.rayLabel = tab.label(sol.outcome.entering);
+  return sol;
+}
+
+// The factored basis (lemke_revised.hpp), warm from `warm` when it is a complementary basis.
+LcpSolution solveRevised(const StandardForm& f, detail::RevisedLemkeSettings settings) {
+  const detail::RevisedLemkeResult r = detail::revisedLemke(f.M, f.q, settings);
+  LcpSolution sol;
+  sol.outcome = r.outcome;
+  sol.y = r.y;
+  sol.yBasic = r.yBasic;
+  sol.singular = r.singular;
+  if (r.outcome.end == LemkeEnd::Ray && !r.singular)
+    sol.rayLabel = detail::variableLabel(r.outcome.entering, static_cast<int>(f.q.size()));
+  return sol;
+}
+
+// The friction passes' warm start: whether each LCP variable (original row, role) was basic at
+// the end of the last pass.
+class BasisMemory {
+ public:
+  explicit BasisMemory(int n) : state_(static_cast<size_t>(n) * kRoles, -1) {}
+  void store(const StandardForm& f, const std::vector<bool>& yBasic) {
+    std::fill(state_.begin(), state_.end(), -1);
+    for (size_t a = 0; a < f.vars.size(); ++a) state_[key(f, a)] = yBasic[a] ? 1 : 0;
+  }
+  // The basis with y_a basic in position a where it was basic last time, w_a otherwise.
+  std::vector<int> basis(const StandardForm& f) const {
+    const int m = static_cast<int>(f.vars.size());
+    std::vector<int> b(m);
+    for (int a = 0; a < m; ++a) b[a] = state_[key(f, a)] == 1 ? m + a : a;
+    return b;
+  }
+
+ private:
+  static constexpr int kRoles = 6;
+  static size_t key(const StandardForm& f, size_t a) {
+    return static_cast<size_t>(f.kept[f.vars[a].row]) * kRoles + static_cast<int>(f.vars[a].role);
+  }
+  std::vector<signed char> state_;
+};
+
+// The largest relative move of a friction bound between two answers.
+double boundsMove(const Problem& p, const Vector& before, const Vector& after) {
+  double move = 0;
+  for (int i = 0; i < p.size(); ++i) {
+    const double a = p.effectiveHi(i, before), b = p.effectiveHi(i, after);
+    if (a != b) move = std::max(move, std::abs(a - b) / (1 + std::abs(a)));
+  }
+  return move;
+}
+
+}  // namespace
+
+void LemkeSolver::run(const Problem& problem, Vector& x, Result& result) {
+  const int n = problem.size();
+  result.iterations = 0;
+  if (n == 0) {
+    result.status = Status::Converged;
+    result.message = "empty problem";
+    return;
+  }
+  if (n > maxRows) {
+    std::ostringstream os;
+    os << "lemke for " << n << " rows exceeds LemkeSolver::maxRows = " << maxRows
+       << "; use dantzig or pgs";
+    result.status = Status::Unsupported;
+    result.message = os.str();
+    return;
+  }
+  SparseMatrix A = problem.toSparse();
+  A.makeCompressed();
+  const Vector start = x;
+  pivot(problem, A, x, result);
+  if (result.status != Status::Failed) return;
+  // A ray on a singular A (redundant joints): once more from the start on A + delta I, the
+  // answer measured on A; the better of the two stands.
+  double diag = 0;
+  for (int i = 0; i < n; ++i) diag = std::max(diag, std::abs(problem.diagonal(i)));
+  const double delta = kLemkeRayShift * std::max(1.0, diag);
+  SparseMatrix I(n, n);
+  I.setIdentity();
+  A = A + delta * I;
+  A.makeCompressed();
+  Vector again = start;
+  Result second = result;
+  second.iterations = 0;
+  pivot(problem, A, again, second);
+  const int pivots = result.iterations + second.iterations;
+  std::ostringstream os;
+  if (second.status == Status::Converged || residual(problem, again) < residual(problem, x)) {
+    os << "regularised: A + " << delta << " I after a ray (" << result.message << "); "
+       << second.message;
+    result = std::move(second);
+    x = std::move(again);
+  } else {
+    os << result.message;  // an infeasible problem: the ray stands
+  }
+  result.iterations = pivots;
+  result.message = os.str();
+}
+
+void LemkeSolver::pivot(const Problem& problem, const SparseMatrix& A, Vector& x, Result& result) {
+  const Options& opt = options();
+  const int n = problem.size();
+  const bool friction = problem.hasFindex();
+  const bool standard = problem.classify() == ProblemClass::StandardLcp;
+  // Free rows keep the tableau (its Schur elimination, see lemke.hpp) up to
+  // kLemkeFreeRowsTableauRows.
+  const bool revised =
+      n > denseRows && (!hasFreeRows(problem.lo, problem.hi) || n > kLemkeFreeRowsTableauRows);
+  const int outerLimit = friction ? std::max(1, opt.maxIterations) : 1;
+  ToleranceRules rules;
+  rules.pivotTolerance = opt.pivotTolerance;
+  // A tableau pivot costs O(m^2) with m >= n, a factored one at least O(m): the clock is read
+  // once per ~4096 / n^2 (tableau) or 4096 / n (factored) pivots, at most ~2% of their cost.
+  const int clockEvery = std::max(1, 4096 / std::max(1, revised ? n : n * n));
+  int sinceClock = 0;
+  auto stop = [&] {
+    if (opt.timeBudget <= 0 || ++sinceClock < clockEvery) return false;
+    sinceClock = 0;
+    return outOfTime();
+  };
+
+  Vector current = x;  // seeds the friction bounds
+  BasisMemory memory(revised && friction ? n : 0);
+  // The pivot limit bounds the whole solve, the friction passes together: a pass that does not
+  // settle the bounds cannot buy another full limit (50 m + 100 pivots a pass times 1000 passes
+  // ran for minutes on a 600-row contact problem).
+  int pivotLimit = -1;
+  double lastMove = 0;
+  for (int outer = 1; outer <= outerLimit; ++outer) {
+    Vector lo(n), hi(n);
+    for (int i = 0; i < n; ++i) {
+      lo[i] = problem.effectiveLo(i, current);
+      hi[i] = problem.effectiveHi(i, current);
+    }
+    const StandardForm f = toStandard(A, problem.b, lo, hi, !revised);
+    const int m = static_cast<int>(f.q.size());
+    if (pivotLimit < 0) pivotLimit = opt.maxPivots > 0 ? opt.maxPivots : 50 * m + 100;
+    const int maxPivots = std::max(1, pivotLimit - result.iterations);
+    LcpSolution s;
+    if (revised) {
+      detail::RevisedLemkeSettings settings;
+      settings.rules = rules;
+      settings.maxPivots = maxPivots;
+      settings.refactorPeriod = refactorPeriod;
+      settings.stop = stop;
+      if (outer > 1) settings.warmBasis = memory.basis(f);
+      s = solveRevised(f, settings);
+    } else {
+      s = solveDense(f, rules, maxPivots, stop);
+    }
+    result.iterations += s.outcome.pivots;
+
+    std::ostringstream os;
+    const std::string where = friction ? " in friction iteration " + std::to_string(outer) : "";
+    const std::string lcp = standard ? "the LCP" : "the transformed LCP (see lemke.hpp)";
+    switch (s.outcome.end) {
+      case LemkeEnd::Solved: break;
+      case LemkeEnd::Ray:
+        result.status = Status::Failed;
+        result.message = s.singular ? "the factored basis became singular after " +
+                                          std::to_string(s.outcome.pivots) + " pivots" + where
+                                    : detail::rayMessage(s.outcome, s.rayLabel, lcp) + where;
+        return;
+      case LemkeEnd::PivotLimit:
+        os << "gave up: pivot limit " << pivotLimit << " reached" << where
+           << " (Options::maxPivots, over all friction iterations; 0 means 50 m + 100 for m = " << m
+           << "): " << (outer > 1 ? "the last friction iteration's answer" : "the start")
+           << " is returned";
+        result.status = Status::MaxIterations;
+        result.message = os.str();
+        return;
+      case LemkeEnd::Stopped:
+        os << "gave up when the time budget (" << opt.timeBudget << " s) ran out after "
+           << s.outcome.pivots << " pivots" << where << ": "
+           << (outer > 1 ? "the last friction iteration's answer" : "the start") << " is returned";
+        result.status = Status::TimeLimit;
+        result.message = os.str();
+        return;
+    }
+
+    Vector best = toOriginal(f, s.y, lo);
+    Accuracy acc = accuracy(problem, best);
+    const std::vector<RowState> states = rowStates(f, s.yBasic, n);
+    if (std::optional<Vector> refined = resolveActiveSet(problem, A, states, best, revised)) {
+      const Accuracy a = accuracy(problem, *refined);
+      if (a.finite && !(a.residual > acc.residual)) {
+        best = std::move(*refined);
+        acc = a;
+      }
+    }
+    x = best;
+    if (!friction || acc.residual <= opt.tolerance) {
+      result.status = Status::Converged;
+      os << "z0 left the basis after " << result.iterations << " pivots";
+      if (friction) os << " (" << outer << " friction iterations)";
+      result.message = os.str();
+      return;
+    }
+    lastMove = boundsMove(problem, current, best);
+    if (!(lastMove > 1e-15)) {
+      os << "the friction bounds reached a fixed point with residual " << acc.residual
+         << " above the tolerance";
+      result.status = Status::Failed;
+      result.message = os.str();
+      return;
+    }
+    if (revised) memory.store(f, s.yBasic);
+    current = best;
+  }
+  std::ostringstream os;
+  os << "friction bounds still moving after " << outerLimit
+     << " outer iterations (Options::maxIterations; the last moved a bound by " << lastMove
+     << " relative)";
+  result.status = Status::MaxIterations;
+  result.message = os.str();
+}
+
+}  // namespace mlcp

@@ -1,0 +1,340 @@
+#include "pivoting/lemke_revised.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "linalg/sparse_lu.hpp"
+#include "mlcp/thresholds.hpp"
+
+namespace mlcp::detail {
+
+namespace {
+
+// Ties of the ratio test up to this many keep their rows of B^-1 for the column-by-column
+// lexicographic filter (as the tableau does); more are decided pairwise, two rows at a time.
+constexpr size_t kStoredRows = 64;
+
+// The basis matrix B = B0 E_1 ... E_k: a KLU factor of B0 and the eta file.
+class FactoredBasis {
+ public:
+  FactoredBasis(const ColumnMatrix& M, const Vector& cover)
+      : M_(M), m_(static_cast<int>(M.cols())), cover_(cover) {}
+
+  // out <- the column of variable v in [I, -M, -c].
+  void column(int v, Vector& out) const {
+    out.setZero(m_);
+    if (v < m_) {
+      out[v] = 1;
+    } else if (v < 2 * m_) {
+      for (ColumnMatrix::InnerIterator it(M_, v - m_); it; ++it) out[it.row()] = -it.value();
+    } else {
+      out = -cover_;
+    }
+  }
+
+  // Factors the basis matrix of `basis` and empties the eta file. False when it is singular.
+  bool factor(const std::vector<int>& basis) {
+    // B by columns is B' by rows, the form SparseLu takes: its solve() is then B' y = c and
+    // solveTransposed() B y = c.
+    colStart_.assign(1, 0);
+    rows_.clear();
+    values_.clear();
+    for (int v : basis) {
+      if (v < m_) {
+        push(v, 1.0);
+      } else if (v < 2 * m_) {
+        for (ColumnMatrix::InnerIterator it(M_, v - m_); it; ++it) push(it.row(), -it.value());
+      } else {
+        for (int i = 0; i < m_; ++i)
+          if (cover_[i] != 0) push(i, -cover_[i]);
+      }
+      colStart_.push_back(static_cast<int>(rows_.size()));
+    }
+    etas_.clear();
+    return lu_.analyze(m_, colStart_, rows_) && lu_.factor(values_);
+  }
+
+  // y <- B^-1 y.
+  bool ftran(Vector& y) {
+    if (!lu_.solveTransposed(y)) return false;
+    for (const Eta& e : etas_) {
+      const double yr = y[e.row] / e.pivot;
+      for (size_t k = 0; k < e.index.size(); ++k) y[e.index[k]] -= e.value[k] * yr;
+      y[e.row] = yr;
+    }
+    return y.allFinite();
+  }
+
+  // y <- B^-T y.
+  bool btran(Vector& y) {
+    for (auto e = etas_.rbegin(); e != etas_.rend(); ++e) {
+      double s = y[e->row];
+      for (size_t k = 0; k < e->index.size(); ++k) s -= e->value[k] * y[e->index[k]];
+      y[e->row] = s / e->pivot;
+    }
+    return lu_.solve(y);
+  }
+
+  // Records the pivot on row r with the tableau column d = B^-1 a.
+  void update(int r, const Vector& d) {
+    Eta e;
+    e.row = r;
+    e.pivot = d[r];
+    for (int i = 0; i < m_; ++i)
+      if (i != r && d[i] != 0) {
+        e.index.push_back(i);
+        e.value.push_back(d[i]);
+      }
+    etas_.push_back(std::move(e));
+  }
+
+  int etas() const { return static_cast<int>(etas_.size()); }
+
+ private:
+  void push(int row, double value) {
+    rows_.push_back(row);
+    values_.push_back(value);
+  }
+  struct Eta {
+    int row = 0;
+    double pivot = 1;
+    std::vector<int> index;
+    std::vector<double> value;
+  };
+  const ColumnMatrix& M_;
+  int m_;
+  Vector cover_;
+  linalg::SparseLu lu_;
+  std::vector<Eta> etas_;
+  std::vector<int> colStart_, rows_;
+  std::vector<double> values_;
+};
+
+class RevisedRun {
+ public:
+  RevisedRun(const ColumnMatrix& M, const Vector& q, const RevisedLemkeSettings& s,
+             const Vector& cover)
+      : m_(static_cast<int>(M.cols())), q_(q), s_(s), basis_(M, cover), period_(s.refactorPeriod) {}
+
+  // Runs from `basis` (the slack basis, or a warm one whose covering vector is `cover`).
+  LemkeOutcome run(std::vector<int> basis, int maxPivots, RevisedLemkeResult& res) {
+    LemkeOutcome out;
+    order_ = std::move(basis);
+    if (!refactor(res, /*checkLemkeDrift=*/false)) return singular(out, res);
+    bool feasible = true;
+    for (int i = 0; i < m_; ++i) feasible = feasible && !(x_[i] < 0);
+    if (feasible) return out;
+    const ToleranceRules& rules = s_.rules;
+    int entering = 2 * m_;
+    int row = 0;
+    for (int i = 1; i < m_; ++i)
+      if (rules.compare(x_[i], x_[row]) <= 0) row = i;
+    Vector d;
+    if (!enteringColumn(entering, d)) return singular(out, res);
+    for (;;) {
+      if (out.pivots >= maxPivots) {
+        out.end = LemkeEnd::PivotLimit;
+        return out;
+      }
+      if (s_.stop && s_.stop()) {
+        out.end = LemkeEnd::Stopped;
+        return out;
+      }
+      const int leaving = order_[row];
+      const double theta = x_[row] / d[row];
+      x_ -= theta * d;
+      x_[row] = theta;
+      order_[row] = entering;
+      basis_.update(row, d);
+      ++out.pivots;
+      if (basis_.etas() >= period_ && !refactor(res, true)) return singular(out, res);
+      if (leaving == 2 * m_) return out;
+      entering = leaving < m_ ? leaving + m_ : leaving - m_;
+      if (!enteringColumn(entering, d)) return singular(out, res);
+      row = leavingRow(d);
+      if (row < 0) {
+        out.end = LemkeEnd::Ray;
+        out.entering = entering;
+        return out;
+      }
+    }
+  }
+
+  const std::vector<int>& order() const { return order_; }
+  const Vector& values() const { return x_; }
+
+ private:
+  static LemkeOutcome& singular(LemkeOutcome& out, RevisedLemkeResult& res) {
+    res.singular = true;
+    out.end = LemkeEnd::Ray;
+    return out;
+  }
+
+  bool enteringColumn(int v, Vector& d) {
+    basis_.column(v, d);
+    return basis_.ftran(d);
+  }
+
+  // Factors B again and recomputes x_B = B^-1 q; halves the period when the updated values had
+  // drifted from it.
+  bool refactor(RevisedLemkeResult& res, bool checkLemkeDrift) {
+    ++res.refactorizations;
+    Vector fresh = q_;
+    if (!basis_.factor(order_) || !basis_.ftran(fresh)) return false;
+    if (checkLemkeDrift) {
+      const double scale = 1 + fresh.lpNorm<Eigen::Infinity>();
+      if ((fresh - x_).lpNorm<Eigen::Infinity>() > kLemkeDrift * scale)
+        period_ = std::max(4, period_ / 2);
+    }
+    x_ = std::move(fresh);
+    return true;
+  }
+
+  // Row e_i' B^-1.
+  Vector inverseRow(int i) {
+    Vector r = Vector::Zero(m_);
+    r[i] = 1;
+    basis_.btran(r);
+    return r;
+  }
+
+  // The minimum-ratio test with the lexicographic tie-break of LemkeTableau::leavingRow, on the
+  // column d = B^-1 a; -1 when d has no positive entry.
+  int leavingRow(const Vector& d) {
+    const ToleranceRules& rules = s_.rules;
+    const double colMax = d.lpNorm<Eigen::Infinity>();
+    std::vector<int> ties;
+    for (int i = 0; i < m_; ++i)
+      if (rules.positive(d[i], colMax)) ties.push_back(i);
+    if (ties.empty()) return -1;
+    auto ratio = [&](int i) { return rules.clampRhs(x_[i]) / d[i]; };
+    double best = ratio(ties[0]);
+    for (int i : ties) best = std::min(best, ratio(i));
+    std::vector<int> kept;
+    for (int i : ties)
+      if (rules.compare(ratio(i), best) == 0) kept.push_back(i);
+    ties.swap(kept);
+    for (int i : ties)
+      if (order_[i] == 2 * m_) return i;
+    if (ties.size() > 1)
+      ties = ties.size() <= kStoredRows ? byStoredRows(ties, d) : byPairs(ties, d);
+    // Only round-off can leave two rows here (B^-1 has independent rows): the larger pivot.
+    int row = ties[0];
+    for (int i : ties)
+      if (d[row] < d[i]) row = i;
+    return row;
+  }
+
+  // Column-by-column filter over the rows of B^-1 / d_i, as the tableau does.
+  std::vector<int> byStoredRows(std::vector<int> ties, const Vector& d) {
+    std::vector<Vector> rows;
+    std::vector<int> at(m_, -1);
+    for (int i : ties) {
+      at[i] = static_cast<int>(rows.size());
+      rows.push_back(inverseRow(i));
+    }
+    auto key = [&](int i, int k) { return rows[at[i]][k] / d[i]; };
+    for (int k = 0; k < m_ && ties.size() > 1; ++k) {
+      double best = key(ties[0], k);
+      for (int i : ties) best = std::min(best, key(i, k));
+      std::vector<int> kept;
+      for (int i : ties)
+        if (s_.rules.compare(key(i, k), best) == 0) kept.push_back(i);
+      ties.swap(kept);
+    }
+    return ties;
+  }
+
+  // The lexicographic minimum by pairwise comparison, two rows of B^-1 in memory at a time.
+  std::vector<int> byPairs(const std::vector<int>& ties, const Vector& d) {
+    int best = ties[0];
+    Vector bestRow = inverseRow(best);
+    for (size_t t = 1; t < ties.size(); ++t) {
+      const int i = ties[t];
+      const Vector row = inverseRow(i);
+      for (int k = 0; k < m_; ++k) {
+        const int c = s_.rules.compare(row[k] / d[i], bestRow[k] / d[best]);
+        if (c == 0) continue;
+        if (c < 0) {
+          best = i;
+          bestRow = row;
+        }
+        break;
+      }
+    }
+    return {best};
+  }
+
+  int m_;
+  const Vector& q_;
+  const RevisedLemkeSettings& s_;
+  FactoredBasis basis_;
+  int period_;
+  std::vector<int> order_;
+  Vector x_;
+};
+
+bool complementary(const std::vector<int>& basis, int m) {
+  if (static_cast<int>(basis.size()) != m) return false;
+  std::vector<bool> seen(m, false);
+  for (int v : basis) {
+    if (v < 0 || v >= 2 * m || seen[v % m]) return false;
+    seen[v % m] = true;
+  }
+  return true;
+}
+
+void finish(const RevisedRun& run, int m, RevisedLemkeResult& res) {
+  res.basis = run.order();
+  res.y = Vector::Zero(m);
+  res.yBasic.assign(m, false);
+  for (int r = 0; r < m; ++r) {
+    const int v = res.basis[r];
+    if (v >= m && v < 2 * m) {
+      res.y[v - m] = std::max(run.values()[r], 0.0);
+      res.yBasic[v - m] = true;
+    }
+  }
+}
+
+}  // namespace
+
+RevisedLemkeResult revisedLemke(const ColumnMatrix& M, const Vector& q,
+                                const RevisedLemkeSettings& settings) {
+  const int m = static_cast<int>(M.cols());
+  RevisedLemkeResult res;
+  const int maxPivots = std::max(1, settings.maxPivots);
+  std::vector<int> slack(m);
+  for (int i = 0; i < m; ++i) slack[i] = i;
+  if (complementary(settings.warmBasis, m) && settings.warmBasis != slack) {
+    // Covering vector B0 e: z0's column is -e in the warm basis, as it is in the slack one. It
+    // need not be positive, so the guarantees are the cold start's: a warm attempt that ends on
+    // a ray, a singular basis or half the pivots is followed by a cold start.
+    Vector cover = Vector::Zero(m);
+    for (int v : settings.warmBasis) {
+      Vector c;
+      FactoredBasis(M, cover).column(v, c);
+      cover += c;
+    }
+    RevisedRun warm(M, q, settings, cover);
+    RevisedLemkeResult attempt;
+    attempt.outcome = warm.run(settings.warmBasis, std::max(1, maxPivots / 2), attempt);
+    res.refactorizations += attempt.refactorizations;
+    if (attempt.outcome.end == LemkeEnd::Solved || attempt.outcome.end == LemkeEnd::Stopped) {
+      res.outcome = attempt.outcome;
+      res.refactorizations = attempt.refactorizations;
+      finish(warm, m, res);
+      return res;
+    }
+    res.outcome.pivots = attempt.outcome.pivots;
+  }
+  const int before = res.outcome.pivots;
+  RevisedRun cold(M, q, settings, Vector::Ones(m));
+  res.singular = false;
+  res.outcome = cold.run(slack, std::max(0, maxPivots - before), res);
+  res.outcome.pivots += before;
+  finish(cold, m, res);
+  return res;
+}
+
+}  // namespace mlcp::detail
