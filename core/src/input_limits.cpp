@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <vector>
 
@@ -89,6 +90,17 @@ std::string jsonErrorText(const std::exception& e) {
     what = what.substr(close + 2);
   std::replace(what.begin(), what.end(), '\n', ' ');
   return "not valid JSON: " + capped(what, 2 * kMaxEchoChars);
+}
+
+double parseNumber(const std::string& text) {
+  std::size_t used = 0;
+  double v = 0;
+  try {
+    v = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  return used != 0 && used == text.size() ? v : std::numeric_limits<double>::quiet_NaN();
 }
 
 std::string capped(const std::string& s, std::size_t maxChars) {

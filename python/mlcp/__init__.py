@@ -26,8 +26,9 @@ error: its Result says so in `status` ("max-iterations", "failed", ...).
 from __future__ import annotations
 
 import dataclasses
+import numbers
 import os
-from typing import Any, Dict, List, Optional
+from typing import Any, Dict, List, Mapping, Optional, Tuple
 
 import numpy as np
 
@@ -180,11 +181,19 @@ class Problem:
         return np.asarray(f, dtype=np.int32) if f else np.full(self.n, -1, dtype=np.int32)
 
     def solve(self, solver: str = "auto", tol: float = 1e-10, guess: Any = None,
-              max_iter: int = 1000, relaxation: float = 1.0, time_budget: float = 0.0) -> Result:
+              max_iter: int = 1000, relaxation: float = 1.0, time_budget: float = 0.0,
+              max_pivots: int = 0, check_every: int = 1, pivot_tolerance: float = 1e-12,
+              friction_bounds: str = "exact", newton: Optional[Mapping[str, Any]] = None,
+              dantzig: Optional[Mapping[str, Any]] = None,
+              lemke: Optional[Mapping[str, Any]] = None) -> Result:
         """Solves with a registered solver (see solvers()); `guess` is the start point; the
-        settings of `mlcp solve` (--tol, --max-iter, --relaxation, --time-budget)."""
+        settings are those of `mlcp solve`, snake_case (see solve())."""
         g = _vector("guess", guess, self.n, None)
-        return Result(**self._core.solve(solver, tol, max_iter, relaxation, time_budget, g))
+        options = dict(tol=tol, max_iter=max_iter, relaxation=relaxation,
+                       time_budget=time_budget, max_pivots=max_pivots, check_every=check_every,
+                       pivot_tolerance=pivot_tolerance, friction_bounds=friction_bounds)
+        params = _params(newton=newton, dantzig=dantzig, lemke=lemke)
+        return Result(**self._core.solve(solver, options, params, g))
 
     def __repr__(self) -> str:
         storage = "sparse" if self.is_sparse else "dense"
@@ -193,14 +202,27 @@ class Problem:
 
 def solve(A: Any, b: Any = None, lo: Any = None, hi: Any = None, findex: Any = None,
           solver: str = "auto", tol: float = 1e-10, guess: Any = None, max_iter: int = 1000,
-          relaxation: float = 1.0, time_budget: float = 0.0) -> Result:
+          relaxation: float = 1.0, time_budget: float = 0.0, max_pivots: int = 0,
+          check_every: int = 1, pivot_tolerance: float = 1e-12, friction_bounds: str = "exact",
+          newton: Optional[Mapping[str, Any]] = None, dantzig: Optional[Mapping[str, Any]] = None,
+          lemke: Optional[Mapping[str, Any]] = None) -> Result:
     """Solves w = A x + b, lo <= x <= hi (findex) with the named solver ("auto" chooses).
 
-    A may also be a Problem (then b, lo, hi and findex are not given). tol is the target of the
-    scaled natural-map residual, max_iter the sweep (or outer iteration) limit, relaxation the
-    SOR factor of gs/pgs, time_budget the wall-clock limit in seconds (0: none; when it runs
-    out the best answer so far comes back as "time-limit"). A result that did not reach tol
-    says so in its status.
+    A may also be a Problem (then b, lo, hi and findex are not given). The settings are those of
+    `mlcp solve`, snake_case, with its defaults and checks: tol is the target of the scaled
+    natural-map residual, max_iter the sweep (or outer iteration) limit, relaxation the SOR
+    factor of gs/pgs, time_budget the wall-clock limit in seconds (0: none; when it runs out the
+    best answer so far comes back as "time-limit"), max_pivots the pivot limit of pivoting
+    methods (0: 50 n + 100), check_every the sweeps between residual checks of iterative
+    methods, pivot_tolerance the pivot magnitude treated as zero, friction_bounds "exact" or
+    "fixed-once" (stock ODE's and Bullet's friction handling).
+
+    newton, dantzig and lemke are dicts of that solver's typed parameters (`mlcp solve --newton
+    KEY=VALUE,...`; names and defaults in the stub, mlcp/__init__.pyi), e.g.
+    newton={"pivoting_steps": 0, "cold_sweeps": 0}; they apply wherever that solver runs (named,
+    in a chain "a>b", or chosen by auto). An unknown name or a value out of range raises
+    ValueError naming it; a value that is not a number or a bool raises TypeError. A result that
+    did not reach tol says so in its status.
     """
     if isinstance(A, Problem):
         if b is not None or lo is not None or hi is not None or findex is not None:
@@ -208,7 +230,28 @@ def solve(A: Any, b: Any = None, lo: Any = None, hi: Any = None, findex: Any = N
         problem = A
     else:
         problem = Problem(A, b, lo, hi, findex)
-    return problem.solve(solver, tol, guess, max_iter, relaxation, time_budget)
+    return problem.solve(solver, tol, guess, max_iter, relaxation, time_budget, max_pivots,
+                         check_every, pivot_tolerance, friction_bounds, newton, dantzig, lemke)
+
+
+def _params(**groups: Optional[Mapping[str, Any]]) -> List[Tuple[str, str, float, str]]:
+    """The typed parameters given as (solver, name, value, value as written), checked for their
+    types here and for their names and values by the C++ side (the CLI's checks)."""
+    out = []
+    for solver, given in groups.items():
+        if given is None:
+            continue
+        if not isinstance(given, Mapping):
+            raise TypeError(f"{solver} must be a dict of parameter names to values, "
+                            f"not {type(given).__name__}")
+        for key, value in given.items():
+            if not isinstance(key, str):
+                raise TypeError(f"{solver}: parameter names are str, not {key!r}")
+            if not isinstance(value, (numbers.Real, np.bool_)):
+                raise TypeError(f"{solver}: {key} must be a number or a bool, "
+                                f"not {type(value).__name__}")
+            out.append((solver, key, float(value), str(value)))
+    return out
 
 
 _RUN_COLUMNS = ("solver_ms", "step_ms", "residual", "iterations", "status", "fallbacks", "choice",

@@ -2,7 +2,7 @@
 # python/tests/test_stubs.py checks that every public name and signature here matches the module.
 import concurrent.futures
 import os
-from typing import Any, Dict, Iterable, List, Optional, Sequence, Union
+from typing import Any, Dict, Iterable, List, Literal, Optional, Sequence, TypedDict, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -13,6 +13,43 @@ _Vector = Optional[npt.ArrayLike]
 
 __all__ = ["Problem", "Result", "Run", "solve", "run", "solvers", "engines", "sweep",
            "stability"]
+
+# The typed solver parameters of solve() and Problem.solve() (`mlcp solve --newton KEY=VALUE,...`
+# with the names kebab-case), each with its default and accepted values; the fields of
+# NewtonParams, DantzigParams (core/include/mlcp/solvers/newton.hpp, dantzig.hpp) and LemkeSolver
+# (lemke.hpp). Any subset may be given; an unknown name or a value out of range raises ValueError.
+class _NewtonParams(TypedDict, total=False):
+    cold_sweeps: int  # 10, >= 0: pgs sweeps over a cold start
+    warm_sweeps: int  # 20, >= 0: pgs sweeps over a warm start above warm_sweeps_residual
+    warm_sweeps_residual: float  # 0.2, >= 0
+    dense_factor_max_rows: int  # 100, >= 0: most rows of the dense LU (above: sparse KLU)
+    proximal: float  # 1e-3, > 0: the proximal weight's start
+    proximal_max: float  # 1e3, > 0: its largest value
+    max_halvings: int  # 30, >= 0: line search halvings, dense path
+    sparse_max_halvings: int  # 12, >= 0: line search halvings, sparse path
+    step_sweeps: int  # 10, >= 0: pgs sweeps of the fallback step
+    max_stalls: int  # 3, >= 0: steps in a row without descent before the solve stops
+    max_stagnation: int  # 50, >= 0: steps in a row without a new best before it stops
+    nonmonotone_memory: int  # 1, >= 0: merits the line search compares with (0: monotone)
+    pivoting_steps: int  # 40, >= 0: block pivoting steps after damped steps end short (0: none)
+    body_pivoting_steps: int  # 120, >= 0: the same on an engine's rows
+    pivoting_woodbury_rows: int  # 16, >= 0: most sliding rows solved by Woodbury
+    pivoting_update_rows: int  # 40, >= 0: most changed rows for a factor update (0: refactor)
+    pivoting_descent_steps: int  # 8, >= 0: descending block steps not counted as stalls
+    pivoting_break_cycles: bool  # True, a flag: a 2-cycle of index sets hands over to damped steps
+
+class _DantzigParams(TypedDict, total=False):
+    breakdown_shift: float  # 1e-10, >= 0: shift of the retry after a breakdown, x max A_ii
+    anderson_depth: int  # 6, >= 0: normals' history of Anderson's extrapolation (friction)
+    anderson_stall: int  # 20, >= 0: passes without gain before damped iteration
+    stall_damping: float  # 0.3, in (0, 1]: damping factor of that iteration
+
+class _LemkeParams(TypedDict, total=False):
+    dense_rows: int  # 50, >= 0: most rows of the dense tableau (above: factored basis)
+    refactor_period: int  # 50, >= 1: pivots between refactorizations of the basis
+    max_rows: int  # 5000000, >= 1: largest problem accepted, rows
+
+_FrictionBounds = Literal["exact", "fixed-once"]
 
 class Result:
     x: npt.NDArray[np.float64]
@@ -57,13 +94,19 @@ class Problem:
     @property
     def findex(self) -> npt.NDArray[np.int32]: ...
     def solve(self, solver: str = "auto", tol: float = 1e-10, guess: _Vector = None,
-              max_iter: int = 1000, relaxation: float = 1.0,
-              time_budget: float = 0.0) -> Result: ...
+              max_iter: int = 1000, relaxation: float = 1.0, time_budget: float = 0.0,
+              max_pivots: int = 0, check_every: int = 1, pivot_tolerance: float = 1e-12,
+              friction_bounds: _FrictionBounds = "exact",
+              newton: Optional[_NewtonParams] = None, dantzig: Optional[_DantzigParams] = None,
+              lemke: Optional[_LemkeParams] = None) -> Result: ...
 
 def solve(A: Union[_Matrix, Problem], b: _Vector = None, lo: _Vector = None,
           hi: _Vector = None, findex: _Vector = None, solver: str = "auto", tol: float = 1e-10,
           guess: _Vector = None, max_iter: int = 1000, relaxation: float = 1.0,
-          time_budget: float = 0.0) -> Result: ...
+          time_budget: float = 0.0, max_pivots: int = 0, check_every: int = 1,
+          pivot_tolerance: float = 1e-12, friction_bounds: _FrictionBounds = "exact",
+          newton: Optional[_NewtonParams] = None, dantzig: Optional[_DantzigParams] = None,
+          lemke: Optional[_LemkeParams] = None) -> Result: ...
 
 class Run:
     scene: str

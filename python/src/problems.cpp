@@ -1,19 +1,24 @@
 // mlcp._mlcp.Problem (an mlcp::Problem whose vectors numpy reads in place), its files, and
 // solve by registry name. Errors the CLI reports as invalid input (Problem::validate()'s
 // message, a file's FormatError, an unknown solver name, a bad guess) raise ValueError with the
-// same message; numerical outcomes, converged or not, are a status in the returned dict.
+// same message; numerical outcomes, converged or not, are a status in the returned dict. The
+// solver settings are `mlcp solve`'s, checked by the same code (tools/mlcp/solver_settings.hpp).
 #include <nanobind/stl/optional.h>
 #include <nanobind/stl/string.h>
+#include <nanobind/stl/tuple.h>
 #include <nanobind/stl/vector.h>
 
 #include <optional>
+#include <stdexcept>
 #include <string>
+#include <tuple>
 #include <utility>
 
 #include "arrays.hpp"
 #include "bindings.hpp"
 #include "mlcp/io.hpp"
 #include "mlcp/registry.hpp"
+#include "mlcp/solver_settings.hpp"
 
 namespace mlcp::python {
 
@@ -92,16 +97,54 @@ nb::tuple csr(Problem& p) {
                         Array1<double>(a.valuePtr(), {nnz}, self));
 }
 
-nb::dict solve(const Problem& p, const std::string& name, double tol, int maxIter,
-               double relaxation, double timeBudget, const OptVector& guess) {
+// (solver, parameter, value, value as written): a typed parameter, e.g. ("newton",
+// "pivoting_steps", 0.0, "0").
+using ParamTuple = std::tuple<std::string, std::string, double, std::string>;
+
+// options[name] as a T; TypeError naming it otherwise.
+template <typename T>
+T option(const nb::dict& options, const char* name, const char* expected) {
+  try {
+    return nb::cast<T>(options[name]);
+  } catch (const nb::cast_error&) {
+    throw nb::type_error((std::string(name) + " must be " + expected).c_str());
+  }
+}
+
+// The settings of `mlcp solve`, checked by the same code (solver_settings.hpp); a bad one raises
+// ValueError with its message, "newton: " before a typed parameter's.
+cli::SolverSettings solveSettings(const nb::dict& options, const std::vector<ParamTuple>& params) {
+  cli::SolverSettings s;
+  s.tolerance = option<double>(options, "tol", "a number");
+  s.maxIterations = option<int>(options, "max_iter", "an int");
+  s.relaxation = option<double>(options, "relaxation", "a number");
+  s.timeBudget = option<double>(options, "time_budget", "a number");
+  s.maxPivots = option<int>(options, "max_pivots", "an int");
+  s.checkEvery = option<int>(options, "check_every", "an int");
+  s.pivotTolerance = option<double>(options, "pivot_tolerance", "a number");
+  s.frictionBounds = option<std::string>(options, "friction_bounds", "a str");
+  try {
+    cli::checkSettings(s);
+  } catch (const std::invalid_argument& e) {
+    throw nb::value_error(e.what());
+  }
+  for (const auto& [solver, key, value, text] : params) {
+    try {
+      cli::setSolverParam(s, solver, key, value, text, false);
+    } catch (const std::invalid_argument& e) {
+      throw nb::value_error((solver + ": " + e.what()).c_str());
+    }
+  }
+  return s;
+}
+
+nb::dict solve(const Problem& p, const std::string& name, const nb::dict& options,
+               const std::vector<ParamTuple>& params, const OptVector& guess) {
+  const cli::SolverSettings settings = solveSettings(options, params);
   std::string error;
   std::unique_ptr<Solver> solver = makeSolver(name, &error);
   if (!solver) throw nb::value_error(error.c_str());
-  Options& opt = solver->options();
-  opt.tolerance = tol;
-  opt.maxIterations = maxIter;
-  opt.relaxation = relaxation;
-  opt.timeBudget = timeBudget;
+  cli::applySettings(settings, *solver);
   Vector x;
   Result r;
   {
@@ -123,6 +166,22 @@ nb::dict solve(const Problem& p, const std::string& name, double tol, int maxIte
   out["bound_violation"] = r.boundViolation;
   out["seconds"] = r.seconds;
   out["fallbacks"] = r.fallbacks;
+  return out;
+}
+
+// Every typed parameter: (solver, name, kind "int" / "float" / "bool", default, accepted values,
+// what it is).
+using ParamInfo =
+    std::tuple<std::string, std::string, std::string, double, std::string, std::string>;
+
+std::vector<ParamInfo> solverParams() {
+  std::vector<ParamInfo> out;
+  for (const cli::SolverParam& p : cli::solverParams()) {
+    const std::unique_ptr<Solver> fresh = makeSolver(p.solver);
+    const bool flag = p.whole && p.lo == 0 && p.hi == 1;
+    out.emplace_back(p.solver, p.name, flag ? "bool" : (p.whole ? "int" : "float"), p.get(*fresh),
+                     p.range, p.help);
+  }
   return out;
 }
 
@@ -164,9 +223,10 @@ void bindProblems(nb::module_& m) {
           },
           nb::rv_policy::reference_internal)
       .def_prop_ro("csr", &csr)
-      .def("solve", &solve, nb::arg("solver"), nb::arg("tol"), nb::arg("max_iter"),
-           nb::arg("relaxation"), nb::arg("time_budget"), nb::arg("guess").none());
+      .def("solve", &solve, nb::arg("solver"), nb::arg("options"), nb::arg("params"),
+           nb::arg("guess").none());
   m.def("solver_names", &solverNames);
+  m.def("solver_params", &solverParams);
 }
 
 }  // namespace mlcp::python

@@ -1,11 +1,13 @@
 """mlcp.solve and mlcp.Problem on dense and sparse problems: answers checked independently."""
 
+import re
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
 
 import mlcp
-from conftest import SEED_M, SEED_Q, natural_map_residual
+from conftest import DATA, SEED_M, SEED_Q, cli, natural_map_residual
 
 
 def test_seed_lemke_example():
@@ -119,3 +121,140 @@ def test_bad_shapes_raise_value_error():
 def test_solvers_listed():
     names = mlcp.solvers()
     assert {"auto", "pgs", "dantzig", "lemke", "ldlt"} <= set(names)
+
+
+# The solver settings of `mlcp solve`: Options' fields and the typed parameters (newton=,
+# dantzig=, lemke=), checked by the same code as the CLI's options.
+
+
+def friction_problems(count=10, contacts=4, mu=0.8, seed=1):
+    """Random friction-coupled problems: per contact a normal row and two tangent rows bounded by
+    mu |x_normal|, A = J J^T + 0.1 I."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for _ in range(count):
+        n = 3 * contacts
+        J = rng.normal(size=(n, 8))
+        A, b = J @ J.T + 0.1 * np.eye(n), rng.normal(size=n)
+        lo, hi, findex = np.zeros(n), np.full(n, np.inf), np.full(n, -1)
+        for c in range(contacts):
+            for i in (3 * c + 1, 3 * c + 2):
+                lo[i], hi[i], findex[i] = -mu, mu, 3 * c
+        out.append((A, b, lo, hi, findex))
+    return out
+
+
+def test_newton_params_change_the_solve():
+    A, b = spd_tridiagonal(60), np.sin(np.arange(60))
+    default = mlcp.solve(A, b, solver="newton")
+    no_sweeps = mlcp.solve(A, b, solver="newton", newton={"cold_sweeps": 0})
+    many_sweeps = mlcp.Problem(A, b).solve(solver="newton", newton={"cold_sweeps": 50})
+    assert default.converged and no_sweeps.converged and many_sweeps.converged
+    # pgs sweeps before the first Newton step: without them more steps, with many none.
+    assert no_sweeps.iterations > default.iterations > many_sweeps.iterations == 0
+    np.testing.assert_allclose(no_sweeps.x, default.x, atol=1e-9)
+
+
+def test_dantzig_params_change_the_solve():
+    A, b, lo, hi, findex = friction_problems()[9]
+    default = mlcp.solve(A, b, lo, hi, findex, solver="dantzig")
+    plain = mlcp.solve(A, b, lo, hi, findex, solver="dantzig", dantzig={"anderson_depth": 1})
+    assert default.converged and plain.converged
+    assert plain.iterations != default.iterations  # no extrapolation of the friction bounds
+    assert natural_map_residual(A, b, lo, hi, plain.x, findex) < 1e-9
+
+
+def test_lemke_params_reach_the_solver_named_chained_or_chosen_by_auto():
+    named = mlcp.solve(SEED_M, SEED_Q, solver="lemke", lemke={"max_rows": 2})
+    assert named.status == "unsupported" and "maxRows = 2" in named.message
+    assert mlcp.solve(SEED_M, SEED_Q, solver="lemke").converged
+    # auto picks lemke (A_22 = 0) with newton behind it: newton answers when lemke refuses.
+    assert mlcp.solve(SEED_M, SEED_Q, solver="auto").solver == "lemke"
+    chosen = mlcp.solve(SEED_M, SEED_Q, solver="auto", lemke={"max_rows": 2})
+    assert chosen.converged and chosen.solver == "newton" and chosen.fallbacks == 1
+    chained = mlcp.solve(SEED_M, SEED_Q, solver="lemke>newton", lemke={"max_rows": 2})
+    assert chained.solver == "newton" and chained.fallbacks == 1
+
+
+def test_options_fields():
+    assert mlcp.solve(SEED_M, SEED_Q, solver="lemke").iterations == 3
+    r = mlcp.solve(SEED_M, SEED_Q, solver="lemke", max_pivots=1)
+    assert r.status == "max-iterations" and r.iterations == 1
+    A, b = spd_tridiagonal(60), np.sin(np.arange(60))
+    every = mlcp.solve(A, b, solver="pgs", max_iter=5000).iterations
+    fifth = mlcp.solve(A, b, solver="pgs", max_iter=5000, check_every=5).iterations
+    assert every % 5 != 0 and fifth == -(-every // 5) * 5  # checked every 5th sweep only
+    A, b, lo, hi, findex = friction_problems()[0]
+    assert mlcp.solve(A, b, lo, hi, findex, solver="dantzig").converged
+    stock = mlcp.solve(A, b, lo, hi, findex, solver="dantzig", friction_bounds="fixed-once")
+    assert stock.status == "failed"  # bounds fixed from an intermediate normal, as ODE's
+
+
+def test_flags_and_numpy_values_are_accepted():
+    A, b = spd_tridiagonal(30), np.sin(np.arange(30))
+    r = mlcp.solve(A, b, solver="newton",
+                   newton={"pivoting_break_cycles": False, "pivoting_steps": np.int64(0),
+                           "proximal": np.float64(1e-2)})
+    assert r.converged
+    for solver, name, kind, default, _, _ in mlcp._mlcp.solver_params():  # defaults accepted
+        value = bool(default) if kind == "bool" else (int(default) if kind == "int" else default)
+        assert mlcp.solve(A, b, solver=solver, **{solver: {name: value}}).converged, name
+
+
+@pytest.mark.parametrize(
+    "kwargs, error, message",
+    [
+        (dict(newton={"pivoting_stepz": 1}), ValueError,
+         "newton: unknown parameter 'pivoting_stepz' (closest: pivoting_steps; known: cold_sweeps"),
+        (dict(lemke={"cold_sweeps": 1}), ValueError, "lemke: unknown parameter 'cold_sweeps'"),
+        (dict(newton={"cold_sweeps": -1}), ValueError,
+         "newton: cold_sweeps: expected a whole number >= 0, got '-1'"),
+        (dict(newton={"cold_sweeps": 2.5}), ValueError, "expected a whole number >= 0, got '2.5'"),
+        (dict(dantzig={"stall_damping": 0}), ValueError,
+         "dantzig: stall_damping: expected a number in (0, 1], got '0'"),
+        (dict(lemke={"refactor_period": 0}), ValueError,
+         "refactor_period: expected a whole number >= 1"),
+        (dict(check_every=0), ValueError, "check_every: expected a whole number >= 1, got '0'"),
+        (dict(max_pivots=-2), ValueError, "max_pivots: expected a whole number >= 0, got '-2'"),
+        (dict(pivot_tolerance=2.0), ValueError, "pivot_tolerance: expected a number in [0, 1]"),
+        (dict(friction_bounds="fixed"), ValueError,
+         "friction_bounds: expected exact or fixed-once, got 'fixed'"),
+        (dict(tol=-1.0), ValueError, "tol: expected a number in [1e-300, 1e300], got '-1'"),
+        (dict(newton=[("cold_sweeps", 1)]), TypeError, "newton must be a dict"),
+        (dict(newton={"cold_sweeps": "1"}), TypeError, "cold_sweeps must be a number or a bool"),
+        (dict(newton={1: 1}), TypeError, "parameter names are str"),
+        (dict(max_pivots=1.5), TypeError, "max_pivots must be an int"),
+        (dict(newtn={"cold_sweeps": 1}), TypeError, "newtn"),
+    ],
+)
+def test_bad_settings_raise_naming_the_setting(kwargs, error, message):
+    with pytest.raises(error, match=re.escape(message)):
+        mlcp.solve(SEED_M, SEED_Q, solver="newton", **kwargs)
+
+
+@pytest.mark.parametrize(
+    "python, cli_args, message",
+    [
+        (dict(newton={"cold_sweeps": -1}), ["--newton", "cold_sweeps=-1"],
+         "cold_sweeps: expected a whole number >= 0, got '-1'"),
+        (dict(dantzig={"stall_damping": 2}), ["--dantzig", "stall-damping=2"],
+         "expected a number in (0, 1], got '2'"),
+        (dict(check_every=0), ["--check-every", "0"], "expected a whole number >= 1, got '0'"),
+        (dict(friction_bounds="x"), ["--friction-bounds", "x"],
+         "expected exact or fixed-once, got 'x'"),
+    ],
+)
+def test_the_cli_refuses_the_same_values_with_the_same_words(python, cli_args, message):
+    with pytest.raises(ValueError, match=re.escape(message)):
+        mlcp.solve(SEED_M, SEED_Q, **python)
+    code, _, err = cli("solve", DATA / "seed_lemke.json", *cli_args)
+    assert code == 2 and message in err, err
+
+
+def test_the_cli_takes_the_same_parameters():
+    code, out, _ = cli("solve", DATA / "seed_lemke.json", "--solver", "lemke", "--lemke",
+                       "max-rows=2")
+    assert code == 1 and "unsupported" in out
+    code, out, _ = cli("solve", DATA / "seed_lemke.json", "--solver", "auto", "--lemke",
+                       "max-rows=2,dense-rows=0", "--newton", "cold-sweeps=0")
+    assert code == 0 and "-> lemke>newton): converged" in out

@@ -61,3 +61,19 @@ def test_class_members_match():
             if isinstance(attr, classmethod):
                 names = ["cls"] + names
             assert stub_params(node) == (names, defaults), f"{cls_name}.{name}"
+
+
+def test_typed_solver_parameters_are_stubbed_with_their_types_and_defaults():
+    """_NewtonParams, _DantzigParams and _LemkeParams list every typed parameter the module
+    takes, with its type and, first in its comment, its default."""
+    lines = STUB.read_text().splitlines()
+    stubs = stub_tree()
+    stubbed = {}
+    for solver in ("newton", "dantzig", "lemke"):
+        for node in stubs[f"_{solver.capitalize()}Params"].body:
+            if isinstance(node, ast.AnnAssign):
+                default = lines[node.lineno - 1].split("#", 1)[1].split(",")[0].strip()
+                stubbed[(solver, node.target.id)] = (node.annotation.id, ast.literal_eval(default))
+    actual = {(solver, name): (kind, default)
+              for solver, name, kind, default, _, _ in mlcp._mlcp.solver_params()}
+    assert stubbed == actual

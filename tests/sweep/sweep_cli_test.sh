@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `mlcp sweep` and `mlcp chart` as a user runs them: the tidy CSV's header, rows and columns;
-# stock solvers that ignore the swept setting run once; exit 2 with a clear message on bad
-# arguments; charts drawn from the sweep when the venv exists. Prints "N passed, N failed".
+# stock solvers that ignore the swept setting run once; --jobs gives the serial sweep's rows;
+# exit 2 with a clear message on bad arguments; charts drawn from the sweep when the venv
+# exists. Prints "N passed, N failed".
 #   sweep_cli_test.sh MLCP SCENES_DIR REPO
 set -u
 mlcp=$1 scenes=$2 repo=$3
@@ -70,6 +71,44 @@ printf 'scene,engine\n' > "$tmp/other.csv"
 check sweep-append-other 2 "other.csv is not a sweep CSV" -- \
   "$mlcp" sweep "$scenes/resting_box.json" --values 5 --steps 1 --append --csv "$tmp/other.csv"
 
+# --jobs: every run in a worker process of its own; the rows, their order and every column but
+# the times (solver_ms, step_ms: fields 8 and 9) are the serial sweep's, repeats and stock
+# solvers (run once, skipped in the other engine) included.
+same_rows() {  # same_rows NAME SERIAL_CSV JOBS_CSV
+  if [ -s "$2" ] && diff <(cut -d, -f1-7,10- "$2") <(cut -d, -f1-7,10- "$3") > "$tmp/rows.diff"; then
+    passed=$((passed + 1))
+  else
+    failed=$((failed + 1)); echo "FAIL $1: --jobs changed the rows:"; head -5 "$tmp/rows.diff" | sed 's/^/    /'
+  fi
+}
+jobs_sweep=("$scenes/resting_box.json" "$scenes/stack_10.json" --solvers pgs,dantzig,bullet-si,ode-quick
+            --values 3,8 --steps 4)
+check sweep-jobs-serial 0 'wrote' -- "$mlcp" sweep "${jobs_sweep[@]}" --csv "$tmp/j1.csv"
+check sweep-jobs-2 0 'wrote' -- "$mlcp" sweep "${jobs_sweep[@]}" --jobs 2 --csv "$tmp/j2.csv"
+same_rows sweep-jobs-2-rows "$tmp/j1.csv" "$tmp/j2.csv"
+check sweep-jobs-all-cores 0 'wrote' -- "$mlcp" sweep "${jobs_sweep[@]}" --jobs 0 --csv "$tmp/j0.csv"
+same_rows sweep-jobs-0-rows "$tmp/j1.csv" "$tmp/j0.csv"
+check sweep-jobs-repeat 0 "x 3 passes" -- "$mlcp" sweep "$scenes/resting_box.json" --solvers pgs,dantzig \
+  --setting iterations --values 5,10 --steps 3 --repeat 3 --jobs 3 --csv "$tmp/rj.csv"
+same_rows sweep-jobs-repeat-rows "$tmp/r.csv" "$tmp/rj.csv"
+if tr ',' '\n' <<< "$engines" | grep -qx ode; then
+  # A run that throws in a worker (this ODE may have no cylinder-cylinder collider): the serial
+  # sweep's exit code, message and rows up to it, whichever it is.
+  printf '%s' '{"format": "mlcp-scene/1", "bodies": [
+    {"name": "a", "shape": {"type": "cylinder", "radius": 0.5, "length": 0.2}, "mass": 1, "position": [0, 0, 0]},
+    {"name": "b", "shape": {"type": "cylinder", "radius": 0.5, "length": 0.2}, "mass": 1, "position": [0, 0, 0.25]}]}' > "$tmp/cylinders.json"
+  throwing=("$scenes/resting_box.json" "$tmp/cylinders.json" "$scenes/stack_10.json" --engines ode
+            --solvers pgs,dantzig --values 5 --steps 30)
+  "$mlcp" sweep "${throwing[@]}" --csv "$tmp/e1.csv" > /dev/null 2> "$tmp/e1.err"; e1=$?
+  "$mlcp" sweep "${throwing[@]}" --jobs 2 --csv "$tmp/e2.csv" > /dev/null 2> "$tmp/e2.err"; e2=$?
+  if [ "$e1" -eq "$e2" ] && [ "$(grep '^mlcp' "$tmp/e1.err")" = "$(grep '^mlcp' "$tmp/e2.err")" ]; then
+    passed=$((passed + 1))
+  else
+    failed=$((failed + 1)); echo "FAIL sweep-jobs-error: exit $e1 / $e2:"; grep -h '^mlcp' "$tmp/e1.err" "$tmp/e2.err"
+  fi
+  same_rows sweep-jobs-error-rows "$tmp/e1.csv" "$tmp/e2.csv"
+fi
+
 bad() {  # bad NAME PATTERN sweep-arguments...
   local name=$1 pattern=$2; shift 2
   check "$name" 2 "$pattern" -- "$mlcp" sweep "$scenes/resting_box.json" --steps 1 --csv "$tmp/bad.csv" "$@"
@@ -82,6 +121,7 @@ bad fractional-iterations "'2.5' is not a whole number of iterations" --values 5
 bad negative-tolerance "'-1e-6' is not a positive tolerance" --setting tolerance --values -1e-6
 bad missing-values "--values is required" --solvers pgs
 bad repeat-zero "--repeat: Value 0 not in range" --values 5 --repeat 0
+bad jobs-negative "--jobs: Value -1 not in range" --values 5 --jobs -1
 check missing-scene 2 'nope.json' -- "$mlcp" sweep "$tmp/nope.json" --values 5 --csv "$tmp/bad.csv"
 
 # mlcp chart: a clear message without Python; bad CSVs pass through as exit 2; charts drawn.

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "mlcp/result.hpp"
+#include "solver_settings.hpp"
 
 namespace mlcp::cli {
 
@@ -27,13 +28,9 @@ Runner addChartCommand(CLI::App& app);
 // (1: no Python or script).
 int runChart(const std::vector<std::string>& args);
 
-// Shared by subcommands that take solver settings.
-struct SolverSettings {
-  double tolerance = 1e-10;
-  int maxIterations = 1000;
-  double relaxation = 1.0;
-  double timeBudget = 0;  // seconds, 0 for none (Options::timeBudget)
-};
+// The options of the solver settings (solver_settings.hpp), shared by solve and table: --tol,
+// --max-iter, --relaxation, --time-budget, --max-pivots, --check-every, --pivot-tolerance,
+// --friction-bounds, and the typed parameters as --newton / --dantzig / --lemke KEY=VALUE,...
 void addSolverSettings(CLI::App& cmd, SolverSettings& s);
 
 // Option checks with one-line messages that echo at most a few characters of the value
@@ -41,6 +38,5 @@ void addSolverSettings(CLI::App& cmd, SolverSettings& s);
 // a number in [1e-300, 1e300] (positive), or in [0, 1e300] (non-negative).
 CLI::Validator positiveNumber();
 CLI::Validator nonNegativeNumber();
-void applySettings(const SolverSettings& s, Options& options);
 
 }  // namespace mlcp::cli

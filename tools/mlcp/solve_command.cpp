@@ -1,4 +1,7 @@
-// mlcp solve FILE --solver NAME [--tol T] [--max-iter N] [--guess X.json] [--json]
+// mlcp solve FILE --solver NAME [--tol T] [--max-iter N] [--guess X.json] [--json]: one problem
+// file solved, with every solver setting of solver_settings.hpp (Options' fields and the typed
+// parameters, e.g. --newton pivoting-steps=0,cold-sweeps=0).
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -17,14 +20,8 @@ namespace {
 CLI::Validator numberIn(double lo, double hi, const std::string& range) {
   return CLI::Validator(
       [lo, hi, range](std::string& text) -> std::string {
-        std::size_t used = 0;
-        double v = 0;
-        try {
-          v = std::stod(text, &used);
-        } catch (const std::exception&) {
-          used = 0;
-        }
-        if (used != 0 && used == text.size() && v >= lo && v <= hi) return "";
+        const double v = io::parseNumber(text);
+        if (v >= lo && v <= hi) return "";
         return "expected a number in " + range + ", got '" + io::capped(text, 24) + "'";
       },
       range);
@@ -34,6 +31,43 @@ CLI::Validator numberIn(double lo, double hi, const std::string& range) {
 
 CLI::Validator positiveNumber() { return numberIn(1e-300, 1e300, "[1e-300, 1e300]"); }
 CLI::Validator nonNegativeNumber() { return numberIn(0, 1e300, "[0, 1e300]"); }
+
+namespace {
+
+// An option of Options' fields checked as solver_settings.hpp checks them (Python's name).
+CLI::Validator settingCheck(const std::string& name) {
+  return CLI::Validator(
+      [name](std::string& text) -> std::string {
+        return settingError(name, io::parseNumber(text), text);
+      },
+      "");
+}
+
+// --newton / --dantzig / --lemke KEY=VALUE,...: each assignment checked as it is parsed.
+void addParamOption(CLI::App& cmd, SolverSettings& s, const std::string& solver) {
+  cmd.add_option_function<std::vector<std::string>>(
+         "--" + solver,
+         [&s, solver](const std::vector<std::string>& list) {
+           for (const std::string& a : list) setSolverParam(s, solver, a);
+         },
+         solver + "'s parameters, KEY=VALUE,... (a flag: true or false; wherever " + solver +
+             " runs: named, in a chain or chosen by auto), with their defaults: " +
+             paramList(solver, true))
+      ->delimiter(',')
+      ->check(CLI::Validator(
+          [solver](std::string& a) -> std::string {
+            SolverSettings scratch;
+            try {
+              setSolverParam(scratch, solver, a);
+            } catch (const std::invalid_argument& e) {
+              return e.what();
+            }
+            return "";
+          },
+          "KEY=VALUE"));
+}
+
+}  // namespace
 
 void addSolverSettings(CLI::App& cmd, SolverSettings& s) {
   cmd.add_option("--tol", s.tolerance, "target scaled natural-map residual")
@@ -50,13 +84,24 @@ void addSolverSettings(CLI::App& cmd, SolverSettings& s) {
                  "best answer so far is returned with status time-limit")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-}
-
-void applySettings(const SolverSettings& s, Options& options) {
-  options.tolerance = s.tolerance;
-  options.maxIterations = s.maxIterations;
-  options.relaxation = s.relaxation;
-  options.timeBudget = s.timeBudget;
+  cmd.add_option("--max-pivots", s.maxPivots,
+                 "pivot limit of pivoting methods (per friction pass for dantzig), 0: 50 n + 100")
+      ->check(settingCheck("max_pivots"))
+      ->capture_default_str();
+  cmd.add_option("--check-every", s.checkEvery,
+                 "iterative methods check the residual every this many sweeps")
+      ->check(settingCheck("check_every"))
+      ->capture_default_str();
+  cmd.add_option("--pivot-tolerance", s.pivotTolerance,
+                 "pivots below this (relative to max A_ii) count as zero, in [0, 1]")
+      ->check(settingCheck("pivot_tolerance"))
+      ->capture_default_str();
+  cmd.add_option("--friction-bounds", s.frictionBounds,
+                 "friction rows' bounds: exact, or fixed-once (fixed from an intermediate "
+                 "normal, as stock ODE and Bullet do)")
+      ->check(settingCheck("friction_bounds"))
+      ->capture_default_str();
+  for (const char* solver : {"newton", "dantzig", "lemke"}) addParamOption(cmd, s, solver);
 }
 
 namespace {
@@ -96,8 +141,8 @@ int runSolve(const SolveArgs& args) {
     std::cerr << "mlcp solve: " << e.what() << "\n";
     return kInvalidInput;
   }
-  Options& opt = solver->options();
-  applySettings(args.settings, opt);
+  const Options& opt = solver->options();
+  applySettings(args.settings, *solver);
   Vector x;
   Result r =
       args.guess.empty() ? solver->solve(problem, x) : solver->solveWithGuess(problem, guess, x);

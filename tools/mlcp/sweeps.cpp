@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <iomanip>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
 
 #include "mlcp/input_limits.hpp"
 
@@ -22,6 +24,43 @@ bool sameStep(const scene::StepMeasures& a, const scene::StepMeasures& b) {
          same(a.maxPenetration, b.maxPenetration) && same(a.energy, b.energy);
 }
 
+// Numbers (their bytes as in memory: parent and child are the same program) and strings
+// (length, then the characters) appended to one string, and read back in the same order.
+struct ByteWriter {
+  std::string bytes;
+  template <typename T>
+  ByteWriter& number(T v) {
+    static_assert(std::is_arithmetic_v<T>);
+    bytes.append(reinterpret_cast<const char*>(&v), sizeof v);
+    return *this;
+  }
+  ByteWriter& text(const std::string& s) {
+    number(s.size());
+    bytes += s;
+    return *this;
+  }
+};
+
+struct ByteReader {
+  const std::string& bytes;
+  std::size_t at = 0;
+  bool ok = true;  // false once a read ran past the end
+  template <typename T>
+  ByteReader& number(T& v) {
+    static_assert(std::is_arithmetic_v<T>);
+    ok = ok && bytes.size() - at >= sizeof v;
+    if (ok) std::memcpy(&v, bytes.data() + at, sizeof v), at += sizeof v;
+    return *this;
+  }
+  ByteReader& text(std::string& s) {
+    std::size_t n = 0;
+    number(n);
+    ok = ok && bytes.size() - at >= n;
+    if (ok) s.assign(bytes, at, n), at += n;
+    return *this;
+  }
+};
+
 bool isStock(const std::string& solver) {
   return solver.rfind("bullet-", 0) == 0 || solver.rfind("ode-", 0) == 0;
 }
@@ -37,16 +76,9 @@ std::vector<double> parseValues(const SweepSpec& spec) {
   for (const std::string& text : spec.values) {
     if (text.empty())
       throw std::invalid_argument("--values: an empty value (give e.g. --values 5,10,20)");
-    std::size_t used = 0;
-    double v = std::nan("");
-    try {
-      v = std::stod(text, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
+    const double v = io::parseNumber(text);
     const bool whole = std::isfinite(v) && v == std::floor(v) && v >= 1 && v <= 1e9;
-    if (used == 0 || used != text.size() || !std::isfinite(v) ||
-        (spec.setting == "iterations" ? !whole : v <= 0))
+    if (!std::isfinite(v) || (spec.setting == "iterations" ? !whole : v <= 0))
       throw std::invalid_argument("--values: '" + io::capped(text, 24) + "' is not " +
                                   (spec.setting == "iterations"
                                        ? "a whole number of iterations >= 1"
@@ -155,24 +187,72 @@ void runSweepPass(const SweepSpec& spec, const scene::Scene& s, const SweepCombo
                   SweepRun& run, const std::function<void(const scene::World&, int)>& onStep) {
   std::unique_ptr<scene::World> world = makeWorld(combo.engine, s, comboSettings(spec, s, combo));
   const int steps = spec.steps >= 0 ? spec.steps : s.settings.steps;
-  const int pass = run.passes++;
-  const bool first = pass == 0;
-  bool matching = true;  // this pass's steps still match the first pass's
-  const RunSummary sum = runWorld(*world, steps, [&](const scene::World& w, int i) {
-    const scene::StepMeasures& m = w.last();
-    if (first) {
-      if (i == 0) run.scene = w.scene().name, run.engine = w.engine();
-      run.steps.push_back(m);
-    } else if (matching && i < static_cast<int>(run.steps.size()) && sameStep(run.steps[i], m)) {
-      run.steps[i].solverMs = std::min(run.steps[i].solverMs, m.solverMs);
-      run.steps[i].stepMs = std::min(run.steps[i].stepMs, m.stepMs);
-    } else if (matching) {
-      matching = false;
-      run.differing.emplace_back(pass, i);
-    }
+  SweepRun pass;
+  pass.passes = 1;
+  pass.first = runWorld(*world, steps, [&](const scene::World& w, int i) {
+    if (i == 0) pass.scene = w.scene().name, pass.engine = w.engine();
+    pass.steps.push_back(w.last());
     if (onStep) onStep(w, i);
   });
-  if (first) run.first = sum;
+  addSweepPass(run, std::move(pass));
+}
+
+void addSweepPass(SweepRun& run, SweepRun&& pass) {
+  const int index = run.passes++;
+  if (index == 0) {
+    run.scene = std::move(pass.scene);
+    run.engine = std::move(pass.engine);
+    run.steps = std::move(pass.steps);
+    run.first = pass.first;
+    return;
+  }
+  for (std::size_t i = 0; i < pass.steps.size(); ++i) {
+    const scene::StepMeasures& m = pass.steps[i];
+    if (i >= run.steps.size() || !sameStep(run.steps[i], m)) {
+      run.differing.emplace_back(index, static_cast<int>(i));
+      return;
+    }
+    run.steps[i].solverMs = std::min(run.steps[i].solverMs, m.solverMs);
+    run.steps[i].stepMs = std::min(run.steps[i].stepMs, m.stepMs);
+  }
+}
+
+std::string encodeSweepRun(const SweepRun& run) {
+  ByteWriter out;
+  out.text(run.scene).text(run.engine);
+  const RunSummary& f = run.first;
+  out.number(f.steps).number(f.meanSolverMs).number(f.meanStepMs).number(f.worstResidual);
+  out.number(f.maxPenetration).number(f.maxJointError).number(f.maxSpeed).number(f.fallbacks);
+  out.number(f.unconverged).number(f.failedSteps).number(f.finite);
+  out.number(run.steps.size());
+  for (const scene::StepMeasures& m : run.steps) {
+    out.number(m.solverMs).number(m.stepMs).number(m.residual).number(m.iterations);
+    out.text(m.status).number(m.fallbacks).number(m.unsolved).text(m.choice).number(m.contacts);
+    out.number(m.maxPenetration).number(m.jointError).number(m.energy).number(m.momentum);
+    out.number(m.maxSpeed);
+  }
+  return out.bytes;
+}
+
+bool decodeSweepRun(const std::string& bytes, SweepRun& run) {
+  ByteReader in{bytes};
+  run = SweepRun();
+  run.passes = 1;
+  in.text(run.scene).text(run.engine);
+  RunSummary& f = run.first;
+  in.number(f.steps).number(f.meanSolverMs).number(f.meanStepMs).number(f.worstResidual);
+  in.number(f.maxPenetration).number(f.maxJointError).number(f.maxSpeed).number(f.fallbacks);
+  in.number(f.unconverged).number(f.failedSteps).number(f.finite);
+  std::size_t n = 0;
+  in.number(n);
+  for (std::size_t i = 0; i < n && in.ok; ++i) {
+    scene::StepMeasures& m = run.steps.emplace_back();
+    in.number(m.solverMs).number(m.stepMs).number(m.residual).number(m.iterations);
+    in.text(m.status).number(m.fallbacks).number(m.unsolved).text(m.choice).number(m.contacts);
+    in.number(m.maxPenetration).number(m.jointError).number(m.energy).number(m.momentum);
+    in.number(m.maxSpeed);
+  }
+  return in.ok && in.at == bytes.size();
 }
 
 }  // namespace mlcp::cli

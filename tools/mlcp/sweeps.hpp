@@ -84,9 +84,20 @@ struct SweepRun {
   int passes = 0;
 };
 
-// Runs one pass of `combo` in its scene `s` and adds it to `run`; onStep(world, i) after each
-// step. Throws std::invalid_argument if the world cannot be made.
+// Runs one pass of `combo` in its scene `s` and adds it to `run` (addSweepPass); onStep(world,
+// i) after each step. Throws std::invalid_argument if the world cannot be made.
 void runSweepPass(const SweepSpec& spec, const scene::Scene& s, const SweepCombo& combo,
                   SweepRun& run, const std::function<void(const scene::World&, int)>& onStep = {});
+
+// Adds `pass`, a run of one pass (passes == 1), to `run`: the first pass is taken whole; a later
+// one lowers the times of the steps that match the first pass's, up to the first that does not
+// (recorded in run.differing). Passes added in the same order give the same run wherever each
+// pass ran (`mlcp sweep --jobs` runs them in child processes).
+void addSweepPass(SweepRun& run, SweepRun&& pass);
+
+// A one-pass run as bytes and back, for a child process to hand its pass to its parent: the
+// numbers bit for bit. decodeSweepRun returns false when the bytes are not a whole encoding.
+std::string encodeSweepRun(const SweepRun& run);
+bool decodeSweepRun(const std::string& bytes, SweepRun& run);
 
 }  // namespace mlcp::cli

@@ -94,7 +94,7 @@ int runTable(const TableArgs& args) {
         std::fprintf(stderr, "mlcp table: %s\n", error.c_str());
         return kInvalidInput;
       }
-      applySettings(args.settings, solver->options());
+      applySettings(args.settings, *solver);
       Vector x;
       rows.push_back({baseName(file), problem.size(), name, solver->solve(problem, x)});
       unsolved += rows.back().result.converged() ? 0 : 1;

@@ -59,4 +59,8 @@ std::string jsonErrorText(const std::exception& e);
 // maxChars - 3 characters and "...".
 std::string capped(const std::string& s, std::size_t maxChars = kMaxEchoChars);
 
+// text read whole as a number (std::stod: decimal, hex, inf, nan), NaN when it is empty or
+// anything follows the number: what command-line values are checked with.
+double parseNumber(const std::string& text);
+
 }  // namespace mlcp::io

@@ -11,8 +11,9 @@
 //     lo_i < x_i < hi_i =>  w_i  = 0.
 //
 // lo may be -inf and hi +inf. A row with (-inf, +inf) is an equality (a bilateral joint row);
-// (0, +inf) is a standard LCP row. This is the seed's `Ax + b >= 0` form. ODE and Bullet
-// write `A x = b + w`: their b is minus ours, and the conversion happens in the adapters only.
+// (0, +inf) is a standard LCP row. This is the `Ax + b >= 0` form of the LCP literature. ODE and
+// Bullet write `A x = b + w`: their b is minus ours, and the conversion happens in the adapters
+// only.
 //
 // Friction coupling: findex[i] = j >= 0 makes row i's effective bounds
 //

@@ -39,8 +39,8 @@ class Solver {
   }
 
   // Whether a solve reads the clock for Result::seconds. Default true. A caller that times the
-  // solve itself turns it off (RowSolver: the two reads cost ~0.13 us on a virtual machine, a
-  // tenth of a 6-row island's solve); Result::seconds is then 0. Time budgets are unaffected.
+  // solve itself turns it off (RowSolver: the two reads are a tenth of a 6-row island's
+  // solve); Result::seconds is then 0. Time budgets are unaffected.
   Solver& setTimed(bool timed) {
     timed_ = timed;
     return *this;

@@ -59,11 +59,12 @@ namespace {
 
 // The chain for these names, made once and kept so that workspaces are reused.
 Solver* cachedChain(std::vector<std::pair<std::string, std::unique_ptr<Solver>>>& cache,
-                    const std::string& chain) {
+                    const std::string& chain, const std::function<void(Solver&)>& configure) {
   for (auto& [key, solver] : cache)
     if (key == chain) return solver.get();
   std::unique_ptr<Solver> solver = makeSolver(chain);
   if (!solver) return nullptr;
+  if (configure) configure(*solver);
   cache.emplace_back(chain, std::move(solver));
   return cache.back().second.get();
 }
@@ -95,7 +96,7 @@ void AutoSolver::run(const Problem& problem, Vector& x, Result& result) {
   std::string chain;
   for (const char* name : {choice.solver, choice.fallback})
     if (registered(name)) chain += (chain.empty() ? "" : ">") + std::string(name);
-  Solver* solver = chain.empty() ? nullptr : cachedChain(cache_, chain);
+  Solver* solver = chain.empty() ? nullptr : cachedChain(cache_, chain, configure);
   const std::string why = std::string(choice.why) + ", " + toString(c) + ", " +
                           std::to_string(problem.size()) + " rows";
   if (!solver) {

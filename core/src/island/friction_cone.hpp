@@ -1,5 +1,5 @@
 // core/src/island/friction_cone.hpp (internal): contact friction as a polyhedral cone, a standard
-// LCP (seed notes 3.2.2).
+// LCP (Stewart and Trinkle 1996, Anitescu and Potra 1997).
 //
 // Engines model friction as a box: per contact a normal row n and one or two tangent rows t1, t2
 // with findex pointing at n, bounded by -mu x_n .. mu x_n each. The box is cheap for pgs and
@@ -35,11 +35,8 @@
 // suits pivoting (lemke), not pgs. toBox() maps an answer back to the engine's rows: the
 // normal impulse, and t1 = sum_j beta_j cos(theta_j), t2 = sum_j beta_j sin(theta_j).
 //
-// The two ends of mu, where the cone degenerates: mu = 0 is no friction (the polygon is a
-// point), so the contact's tangent rows answer 0 and its normal stays as a plain LCP row, without
-// k + 1 unknowns that could only be 0 (counted by frictionless()). mu = +inf (no slip, ODE's
-// dInfinity) never reaches it with findex: rows with findex need a finite mu (problem.hpp), and
-// the ODE adapter hands such contacts over as free tangent rows, which are kept as they are.
+// mu = 0: the tangent rows answer 0 and the normal stays a plain LCP row (frictionless()).
+// mu = +inf never reaches it (findex needs a finite mu; ODE's dInfinity arrives as free rows).
 //
 // Contacts the cone cannot express are refused with a reason, and the caller keeps the box:
 // more than two friction rows on one normal (Bullet's rolling friction), two tangents with

@@ -543,6 +543,79 @@ IslandSolve RowSolver::Impl::solve(const RowSystem& rows, const Vector& start, V
   return out;
 }
 
+// An island without rows: answer "none", converged.
+IslandSolve RowSolver::Impl::noRows(Vector& x) {
+  IslandSolve out;
+  x.resize(0);
+  out.problemClass = ProblemClass::Empty;
+  out.choice = out.requested = "none";
+  out.result.status = Status::Converged;
+  out.result.iterations = 0;
+  out.result.residual = out.result.complementarity = out.result.boundViolation = 0;
+  out.result.solver = "none";
+  out.result.message = "no constraint rows";
+  return out;
+}
+
+// Stage 2 under auto: the policy's choice, the island's pgs-first memory and the engine-relative
+// cap (which may shorten the share).
+void RowSolver::Impl::chooseForAuto(const RowSystem& rows, const Vector& start, Slot& island,
+                                    IslandSolve& out, Plan& plan) {
+  const Policy& policy = settings_.policy;
+  const bool spent = budgetSpent(plan.share);
+  const Choice c = policy.choose(out.problemClass, rows.size(), settings_.options.tolerance, true,
+                                 spent, hasFreeRows(rows.lo, rows.hi));
+  out.requested = c.solver;
+  plan.enginePgs = spent && equals(out.requested, "pgs");
+  if (island.pgsFirst > 0 && !equals(out.requested, "ldlt") && !equals(out.requested, "pgs")) {
+    --island.pgsFirst;
+    out.requested = "pgs";
+    plan.enginePgs = true;
+  }
+  if (out.requested == policy.largeIslandSolver && island.cappedSolves > 0) {
+    const double cap = engineShare(rows, start);
+    plan.capped = cap > 0;
+    if (plan.capped) --island.cappedSolves;
+    if (plan.capped && cap < plan.share) plan.share = cap;
+  }
+}
+
+// Stage 3 on the box rows: the start when it already solves them, else the chosen solver (pgs
+// that auto runs for cost with the fallback's options: the engine's sweeps, the engine's cost).
+Result RowSolver::Impl::solvePrimary(const RowSystem& rows, const Vector& start, Vector& x,
+                                     Slot& island, IslandSolve& out, Plan& plan, double t0) {
+  Result r;
+  plan.fromStart = !equals(out.requested, "pgs") &&
+                   startSolves(rows, start, settings_.options.tolerance, plan.capped, x, r);
+  if (!plan.fromStart)
+    r = run(
+        rows, out.requested,
+        withBudget(plan.enginePgs ? settings_.fallbackOptions : settings_.options, plan.share, t0),
+        start, x, island, out);
+  // The same solver with the same options from the same start gives the same answer: not rerun.
+  primaryWasFallback_ = plan.enginePgs && settings_.fallback == out.requested;
+  return r;
+}
+
+// The island's memory under auto after its primary: the budget's cuts in a row, the capped
+// solves after an uncapped large-island solve ended short, and pgs first after a capped solve
+// that spent its share before its first step (assembly and set-up alone cost more than the cap:
+// it cannot improve on pgs within the engine's cost) or after a breakdown.
+void RowSolver::Impl::remember(Slot& island, const IslandSolve& out, const Result& r,
+                               const Plan& plan) {
+  const Policy& policy = settings_.policy;
+  island.cutsInRow = r.status == Status::TimeLimit ? island.cutsInRow + 1 : 0;
+  if (!plan.capped && !plan.fromStart && out.requested == policy.largeIslandSolver &&
+      r.status != Status::Converged)
+    island.cappedSolves = policy.pgsAfterBreakdown;
+  if (plan.capped && r.status == Status::TimeLimit && r.iterations == 0)
+    island.pgsFirst = policy.pgsAfterBreakdown;
+  if (!acceptable(r, settings_.acceptResidual) && !equals(out.requested, "pgs") &&
+      !equals(out.requested, "ldlt") &&
+      policy.demotes(r, settings_.acceptResidual, island.cutsInRow))
+    island.pgsFirst = policy.pgsAfterBreakdown;
+}
+
 IslandSolve RowSolver::Impl::solveScreened(const RowSystem& rows, const Vector& start, Vector& x,
                                            std::uint64_t key) {
   const double t0 = nowSeconds();
@@ -551,86 +624,40 @@ IslandSolve RowSolver::Impl::solveScreened(const RowSystem& rows, const Vector& 
   haveAssembled_ = false;
   primaryWasFallback_ = false;
   coneNote_.clear();
+  if (rows.size() == 0) return noRows(x);
   IslandSolve out;
-  const int n = rows.size();
   out.problemClass = classify(rows);
-  if (n == 0) {
-    x.resize(0);
-    out.choice = out.requested = "none";
-    out.result.status = Status::Converged;
-    out.result.iterations = 0;
-    out.result.residual = out.result.complementarity = out.result.boundViolation = 0;
-    out.result.solver = "none";
-    out.result.message = "no constraint rows";
-    return out;
-  }
-  double share = islandBudget(t0);
+  Plan plan;
+  plan.share = islandBudget(t0);
   const bool autoChoice = equals(settings_.solver, "auto");
-  const Policy& policy = settings_.policy;
   Slot& island = slot(key);
-  // The cone is tried on every solve: the demotion to pgs below is the box's rule (the cone is
-  // a model the caller asked for, and pgs cannot take its LCP).
+  // The cone is tried on every solve: the demotion to pgs is the box's rule (the cone is a model
+  // the caller asked for, and pgs cannot take its LCP).
   const bool cone = settings_.friction == FrictionModel::Cone &&
                     out.problemClass == ProblemClass::Findex && buildCone(rows, start, out);
   if (!capturePrefix_.empty()) cone ? capture(cone_.problem()) : capture(rows);
 
   Result r;
-  // pgs that auto runs for cost (a demoted island, a spent budget) runs as the fallback does: the
-  // engine's sweeps, the engine's cost.
-  bool enginePgs = false, capped = false;
   if (cone) {
-    r = solveCone(start, x, island, out, share, t0);
-  } else if (autoChoice) {
-    const bool spent = budgetSpent(share);
-    const Choice c = policy.choose(out.problemClass, n, settings_.options.tolerance, true, spent,
-                                   hasFreeRows(rows.lo, rows.hi));
-    out.requested = c.solver;
-    enginePgs = spent && equals(out.requested, "pgs");
-    if (island.pgsFirst > 0 && !equals(out.requested, "ldlt") && !equals(out.requested, "pgs")) {
-      --island.pgsFirst;
-      out.requested = "pgs";
-      enginePgs = true;
-    }
-    if (out.requested == policy.largeIslandSolver && island.cappedSolves > 0) {
-      const double cap = engineShare(rows, start);
-      capped = cap > 0;
-      if (capped) --island.cappedSolves;
-      if (capped && cap < share) share = cap;
-    }
+    r = solveCone(start, x, island, out, plan.share, t0);
   } else {
-    out.requested = settings_.solver;
+    if (autoChoice)
+      chooseForAuto(rows, start, island, out, plan);
+    else
+      out.requested = settings_.solver;
+    r = solvePrimary(rows, start, x, island, out, plan, t0);
   }
-  const bool fromStart = !cone && !equals(out.requested, "pgs") &&
-                         startSolves(rows, start, settings_.options.tolerance, capped, x, r);
-  if (!cone && !fromStart)
-    r = run(rows, out.requested,
-            withBudget(enginePgs ? settings_.fallbackOptions : settings_.options, share, t0), start,
-            x, island, out);
-  // The same solver with the same options from the same start gives the same answer: not rerun.
-  primaryWasFallback_ = enginePgs && settings_.fallback == out.requested;
   if (r.status == Status::InvalidInput || r.status == Status::Unsupported) x = start;
-  out.choice = fromStart ? kStartChoice : out.requested;
-  if (autoChoice && !cone && !fromStart && out.problemClass == ProblemClass::Findex &&
+  out.choice = plan.fromStart ? kStartChoice : out.requested;
+  if (autoChoice && !cone && !plan.fromStart && out.problemClass == ProblemClass::Findex &&
       equals(out.requested, "dantzig") && !acceptable(r, settings_.acceptResidual))
-    continueWithNewton(rows, x, island, out, r, share, t0);
-  const bool islandMemory = autoChoice && !cone;  // pgsFirst and cutsInRow
-  if (islandMemory) island.cutsInRow = r.status == Status::TimeLimit ? island.cutsInRow + 1 : 0;
-  // A capped solve that spent its share before its first step (assembly and set-up alone cost
-  // more than the cap) cannot improve on pgs within the engine's cost: the island runs pgs for
-  // the next pgsAfterBreakdown solves, as after a breakdown.
-  const bool setupOverCap = capped && r.status == Status::TimeLimit && r.iterations == 0;
-  if (islandMemory && !capped && !fromStart && out.requested == policy.largeIslandSolver &&
-      r.status != Status::Converged)
-    island.cappedSolves = policy.pgsAfterBreakdown;
-  if (islandMemory && setupOverCap) island.pgsFirst = policy.pgsAfterBreakdown;
-  if (!acceptable(r, settings_.acceptResidual)) {
-    if (islandMemory && !equals(out.requested, "pgs") && !equals(out.requested, "ldlt") &&
-        policy.demotes(r, settings_.acceptResidual, island.cutsInRow))
-      island.pgsFirst = policy.pgsAfterBreakdown;
-    r = fallBack(rows, start, x, island, out, std::move(r), share, t0);
-  } else if (!fromStart && !equals(out.choice, "pgs") && throwsBodies(rows, x)) {
-    keepSafe(rows, start, x, island, out, r, nullptr, share, t0);
-  }
+    continueWithNewton(rows, x, island, out, r, plan.share, t0);
+  if (autoChoice && !cone) remember(island, out, r, plan);
+  // Stages 4 and 5.
+  if (!acceptable(r, settings_.acceptResidual))
+    r = fallBack(rows, start, x, island, out, std::move(r), plan.share, t0);
+  else if (!plan.fromStart && !equals(out.choice, "pgs") && throwsBodies(rows, x))
+    keepSafe(rows, start, x, island, out, r, nullptr, plan.share, t0);
   out.accepted = acceptable(r, settings_.acceptResidual);
   if (!coneNote_.empty()) r.message = coneNote_ + r.message;
   r.solver = out.choice;

@@ -66,6 +66,19 @@ class RowSolver::Impl {
 
  private:
   struct Slot;
+  // What stage 2 decided for this solve and what stage 3 found.
+  struct Plan {
+    double share = 0;        // the island's time share, seconds (0: no budget)
+    bool enginePgs = false;  // pgs that auto runs for cost: the fallback's options
+    bool capped = false;     // under the engine-relative cap
+    bool fromStart = false;  // the start already solves the rows
+  };
+  static IslandSolve noRows(Vector& x);
+  void chooseForAuto(const RowSystem& rows, const Vector& start, Slot& island, IslandSolve& out,
+                     Plan& plan);
+  Result solvePrimary(const RowSystem& rows, const Vector& start, Vector& x, Slot& island,
+                      IslandSolve& out, Plan& plan, double t0);
+  void remember(Slot& island, const IslandSolve& out, const Result& r, const Plan& plan);
   // Stages 1-4 on rows that passed the screen.
   IslandSolve solveScreened(const RowSystem& rows, const Vector& start, Vector& x,
                             std::uint64_t islandKey);

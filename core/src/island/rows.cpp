@@ -191,28 +191,95 @@ Problem RowSystem::assemble(bool sparse) const {
   return p;
 }
 
-void RowSystem::assemble(bool sparse, Problem& p, AssembleScratch& cache) const {
-  AssembleScratch::Buffers& scratch = *cache.buffers_;
-  const int n = size();
-  // Rows touching each body: only rows sharing a body couple in J M^-1 J^T.
-  auto& touching = scratch.touching;
-  if (touching.size() < bodies.size()) touching.resize(bodies.size());
-  for (std::size_t k = 0; k < bodies.size(); ++k) touching[k].clear();
-  for (int i = 0; i < n; ++i) {
-    if (rows[i].bodyA >= 0) touching[rows[i].bodyA].push_back({i, &rows[i].jA});
-    if (rows[i].bodyB >= 0) touching[rows[i].bodyB].push_back({i, &rows[i].jB});
+namespace {
+
+using Buffers = RowSystem::AssembleScratch::Buffers;
+
+// Rows touching each body: only rows sharing a body couple in J M^-1 J^T.
+void collectTouching(const RowSystem& s, Touching& touching) {
+  if (touching.size() < s.bodies.size()) touching.resize(s.bodies.size());
+  for (std::size_t k = 0; k < s.bodies.size(); ++k) touching[k].clear();
+  for (int i = 0; i < s.size(); ++i) {
+    if (s.rows[i].bodyA >= 0) touching[s.rows[i].bodyA].push_back({i, &s.rows[i].jA});
+    if (s.rows[i].bodyB >= 0) touching[s.rows[i].bodyB].push_back({i, &s.rows[i].jB});
   }
-  // Every entry of A as (row, column, value) in one fixed order: diag(cfm), then per body the
-  // products of the rows touching it. Dense and sparse storage sum them in this order.
-  auto forEachProduct = [&](auto&& add) {
-    for (int i = 0; i < n; ++i) add(i, i, cfm[i]);
-    for (std::size_t k = 0; k < bodies.size(); ++k) {
-      for (const auto& [i, ji] : touching[k]) {
-        const Vector6 mji = applyInverseMass(bodies[k], *ji);
-        for (const auto& [j, jj] : touching[k]) add(i, j, jj->dot(mji));
-      }
+}
+
+// Every entry of A as add(row, column, value) in one fixed order: diag(cfm), then per body the
+// products of the rows touching it. Dense and sparse storage sum them in this order.
+template <class Add>
+void forEachProduct(const RowSystem& s, const Touching& touching, Add&& add) {
+  for (int i = 0; i < s.size(); ++i) add(i, i, s.cfm[i]);
+  for (std::size_t k = 0; k < s.bodies.size(); ++k) {
+    for (const auto& [i, ji] : touching[k]) {
+      const Vector6 mji = applyInverseMass(s.bodies[k], *ji);
+      for (const auto& [j, jj] : touching[k]) add(i, j, jj->dot(mji));
     }
-  };
+  }
+}
+
+// The pattern depends only on which bodies each row joins; `p` must still hold it (its index
+// arrays are compared, so a matrix set by anyone else is never refilled by mistake).
+bool samePattern(const RowSystem& s, const Problem& p, const Buffers& scratch) {
+  const int n = s.size();
+  const auto& key = scratch.patternBodies;
+  const SparseMatrix& held = p.sparseA();
+  if (!p.isSparse() || held.rows() != n || held.cols() != n || !held.isCompressed() ||
+      key.size() != 1 + 2 * static_cast<std::size_t>(n) ||
+      key[0] != static_cast<int>(s.bodies.size()) ||
+      held.nonZeros() != static_cast<Eigen::Index>(scratch.patternInner.size()))
+    return false;
+  for (int i = 0; i < n; ++i)
+    if (key[1 + 2 * i] != s.rows[i].bodyA || key[2 + 2 * i] != s.rows[i].bodyB) return false;
+  return std::equal(scratch.patternOuter.begin(), scratch.patternOuter.end(),
+                    held.outerIndexPtr()) &&
+         std::equal(scratch.patternInner.begin(), scratch.patternInner.end(), held.innerIndexPtr());
+}
+
+// The values of A on its known pattern. The second assembly on a pattern finds where each
+// product lands (row-major: a search of the row's sorted columns), the next ones only write.
+void writeValues(const RowSystem& s, SparseMatrix& A, Buffers& scratch) {
+  auto& slots = scratch.valueSlot;
+  if (slots.empty())
+    forEachProduct(s, scratch.touching, [&](int i, int j, double) {
+      const int* first = A.innerIndexPtr() + A.outerIndexPtr()[i];
+      const int* last = A.innerIndexPtr() + A.outerIndexPtr()[i + 1];
+      slots.push_back(static_cast<int>(std::lower_bound(first, last, j) - A.innerIndexPtr()));
+    });
+  double* values = A.valuePtr();
+  std::fill_n(values, A.nonZeros(), 0.0);
+  const int* slot = slots.data();
+  forEachProduct(s, scratch.touching, [&](int, int, double v) { values[*slot++] += v; });
+}
+
+// A new pattern: each row written in place, its columns the merge of its bodies' row lists;
+// the pattern and the bodies it depends on are remembered.
+void writePattern(const RowSystem& s, SparseMatrix& A, Buffers& scratch) {
+  const int n = s.size();
+  A.resize(n, n);
+  int* outer = A.outerIndexPtr();
+  outer[0] = 0;
+  for (int i = 0; i < n; ++i)
+    outer[i + 1] = outer[i] + mergeRow<false>(s, i, scratch.touching, nullptr);
+  A.resizeNonZeros(outer[n]);
+  for (int i = 0; i < n; ++i) mergeRow<true>(s, i, scratch.touching, &A);
+  scratch.valueSlot.clear();
+  scratch.patternOuter.assign(A.outerIndexPtr(), A.outerIndexPtr() + n + 1);
+  scratch.patternInner.assign(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros());
+  auto& key = scratch.patternBodies;
+  key.resize(1 + 2 * static_cast<std::size_t>(n));
+  key[0] = static_cast<int>(s.bodies.size());
+  for (int i = 0; i < n; ++i) {
+    key[1 + 2 * i] = s.rows[i].bodyA;
+    key[2 + 2 * i] = s.rows[i].bodyB;
+  }
+}
+
+}  // namespace
+
+void RowSystem::assemble(bool sparse, Problem& p, AssembleScratch& cache) const {
+  Buffers& scratch = *cache.buffers_;
+  collectTouching(*this, scratch.touching);
   p.b = b;
   p.lo = lo;
   p.hi = hi;
@@ -220,63 +287,18 @@ void RowSystem::assemble(bool sparse, Problem& p, AssembleScratch& cache) const 
   if (!sparse) {
     DenseMatrix& A = scratch.dense;
     p.swapA(A);  // A now holds the problem's previous dense storage
-    A.setZero(n, n);
-    forEachProduct([&](int i, int j, double v) { A(i, j) += v; });
+    A.setZero(size(), size());
+    forEachProduct(*this, scratch.touching, [&](int i, int j, double v) { A(i, j) += v; });
     p.swapA(A);
     return;
   }
-  // The pattern depends only on which bodies each row joins; `into` must still hold it (its
-  // index arrays are compared, so a matrix set by anyone else is never refilled by mistake).
-  auto& key = scratch.patternBodies;
-  const bool samePattern = [&] {
-    const SparseMatrix& held = p.sparseA();
-    if (!p.isSparse() || held.rows() != n || held.cols() != n || !held.isCompressed() ||
-        key.size() != 1 + 2 * static_cast<std::size_t>(n) ||
-        key[0] != static_cast<int>(bodies.size()) ||
-        held.nonZeros() != static_cast<Eigen::Index>(scratch.patternInner.size()))
-      return false;
-    for (int i = 0; i < n; ++i)
-      if (key[1 + 2 * i] != rows[i].bodyA || key[2 + 2 * i] != rows[i].bodyB) return false;
-    return std::equal(scratch.patternOuter.begin(), scratch.patternOuter.end(),
-                      held.outerIndexPtr()) &&
-           std::equal(scratch.patternInner.begin(), scratch.patternInner.end(),
-                      held.innerIndexPtr());
-  }();
+  const bool known = samePattern(*this, p, scratch);
   SparseMatrix& A = scratch.sparse;
   p.swapA(A);  // A now holds the problem's previous sparse matrix (its storage is reused)
-  if (samePattern) {
-    // The second assembly on a pattern finds where each product lands (row-major: a search of
-    // the row's sorted columns), the next ones only write values.
-    auto& slots = scratch.valueSlot;
-    if (slots.empty())
-      forEachProduct([&](int i, int j, double) {
-        const int* first = A.innerIndexPtr() + A.outerIndexPtr()[i];
-        const int* last = A.innerIndexPtr() + A.outerIndexPtr()[i + 1];
-        slots.push_back(static_cast<int>(std::lower_bound(first, last, j) - A.innerIndexPtr()));
-      });
-    double* values = A.valuePtr();
-    std::fill_n(values, A.nonZeros(), 0.0);
-    const int* slot = slots.data();
-    forEachProduct([&](int, int, double v) { values[*slot++] += v; });
-  } else {
-    // A new pattern: each row written in place, its columns the merge of its bodies' row lists.
-    A.resize(n, n);
-    int* outer = A.outerIndexPtr();
-    outer[0] = 0;
-    for (int i = 0; i < n; ++i)
-      outer[i + 1] = outer[i] + mergeRow<false>(*this, i, touching, nullptr);
-    A.resizeNonZeros(outer[n]);
-    for (int i = 0; i < n; ++i) mergeRow<true>(*this, i, touching, &A);
-    scratch.valueSlot.clear();
-    scratch.patternOuter.assign(A.outerIndexPtr(), A.outerIndexPtr() + n + 1);
-    scratch.patternInner.assign(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros());
-    key.resize(1 + 2 * static_cast<std::size_t>(n));
-    key[0] = static_cast<int>(bodies.size());
-    for (int i = 0; i < n; ++i) {
-      key[1 + 2 * i] = rows[i].bodyA;
-      key[2 + 2 * i] = rows[i].bodyB;
-    }
-  }
+  if (known)
+    writeValues(*this, A, scratch);
+  else
+    writePattern(*this, A, scratch);
   p.swapA(A);
 }
 

@@ -13,9 +13,11 @@
 //
 // AutoSolver classifies the problem, asks Policy (policy.hpp) for a solver and its fallback and
 // runs that two-member chain. The choice and its reason open Result::message. Solvers missing
-// from the registry are skipped.
+// from the registry are skipped. `configure` reaches the solvers it makes (to set their typed
+// parameters, e.g. NewtonParams): each chain is passed to it once, when made.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -44,6 +46,9 @@ class AutoSolver : public Solver {
   const char* name() const override { return "auto"; }
   // The rules; change them between solves (e.g. policy.largeIslandSolver = "newton").
   Policy policy;
+  // Called on each chain auto makes, before its first solve (a FallbackSolver: reach its
+  // members through chain()); empty: none. Set it before the first solve.
+  std::function<void(Solver&)> configure;
 
  protected:
   void run(const Problem& problem, Vector& x, Result& result) override;

@@ -5,7 +5,7 @@
 //         lets the friction force reach mu x_n sqrt(2) along a diagonal of the tangent frame, so
 //         a body sliding diagonally feels up to 41% more friction than one sliding along a
 //         tangent, and its slide turns toward the nearest diagonal.
-//   cone  the seed's polyhedral cone (Stewart-Trinkle / Anitescu-Potra, friction_cone.hpp): k
+//   cone  the polyhedral cone (Stewart-Trinkle / Anitescu-Potra, friction_cone.hpp): k
 //         directions per contact, a standard LCP in k + 1 unknowns per contact whose friction
 //         stays within mu x_n in every direction, exact along the k directions and at least
 //         mu x_n cos(pi / k) between two (0.707 at k = 4, 0.924 at k = 8, 0.981 at k = 16).

@@ -7,59 +7,29 @@
 //     c.fallback;  // "pgs"
 //     c.why;       // "small contact island"
 //
-// One object decides for the registry's `auto` (a Problem, fallback.hpp), for both adapters'
-// islands (RowSolver, row_solver.hpp) and for the CLI (which reaches them through those two).
+// One object decides for the registry's `auto` (fallback.hpp), for both adapters' islands
+// (RowSolver) and for the CLI. The choice, from the problem's class (problem.hpp), its rows,
+// the requested tolerance and whether the step's time budget is spent:
+//   Empty -> "none";  Linear (joints only) -> "ldlt" (one exact factorization);
+//   a row with A_ii <= 0 -> "lemke" (fallback "newton");
+//   contacts with joints up to smallIslandRows, contacts only up to smallContactRows
+//     -> "dantzig" (exact pivoting, fast while the pivot count is small);
+//   larger contact islands -> "pgs" when the budget is spent or the tolerance is loose
+//     (>= looseTolerance), else largeIslandSolver ("newton", whose cost grows more slowly than
+//     pivoting's with the rows).
 //
-// The choice, from the problem's structure (ProblemClass, problem.hpp: read from the bounds and
-// findex alone, and whether any row is free: (-inf, inf), a joint's), its size in rows, the
-// requested tolerance and whether a time budget is spent:
-//   Empty                           -> "none"     nothing to solve
-//   Linear (bilateral joints only)  -> "ldlt"     one LDL^T solve: exact, the cheapest answer
-//   a row with A_ii <= 0            -> "lemke"    (fallback "newton"): neither pgs nor dantzig's
-//                                                 ratio tests can divide by it; newton's dense
-//                                                 LU / least-squares steps take the singular
-//                                                 equality blocks (diode bridges) lemke cannot
-//   contacts with free rows (joints), rows <= smallIslandRows,
-//   contacts only, rows <= smallContactRows    -> "dantzig" exact pivoting answer (~1e-12)
-//   larger contact islands:
-//     the step's time budget spent             -> "pgs"      (improves any start in any share)
-//     tolerance >= looseTolerance              -> "pgs"      (fallback "dantzig")
-//     otherwise                                -> largeIslandSolver ("newton"), whose
-//                                                 pivoting phase finishes the islands its
-//                                                 damped steps leave short (newton.hpp)
-// ("contacts": StandardLcp, Boxed and Findex islands.) Why: one LDL^T solve is exact and cheaper
-// than any iteration on joint chains; pivoting is exact and fastest on small contact islands,
-// but its pivot count grows with the rows, so above ~1000 rows a cold answer takes seconds a
-// step, where pgs reaches a loose tolerance in a bounded number of sweeps; a tight tolerance on
-// a large island still asks for an exact method: newton, whose steps on engine rows cost a
-// body-space factorization (newton.hpp) and whose cold starts never pivot from zero (Bullet's
-// 55-box pyramid under the 0.05 s budget: 18 of 30 steps converged, against none for dantzig,
-// whose cut first steps demote the island to pgs), all bounded by the time budget
-// (row_solver.hpp). Islands of contacts only are newton's from fewer rows: there its steps
-// converge in a few factorizations where pivoting's cost grows with the rows (Bullet's and
-// ODE's 15-box pyramids, 255 and 285 rows: newton 0.57 and 0.13 ms a step against dantzig's 2.3
-// and 1.8 ms); with joint rows newton can stall where pivoting ends exact (Bullet's ragdoll
-// pile, a 196-row island of 128 joint rows: newton stops at 1e-2, dantzig converges).
-// The measurements: docs/benchmarks.md, "auto's choices and the time budget".
+// The fallback rule (a registry chain "a>b>c" and RowSolver's primary and fallback alike):
+//  1. an answer is acceptable when its status is not a breakdown and its residual, recomputed
+//     by residual.hpp (never a solver's claim), is finite and <= the limit (acceptResidual for
+//     islands, Options::tolerance for a chain); a verified LeastSquares answer always is;
+//  2. the next solver runs only when every answer so far is unacceptable, from the caller's
+//     start, with the time left;
+//  3. the first acceptable answer is returned, else the lowest finite residual found, else the
+//     start (an engine's "no change"); never "no impulses" while a finite answer exists;
+//  4. Result::status keeps the returned answer's own status and the message lists every try.
 //
-// The fallback rule (the same for a registry chain "a>b>c" and for RowSolver's primary and
-// fallback):
-//  1. Acceptable answers (acceptable()): the status is not Failed, NumericalIssue, InvalidInput
-//     or Unsupported, and the residual recomputed by residual.hpp (never a solver's claim) is
-//     finite and <= the limit. A LeastSquares answer (equality rows with no exact solution,
-//     verified by the base) is acceptable whatever its residual: no method does better. The limit
-//     is RowSolverSettings::acceptResidual for islands (default 1e-3) and Options::tolerance for a
-//     registry chain (an accepted member answer is a converged one).
-//  2. The next solver runs only when the answers so far are all unacceptable; it starts from the
-//     caller's start point again, with the time left (RowSolver: at least a minimal share).
-//  3. The returned answer is the first acceptable one, else the best answer any solver found:
-//     the lowest finite recomputed residual (better(); the earlier one on a tie), whatever its
-//     status. Only when no solver found a finite answer is the start returned (an engine's "no
-//     change"; zeros if the start is not finite), never "no impulses" while a finite answer
-//     exists.
-//  4. The statistics say when the returned answer is not acceptable: Result::status keeps that
-//     answer's own status (a chain whose members all missed is not Converged), the message lists
-//     every attempt, and RowSolver's IslandSolve::accepted is false.
+// The reasons and measurements behind each threshold: docs/methods/island.md, "auto's choice",
+// and thresholds.hpp.
 #pragma once
 
 #include <string>

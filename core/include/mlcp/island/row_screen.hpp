@@ -23,21 +23,10 @@
 //   inertNormal     friction row whose normal row is      inert (its bounds mu |x_normal| are
 //                   inert                                 0 wide)
 //
-// A row whose b_i is beyond reach is an engine idiom, not an error: Bullet's 6-dof limit "at
-// infinity" (btGeneric6DofSpring2Constraint with +-1e30 or SIMD_INFINITY limits gives its limit
-// rows rhs = fps erp (x - 1e30), or -inf where that overflows) and a motor or spring that pushes
-// "at full force" (target velocity +-SIMD_INFINITY, the impulse bounded by lo_i, hi_i). b_i is
-// the velocity (Bullet; velocity / h in ODE) the row would undo; the impulses of the rest of
-// the island change w_i = A_i x + b_i by far less than 1e10 m/s, so w_i keeps b_i's sign and
-// complementarity puts x_i on the bound that sign names: lo_i for b_i > 0, hi_i for b_i < 0.
-// That is the answer Bullet's sequential impulse gives the row (its impulse clamps there) and
-// the exact one. Left in, such a row breaks every solver the same way: 1 + ||b||_inf, the
-// residual's scale, becomes 1e31, any x passes the acceptance, and a pivoting solver reports
-// "converged" on its start, which holds nothing (scenes/six_dof_spring.json). A fixed row leaves
-// the solve: x_i = c moves the other rows' b_j by A_ji c = J_j M^-1 J_i^T c (nothing when c = 0,
-// Bullet's one-sided limit rows), and a friction row whose normal is fixed at c gets the fixed
-// bounds mu |c|. A friction row beyond reach is inert (its bounds move with its normal).
-//
+// A row whose b_i is beyond reach is an engine idiom, not an error (Bullet's 6-dof limits "at
+// infinity", motors at full force): the rest of the island cannot change w_i's sign, so the
+// exact answer, and Bullet's own, puts x_i on the bound b_i's sign names; left in, such a row
+// makes the residual's scale 1e31 and every answer pass (docs/methods/island.md, "Row screening").
 // ref = sum over the row's bodies of invMass |J_lin|^2 + max|invInertia_kl| |J_ang|^2, the
 // size A_ii would have if J were not in M^-1's null space: the test is relative, so a 1 mm or a
 // 1 km scene screens the same rows. An inert row takes x_i = 0 and a fixed row x_i = c; both
