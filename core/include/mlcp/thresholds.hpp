@@ -45,9 +45,10 @@ inline constexpr double kDantzigBreakdownShift = 1e-10;
 // whose rows drift ~1e-8 of b (a plank bridge) ends in a spurious ray on A and solves in a few
 // pivots on the shifted A, leaving ~5e-11 on A.
 inline constexpr double kLemkeRayShift = 1e-12;
-// lemke's factored basis refactors (and halves its period) when the updated basic values drift
-// from B^-1 q by more than this, relative: well above round-off, far below an answer's error.
-inline constexpr double kLemkeDrift = 1e-9;
+// lemke's factored basis refactors more often (halves its period) when the eta-updated basic
+// values' backward error ||B x - q|| / (||q|| + ||B|| ||x||) exceeds this: ~1e6 units of
+// round-off, far below what changes a ratio test's choice; a fresh factorization leaves ~1e-16.
+inline constexpr double kLemkeBackwardError = 1e-10;
 // The minimum-norm least-squares rank decision, times max(1, max |A_ii|): directions 1e-6
 // below the stiffest are where an exact answer would throw bodies (linalg/min_norm.hpp).
 inline constexpr double kMinNormShift = 1e-6;
