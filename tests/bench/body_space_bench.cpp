@@ -24,8 +24,6 @@
 // on the symmetric pattern; LDL^T without the sliding rows) against CHOLMOD (without the sliding
 // rows), KLU and UMFPACK on the same matrix.
 #include <suitesparse/cholmod.h>
-#include <suitesparse/klu.h>
-#include <suitesparse/umfpack.h>
 
 #include <Eigen/OrderingMethods>
 #include <algorithm>
@@ -37,6 +35,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/sparse_lu_timing.hpp"
 #include "common/contact_scenes.hpp"
 #include "linalg/body_space.hpp"            // BodySpaceSystem (internal)
 #include "linalg/symmetric_pattern_lu.hpp"  // (internal)
@@ -45,36 +44,10 @@
 namespace {
 
 using mlcp::Vector;
-
-struct Csc {
-  int n = 0;
-  std::vector<int> start, index;
-  std::vector<double> values;
-  Vector times(const Vector& z) const {
-    Vector out = Vector::Zero(n);
-    for (int j = 0; j < n; ++j)
-      for (int e = start[j]; e < start[j + 1]; ++e) out[index[e]] += values[e] * z[j];
-    return out;
-  }
-};
-
-double medianMs(const std::function<void()>& run) {
-  std::vector<double> t;
-  double total = 0;
-  while (t.size() < 5 || (total < 500 && t.size() < 200)) {
-    const auto t0 = std::chrono::steady_clock::now();
-    run();
-    t.push_back(
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-    total += t.back();
-  }
-  std::nth_element(t.begin(), t.begin() + t.size() / 2, t.end());
-  return t[t.size() / 2];
-}
-
-double relResidual(const Csc& s, const Vector& r, const Vector& z) {
-  return (s.times(z) - r).norm() / r.norm();
-}
+using mlcp::bench::Csc;
+using mlcp::bench::medianMs;
+using mlcp::bench::relResidual;
+using mlcp::bench::Timing;
 
 std::string loadedBlas() {
   std::ifstream maps("/proc/self/maps");
@@ -84,11 +57,6 @@ std::string loadedBlas() {
       return line.substr(line.find('/'));
   return "none";
 }
-
-// The library factorizations of one S: median ms of a numeric factorization and the solve check.
-struct Timing {
-  double ms = -1, residual = -1;
-};
 
 Timing cholmod(const Csc& s, const Vector& r) {
   cholmod_common c;
@@ -123,45 +91,6 @@ Timing cholmod(const Csc& s, const Vector& r) {
   }
   cholmod_free_factor(&l, &c);
   cholmod_finish(&c);
-  return t;
-}
-
-Timing klu(const Csc& s, const Vector& r) {
-  klu_common c;
-  klu_defaults(&c);
-  std::vector<int> start = s.start, index = s.index;
-  std::vector<double> values = s.values;
-  klu_symbolic* sym = klu_analyze(s.n, start.data(), index.data(), &c);
-  klu_numeric* num = nullptr;
-  Timing t;
-  t.ms = medianMs([&] {
-    if (num) klu_free_numeric(&num, &c);
-    num = klu_factor(start.data(), index.data(), values.data(), sym, &c);
-  });
-  Vector z = r;
-  if (num && klu_solve(sym, num, s.n, 1, z.data(), &c)) t.residual = relResidual(s, r, z);
-  if (num) klu_free_numeric(&num, &c);
-  klu_free_symbolic(&sym, &c);
-  return t;
-}
-
-Timing umfpack(const Csc& s, const Vector& r) {
-  void* sym = nullptr;
-  void* num = nullptr;
-  umfpack_di_symbolic(s.n, s.n, s.start.data(), s.index.data(), s.values.data(), &sym, nullptr,
-                      nullptr);
-  Timing t;
-  t.ms = medianMs([&] {
-    if (num) umfpack_di_free_numeric(&num);
-    umfpack_di_numeric(s.start.data(), s.index.data(), s.values.data(), sym, &num, nullptr,
-                       nullptr);
-  });
-  Vector z(s.n);
-  if (num && umfpack_di_solve(UMFPACK_A, s.start.data(), s.index.data(), s.values.data(), z.data(),
-                              r.data(), num, nullptr, nullptr) == UMFPACK_OK)
-    t.residual = relResidual(s, r, z);
-  if (num) umfpack_di_free_numeric(&num);
-  umfpack_di_free_symbolic(&sym);
   return t;
 }
 
@@ -203,7 +132,7 @@ std::string cell(const Timing& t) {
 void row(int boxes, int coords, const Sets& sets, bool withSliding, const Csc& s, double blockMs,
          double blockResidual, const Vector& r) {
   const Timing ch = withSliding ? Timing{} : cholmod(s, r);
-  const Timing k = klu(s, r), u = umfpack(s, r);
+  const Timing k = mlcp::bench::kluTiming(s, r), u = mlcp::bench::umfpackTiming(s, r);
   std::printf("| %d | %d | %zu | %zu | %s | %zu | %.3g ms (%.0e) | %s | %s | %s |\n", boxes, coords,
               sets.order.size(), withSliding ? sets.sliding.size() : 0,
               withSliding ? "with sliding rows" : "without", s.index.size(), blockMs, blockResidual,
@@ -343,7 +272,7 @@ void pivotingRow(int boxes, const mlcp::Problem& p, const Sets& sets, bool withS
   Vector z = r;
   if (ok) lu.solve(z);
   const Timing ch = withSliding ? Timing{} : cholmod(k, r);
-  const Timing kl = klu(k, r), u = umfpack(k, r);
+  const Timing kl = mlcp::bench::kluTiming(k, r), u = mlcp::bench::umfpackTiming(k, r);
   std::printf("| %d | %d | %zu | %zu | %s | %.3g ms (%.0e) | %s | %s | %s |\n", boxes, k.n,
               withSliding ? sets.sliding.size() : 0, k.index.size(),
               withSliding ? "with sliding rows" : "without", ms, ok ? relResidual(k, r, z) : -1.0,
