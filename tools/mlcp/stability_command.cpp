@@ -109,10 +109,8 @@ int runStability(StabilityArgs args) {
   return runChart({"heatmap", args.csv, "-o", args.chart}) == 0 ? kSolved : kNotSolved;
 }
 
-}  // namespace
-
-Runner addStabilityCommand(CLI::App& app) {
-  auto args = std::make_shared<StabilityArgs>();
+// The command's description: the outcomes with their default thresholds, the grids, the CSV.
+std::string stabilityHelp() {
   const StabilityThresholds t;
   std::ostringstream help;
   help << "Where methods break: stacks of 1 m cubes at rest, run per engine and solver over two "
@@ -140,81 +138,100 @@ Runner addStabilityCommand(CLI::App& app) {
           "max_penetration (m),failed_steps,fallback_steps,worst_residual,mean_solver_ms,"
           "reason. Exit 0: the grid ran (and --chart drew it); 1: --chart failed; 2: bad "
           "arguments.";
-  CLI::App* cmd = app.add_subcommand("stability", help.str());
-  cmd->add_option("--engines", args->grid.engines,
+  return help.str();
+}
+
+// The grids: engines, solvers and each grid's axes, and what every cell runs.
+void addGridOptions(CLI::App* cmd, StabilityGrid& grid) {
+  cmd->add_option("--engines", grid.engines,
                   "engines, comma separated (default: all built: " + engineNames() + ")")
       ->delimiter(',');
-  cmd->add_option("--solvers", args->grid.solvers,
+  cmd->add_option("--solvers", grid.solvers,
                   "solvers, comma separated; stock names (bullet-*, ode-*) run in their own "
                   "engine only")
       ->delimiter(',')
       ->capture_default_str();
-  cmd->add_option("--grids", args->grid.grids, "mass, step or mass,step")->capture_default_str();
-  cmd->add_option("--ratios", args->grid.ratios, "mass grid: top/bottom mass ratios")
+  cmd->add_option("--grids", grid.grids, "mass, step or mass,step")->capture_default_str();
+  cmd->add_option("--ratios", grid.ratios, "mass grid: top/bottom mass ratios")
       ->delimiter(',')
       ->capture_default_str();
-  cmd->add_option("--heights", args->grid.heights, "mass grid: stack heights (boxes, >= 1)")
-      ->delimiter(',')
-      ->check(positiveNumber())
-      ->capture_default_str();
-  cmd->add_option("--time-steps", args->grid.timeSteps, "step grid: time steps (s)")
+  cmd->add_option("--heights", grid.heights, "mass grid: stack heights (boxes, >= 1)")
       ->delimiter(',')
       ->check(positiveNumber())
       ->capture_default_str();
-  cmd->add_option("--iteration-counts", args->grid.iterationCounts,
-                  "step grid: iterations per solve")
+  cmd->add_option("--time-steps", grid.timeSteps, "step grid: time steps (s)")
+      ->delimiter(',')
+      ->check(positiveNumber())
+      ->capture_default_str();
+  cmd->add_option("--iteration-counts", grid.iterationCounts, "step grid: iterations per solve")
       ->delimiter(',')
       ->check(nonNegativeNumber())
       ->capture_default_str();
-  cmd->add_option("--step-height", args->grid.stepHeight, "step grid: stack height (boxes)")
+  cmd->add_option("--step-height", grid.stepHeight, "step grid: stack height (boxes)")
       ->check(positiveNumber())
       ->capture_default_str();
-  cmd->add_option("--step-ratio", args->grid.stepRatio, "step grid: top/bottom mass ratio")
+  cmd->add_option("--step-ratio", grid.stepRatio, "step grid: top/bottom mass ratio")
       ->check(positiveNumber())
       ->capture_default_str();
-  cmd->add_option("--cfm", args->grid.cfm,
+  cmd->add_option("--cfm", grid.cfm,
                   "world cfm of the stacks (the scenes' 1e-5 is a contact spring that a heavy "
                   "stack compresses by centimetres)")
       ->check(nonNegativeNumber())
       ->capture_default_str();
-  cmd->add_option("--seconds", args->grid.seconds, "simulated time per cell (s)")
+  cmd->add_option("--seconds", grid.seconds, "simulated time per cell (s)")
       ->check(positiveNumber())
       ->capture_default_str();
-  cmd->add_option("--iterations", args->grid.iterations, "mass grid: iterations per solve")
+  cmd->add_option("--iterations", grid.iterations, "mass grid: iterations per solve")
       ->check(nonNegativeNumber())
       ->capture_default_str();
-  cmd->add_option("--fallback", args->grid.fallback,
+  cmd->add_option("--fallback", grid.fallback,
                   "core solver run when our adapters reject an answer, or none: each solver "
                   "alone, so that the map shows where it breaks")
       ->capture_default_str();
-  cmd->add_flag("--quick", args->grid.quick,
+  cmd->add_flag("--quick", grid.quick,
                 "a 2 x 2 grid of each kind and 1 s per cell (for tests; overrides the grid "
                 "options)");
-  cmd->add_option("--csv", args->csv,
+}
+
+void addOutputOptions(CLI::App* cmd, StabilityArgs& args) {
+  cmd->add_option("--csv", args.csv,
                   "CSV file to write (default: standard output, or DIR/stability.csv with "
                   "--chart)");
-  cmd->add_option("--chart", args->chart,
+  cmd->add_option("--chart", args.chart,
                   "also draw the heat maps into this folder (tools/chart.py heatmap through "
                   "the venv, as mlcp chart does)");
-  cmd->add_option("--max-speed", args->grid.thresholds.maxSpeed, "exploded above this speed (m/s)")
+}
+
+// The outcome thresholds (stability.hpp).
+void addThresholdOptions(CLI::App* cmd, StabilityThresholds& thresholds) {
+  cmd->add_option("--max-speed", thresholds.maxSpeed, "exploded above this speed (m/s)")
       ->check(positiveNumber())
       ->capture_default_str();
-  cmd->add_option("--failure-share", args->grid.thresholds.failureShare,
+  cmd->add_option("--failure-share", thresholds.failureShare,
                   "solver-failure above this share of failed or fallback steps")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
-  cmd->add_option("--collapse-fraction", args->grid.thresholds.collapseFraction,
+  cmd->add_option("--collapse-fraction", thresholds.collapseFraction,
                   "collapsed when a box moved more than this fraction of its edge")
       ->check(positiveNumber())
       ->capture_default_str();
-  cmd->add_option("--collapse-penetration", args->grid.thresholds.collapsePenetration,
+  cmd->add_option("--collapse-penetration", thresholds.collapsePenetration,
                   "collapsed above this penetration (m)")
       ->check(positiveNumber())
       ->capture_default_str();
-  cmd->add_option("--drift", args->grid.thresholds.drift,
-                  "drifting when the top box moved more than this (m)")
+  cmd->add_option("--drift", thresholds.drift, "drifting when the top box moved more than this (m)")
       ->check(positiveNumber())
       ->capture_default_str();
+}
+
+}  // namespace
+
+Runner addStabilityCommand(CLI::App& app) {
+  auto args = std::make_shared<StabilityArgs>();
+  CLI::App* cmd = app.add_subcommand("stability", stabilityHelp());
+  addGridOptions(cmd, args->grid);
+  addOutputOptions(cmd, *args);
+  addThresholdOptions(cmd, args->grid.thresholds);
   return [args] { return runStability(*args); };
 }
 

@@ -367,68 +367,54 @@ void IslandBuilder::readSolverInfo(const btContactSolverInfo& info) {
                                         SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION));
 }
 
-[[gnu::always_inline]] inline RowPgs::RowView IslandBuilder::view(Island& isl, int r, bool split,
-                                                                  double* scratch) {
-  const int i = isl.inOrder ? r : isl.rowIndex[r];
-  const btSolverConstraint& c = *isl.rows[r];
-  const int a = rowBodies_[i].first, b = rowBodies_[i].second;
-  const int findex = isl.system.findex[r];
-  RowPgs::RowView out;
-  // One side's J = [n * linearFactor; r x n] and M^-1's angular part, read in place (see
-  // islands.hpp); own: 6 doubles for what is not (with single-precision Bullet: J, copied, and no
-  // angular part of M^-1: Bullet's own is rounded to float, not what our products give).
-  auto side = [&](int body, const btVector3& normal, const btVector3& torqueAxis,
-                  const btVector3& invAngular, const double*& lin, const double*& ang,
-                  const double*& invAng, double* own) {
-    const unsigned char unit = unit_[body];
-    if (unit & kUnitLinear) {
-      lin = doubles(normal, own);
-    } else {
-      const btVector3& linearFactor = (*in_.bodies)[body].m_linearFactor;
-      for (int k = 0; k < 3; ++k) own[k] = normal[k] * linearFactor[k];
-      lin = own;
-    }
-    ang = doubles(torqueAxis, own + 3);
+// One side's J = [n * linearFactor; r x n] and M^-1's angular part, read in place (see
+// islands.hpp); own: 6 doubles for what is not (with single-precision Bullet: J, copied, and no
+// angular part of M^-1: Bullet's own is rounded to float, not what our products give).
+[[gnu::always_inline]] inline void IslandBuilder::viewSide(
+    int body, const btVector3& normal, const btVector3& torqueAxis, const btVector3& invAngular,
+    const double*& lin, const double*& ang, const double*& invAng, double* own) const {
+  const unsigned char unit = unit_[body];
+  if (unit & kUnitLinear) {
+    lin = doubles(normal, own);
+  } else {
+    const btVector3& linearFactor = (*in_.bodies)[body].m_linearFactor;
+    for (int k = 0; k < 3; ++k) own[k] = normal[k] * linearFactor[k];
+    lin = own;
+  }
+  ang = doubles(torqueAxis, own + 3);
 #ifdef BT_USE_DOUBLE_PRECISION
-    invAng = (unit & kUnitAngular) ? doubles(invAngular, nullptr) : nullptr;
+  invAng = (unit & kUnitAngular) ? doubles(invAngular, nullptr) : nullptr;
 #else
-    (void)invAngular;
-    invAng = nullptr;
+  (void)invAngular;
+  invAng = nullptr;
 #endif
-  };
-  if (a >= 0) {
-    side(a, c.m_contactNormal1, c.m_relpos1CrossNormal, c.m_angularComponentA, out.linA, out.angA,
-         out.invAngA, scratch);
-  } else {
-    out.linA = out.angA = kZeros;
-  }
-  if (b >= 0) {
-    side(b, c.m_contactNormal2, c.m_relpos2CrossNormal, c.m_angularComponentB, out.linB, out.angB,
-         out.invAngB, scratch + 6);
-  } else {
-    out.linB = out.angB = kZeros;
-  }
-  const double jd = c.m_jacDiagABInv;
-  const double base = split ? c.m_appliedPushImpulse : c.m_appliedImpulse;
-  double start = 0;
+}
+
+[[gnu::always_inline]] inline double IslandBuilder::viewStart(const Island& isl, int r, int i,
+                                                              const btSolverConstraint& c,
+                                                              double base, bool split) const {
   const bool warm = start_ != Start::Zero;
-  const bool contact = i >= nj_ && i < nj_ + nc_;
-  if (split) {
-    start = warm ? base : 0.0;
-  } else if (warm) {
-    start = (i >= nj_ ? unscaleContacts_ : 1.0) * base;
-    const btManifoldPoint* point = points_ ? isl.point[r] : nullptr;
-    if (point) {
-      if (const auto* last = static_cast<const Remembered*>(isl.last[r])) {
-        start = contact ? last->normal : last->friction.dot(frictionDirection(c));
-      } else if (!contact && lateralCache_) {
-        const bool first = i - nj_ - nc_ == (*in_.contacts)[c.m_frictionIndex].m_frictionIndex;
-        start = first ? point->m_appliedImpulseLateral1 : point->m_appliedImpulseLateral2;
-      }
+  if (split) return warm ? base : 0.0;
+  if (!warm) return 0.0;
+  double start = (i >= nj_ ? unscaleContacts_ : 1.0) * base;
+  const btManifoldPoint* point = points_ ? isl.point[r] : nullptr;
+  if (point) {
+    const bool contact = i >= nj_ && i < nj_ + nc_;
+    if (const auto* last = static_cast<const Remembered*>(isl.last[r])) {
+      start = contact ? last->normal : last->friction.dot(frictionDirection(c));
+    } else if (!contact && lateralCache_) {
+      const bool first = i - nj_ - nc_ == (*in_.contacts)[c.m_frictionIndex].m_frictionIndex;
+      start = first ? point->m_appliedImpulseLateral1 : point->m_appliedImpulseLateral2;
     }
   }
-  out.bodyA = a >= 0 ? bodyLocal_[a] : -1;
-  out.bodyB = b >= 0 ? bodyLocal_[b] : -1;
+  return start;
+}
+
+[[gnu::always_inline]] inline double IslandBuilder::viewRhs(Island& isl,
+                                                            const btSolverConstraint& c, int findex,
+                                                            bool split,
+                                                            RowPgs::RowView& out) const {
+  const double jd = c.m_jacDiagABInv;
   // rhs and cfm are stored pre-multiplied by 1 / A_ii; undo it (as btMLCPSolver does).
   const bool scaled = !btFuzzyZero(jd);
   // Most rows have no penetration rhs: no division for them (-0 / jd would be 0 as well).
@@ -441,6 +427,12 @@ void IslandBuilder::readSolverInfo(const btContactSolverInfo& info) {
   else
     out.cfm = scaled ? std::max(0.0, c.m_cfm / jd) : 0.0;
   if (cfm_ == CfmModel::Regularized && findex >= 0 && out.cfm == 0) out.cfm = stockCfm_;
+  return splitB;
+}
+
+[[gnu::always_inline]] inline void IslandBuilder::viewBounds(const btSolverConstraint& c, int i,
+                                                             int findex,
+                                                             RowPgs::RowView& out) const {
   out.findex = findex;
   if (findex >= 0) {
     out.lo = -std::abs(c.m_friction);
@@ -452,6 +444,33 @@ void IslandBuilder::readSolverInfo(const btContactSolverInfo& info) {
     out.lo = bound(c.m_lowerLimit);
     out.hi = bound(c.m_upperLimit);
   }
+}
+
+[[gnu::always_inline]] inline RowPgs::RowView IslandBuilder::view(Island& isl, int r, bool split,
+                                                                  double* scratch) {
+  const int i = isl.inOrder ? r : isl.rowIndex[r];
+  const btSolverConstraint& c = *isl.rows[r];
+  const int a = rowBodies_[i].first, b = rowBodies_[i].second;
+  const int findex = isl.system.findex[r];
+  RowPgs::RowView out;
+  if (a >= 0) {
+    viewSide(a, c.m_contactNormal1, c.m_relpos1CrossNormal, c.m_angularComponentA, out.linA,
+             out.angA, out.invAngA, scratch);
+  } else {
+    out.linA = out.angA = kZeros;
+  }
+  if (b >= 0) {
+    viewSide(b, c.m_contactNormal2, c.m_relpos2CrossNormal, c.m_angularComponentB, out.linB,
+             out.angB, out.invAngB, scratch + 6);
+  } else {
+    out.linB = out.angB = kZeros;
+  }
+  const double base = split ? c.m_appliedPushImpulse : c.m_appliedImpulse;
+  const double start = viewStart(isl, r, i, c, base, split);
+  out.bodyA = a >= 0 ? bodyLocal_[a] : -1;
+  out.bodyB = b >= 0 ? bodyLocal_[b] : -1;
+  const double splitB = viewRhs(isl, c, findex, split, out);
+  viewBounds(c, i, findex, out);
   out.base = base;
   out.start = start;
   if (split) return out;

@@ -69,14 +69,10 @@ void prepareBodies(dxWorld* world, dxBody* const* body, unsigned nb, dReal h, Ro
 // 0: all rows unbounded, 1: mixed, 2: no unbounded row.
 int jointClass(const JointRows& j) { return j.nub == j.m ? 0 : j.nub > 0 ? 1 : 2; }
 
-// Stage 2 and 3: getInfo1 for all joints (before any getInfo2), joints ordered unbounded |
-// mixed | LCP (stable within each class), then getInfo2 into the rows and the right-hand side
-// in the canonical form. Returns the number of purely unbounded joints (what dxStepIsland
-// passes to dxSolveLCP as nub).
-int prepareRows(dxWorld* world, dxBody* const* body, unsigned nb, dxJoint* const* joint,
-                unsigned nj, dReal h, IslandWork& w) {
-  // Active joints by class (unbounded, mixed, LCP), island order kept within each class:
-  // bucketed through a reused buffer (std::stable_partition allocates on every call).
+// Stage 2: getInfo1 for all joints (before any getInfo2), the active ones ordered unbounded |
+// mixed | LCP, island order kept within each class (bucketed through a reused buffer:
+// std::stable_partition allocates on every call). Returns the number of purely unbounded joints.
+int orderJoints(dxJoint* const* joint, unsigned nj, IslandWork& w) {
   w.active.clear();
   int count[3] = {0, 0, 0};
   for (unsigned k = 0; k < nj; ++k) {
@@ -91,15 +87,17 @@ int prepareRows(dxWorld* world, dxBody* const* body, unsigned nb, dxJoint* const
   int next[3] = {0, count[0], count[0] + count[1]};
   w.joints.resize(w.active.size());
   for (const JointRows& j : w.active) w.joints[next[jointClass(j)]++] = j;
-  const int unboundedJoints = count[0];
+  return count[0];
+}
 
+// Numbers the ordered joints (tag) and their first rows (offset); sizes the rows.
+void numberRows(IslandWork& w) {
   int m = 0;
   for (std::size_t k = 0; k < w.joints.size(); ++k) {
     w.joints[k].joint->tag = static_cast<int>(k);
     w.joints[k].offset = m;
     m += w.joints[k].m;
   }
-
   RowSystem& rows = w.rows;
   rows.rows.resize(m);
   rows.b.resize(m);
@@ -107,7 +105,11 @@ int prepareRows(dxWorld* world, dxBody* const* body, unsigned nb, dxJoint* const
   rows.hi.resize(m);
   rows.cfm.resize(m);
   rows.findex.assign(m, -1);
+}
 
+// Stage 3a: getInfo2 of each joint into its rows; b holds ODE's rhs (c/h) until finishRhs.
+void readJointRows(dxWorld* world, dReal h, IslandWork& w) {
+  RowSystem& rows = w.rows;
   const dReal fps = dRecip(h);
   // getInfo2 writes each joint's Jacobian straight into its rows (J1 = jA, J2 = jB of the first
   // row, the next row kRowSkip dReals on): no staging arrays, no copy.
@@ -139,7 +141,7 @@ int prepareRows(dxWorld* world, dxBody* const* body, unsigned nb, dxJoint* const
       row.bodyA = b0->tag;
       row.bodyB = b1 ? b1->tag : -1;
       if (!b1) row.jB.setZero();
-      rows.b[i] = rhsCfm[2 * k + dxJoint::GI2_RHS] * fps;  // ODE's rhs for now
+      rows.b[i] = rhsCfm[2 * k + dxJoint::GI2_RHS] * fps;  // ODE's rhs until finishRhs
       rows.cfm[i] = rhsCfm[2 * k + dxJoint::GI2_CFM] * fps;
       rows.lo[i] = loHi[2 * k + dxJoint::GI2_LO];
       rows.hi[i] = loHi[2 * k + dxJoint::GI2_HI];
@@ -148,9 +150,13 @@ int prepareRows(dxWorld* world, dxBody* const* body, unsigned nb, dxJoint* const
       if (findex[k] != -1 && std::isfinite(rows.hi[i])) rows.findex[i] = findex[k] + jr.offset;
     }
   }
+}
 
-  // rhs = c/h - J (M^-1 f_ext + v/h), after every getInfo2 (joints may add to f_ext). The
-  // products are summed in dxStepIsland's order.
+// Stage 3b: rhs = c/h - J (M^-1 f_ext + v/h), after every getInfo2 (joints may add to f_ext),
+// stored as the canonical b = -rhs. The products are summed in dxStepIsland's order.
+void finishRhs(dxBody* const* body, unsigned nb, dReal h, IslandWork& w) {
+  RowSystem& rows = w.rows;
+  const dReal fps = dRecip(h);
   std::vector<Vector6>& tmp = w.bodyTmp;
   tmp.resize(nb);
   for (unsigned i = 0; i < nb; ++i) {
@@ -168,13 +174,24 @@ int prepareRows(dxWorld* world, dxBody* const* body, unsigned nb, dxJoint* const
     for (int c = 1; c < kRowWidth; ++c) s += j[c] * t[c];
     return s;
   };
-  for (int i = 0; i < m; ++i) {
+  for (int i = 0; i < rows.size(); ++i) {
     const ConstraintRow& row = rows.rows[i];
     double rhs = rows.b[i];
     rhs -= dot6(row.jA, tmp[row.bodyA]);
     if (row.bodyB >= 0) rhs -= dot6(row.jB, tmp[row.bodyB]);
     rows.b[i] = -rhs;  // canonical w = A x + b
   }
+}
+
+// Stages 2 and 3: the island's rows in the canonical form, joints ordered as dxStepIsland
+// orders them. Returns the number of purely unbounded joints (what dxStepIsland passes to
+// dxSolveLCP as nub).
+int prepareRows(dxWorld* world, dxBody* const* body, unsigned nb, dxJoint* const* joint,
+                unsigned nj, dReal h, IslandWork& w) {
+  const int unboundedJoints = orderJoints(joint, nj, w);
+  numberRows(w);
+  readJointRows(world, h, w);
+  finishRhs(body, nb, h, w);
   return unboundedJoints;
 }
 
@@ -452,79 +469,31 @@ using mlcp::ode::Method;
 void mlcp::ode::Stepper::Impl::runIsland(const dxStepperProcessingCallContext* ctx) {
   std::lock_guard<std::mutex> lock(mutex);
   const double t0 = nowSeconds();
-  dxWorld* world = ctx->m_world;
   dxBody* const* body = ctx->m_islandBodiesStart;
-  dxJoint* const* joint = ctx->m_islandJointsStart;
-  const unsigned nb = ctx->m_islandBodiesCount, nj = ctx->m_islandJointsCount;
+  const unsigned nb = ctx->m_islandBodiesCount;
   const dReal h = ctx->m_stepSize;
 
   IslandStats st;
   st.bodies = static_cast<int>(nb);
   if (primary.forwards()) {
-    for (unsigned k = 0; k < nj; ++k) {
-      dxJoint::Info1 info;
-      joint[k]->getInfo1(&info);
-      st.joints += info.m > 0;
-      st.rows += info.m;
-    }
-    if (primary.kind == Method::Kind::ForwardStep)
-      dxStepIsland(ctx);
-    else
-      dxQuickStepIsland(ctx);
-    st.message = primary.name;
+    forwardIsland(ctx, st);
     st.islandSeconds = nowSeconds() - t0;
     stats.islands.push_back(std::move(st));
     return;
   }
 
   IslandWork& w = work;
-  prepareBodies(world, body, nb, h, w.rows);
-  const int nub = prepareRows(world, body, nb, joint, nj, h, w);
+  prepareBodies(ctx->m_world, body, nb, h, w.rows);
+  const int nub =
+      prepareRows(ctx->m_world, body, nb, ctx->m_islandJointsStart, ctx->m_islandJointsCount, h, w);
   const int m = w.rows.size();
   st.joints = static_cast<int>(w.joints.size());
   st.rows = m;
   for (int i = 0; i < m; ++i) st.unbounded += w.rows.lo[i] == -kInf && w.rows.hi[i] == kInf;
 
   if (m > 0) {
-    // Stage 4: warm start (zeros where nothing matches).
-    w.x0.setZero(m);
-    bool warm = false;
-    if (options.warmStart)
-      for (const JointRows& jr : w.joints)
-        warm |= this->warm.lookup(jr.joint, jr.m, w.x0.data() + jr.offset,
-                                  options.contactMatchDistance);
-    st.warmStarted = warm;
-
-    // Stage 5: solve, verify, fall back (RowSolver), keyed by the island's first body.
-    const std::uint64_t key = reinterpret_cast<std::uintptr_t>(body[0]);
-    // The solve's own clock (RowSolver::solve's span, or solveWithOdeLcp's): no second pair of
-    // clock reads around it.
-    IslandSolve solved =
-        solveWith(primary, w, nub, ctx->m_stepperArena, options, stepOptions, key, w.x);
-    st.solveSeconds = solved.result.seconds;
-    st.status = solved.result.status;
-    st.iterations = solved.result.iterations;
-    st.residual = solved.result.residual;
-    st.message = std::move(solved.result.message);
-    st.choice = std::move(solved.choice);
-    st.fellBack = solved.fellBack;
-    st.accepted = solved.accepted;
-    st.screened = solved.screened;
-    st.friction = solved.friction;
-
-    if (hasReference) {
-      const double tr = nowSeconds();
-      const IslandSolve rr =
-          solveWith(reference, w, nub, ctx->m_stepperArena, options, stepOptions, key, w.xAlt);
-      st.referenceSeconds = nowSeconds() - tr;
-      if (std::isfinite(rr.result.residual) && w.xAlt.size() == m) {
-        st.referenceResidual = rr.result.residual;
-        st.referenceDifference =
-            (w.xAlt - w.x).lpNorm<Eigen::Infinity>() / (1 + w.x.lpNorm<Eigen::Infinity>());
-      } else {
-        st.referenceResidual = st.referenceDifference = kInf;
-      }
-    }
+    st.warmStarted = warmStartIsland(w);
+    solveIsland(ctx, nub, st);
     for (const JointRows& jr : w.joints) this->warm.store(jr.joint, jr.m, w.x.data() + jr.offset);
   } else {
     w.x.resize(0);
@@ -538,4 +507,68 @@ void mlcp::ode::Stepper::Impl::runIsland(const dxStepperProcessingCallContext* c
   st.islandSeconds = nowSeconds() - t0;
   if (options.keepProblems && m > 0) keepProblem(w, static_cast<int>(stats.islands.size()));
   stats.islands.push_back(std::move(st));
+}
+
+void mlcp::ode::Stepper::Impl::forwardIsland(const dxStepperProcessingCallContext* ctx,
+                                             IslandStats& st) {
+  dxJoint* const* joint = ctx->m_islandJointsStart;
+  for (unsigned k = 0; k < ctx->m_islandJointsCount; ++k) {
+    dxJoint::Info1 info;
+    joint[k]->getInfo1(&info);
+    st.joints += info.m > 0;
+    st.rows += info.m;
+  }
+  if (primary.kind == Method::Kind::ForwardStep)
+    dxStepIsland(ctx);
+  else
+    dxQuickStepIsland(ctx);
+  st.message = primary.name;
+}
+
+bool mlcp::ode::Stepper::Impl::warmStartIsland(IslandWork& w) {
+  // Stage 4: warm start (zeros where nothing matches).
+  w.x0.setZero(w.rows.size());
+  bool warmed = false;
+  if (options.warmStart)
+    for (const JointRows& jr : w.joints)
+      warmed |= warm.lookup(jr.joint, jr.m, w.x0.data() + jr.offset, options.contactMatchDistance);
+  return warmed;
+}
+
+void mlcp::ode::Stepper::Impl::solveIsland(const dxStepperProcessingCallContext* ctx, int nub,
+                                           IslandStats& st) {
+  // Stage 5: solve, verify, fall back (RowSolver), keyed by the island's first body.
+  IslandWork& w = work;
+  const std::uint64_t key = reinterpret_cast<std::uintptr_t>(ctx->m_islandBodiesStart[0]);
+  // The solve's own clock (RowSolver::solve's span, or solveWithOdeLcp's): no second pair of
+  // clock reads around it.
+  IslandSolve solved =
+      solveWith(primary, w, nub, ctx->m_stepperArena, options, stepOptions, key, w.x);
+  st.solveSeconds = solved.result.seconds;
+  st.status = solved.result.status;
+  st.iterations = solved.result.iterations;
+  st.residual = solved.result.residual;
+  st.message = std::move(solved.result.message);
+  st.choice = std::move(solved.choice);
+  st.fellBack = solved.fellBack;
+  st.accepted = solved.accepted;
+  st.screened = solved.screened;
+  st.friction = solved.friction;
+  if (hasReference) compareWithReference(ctx, nub, key, st);
+}
+
+void mlcp::ode::Stepper::Impl::compareWithReference(const dxStepperProcessingCallContext* ctx,
+                                                    int nub, std::uint64_t key, IslandStats& st) {
+  IslandWork& w = work;
+  const double tr = nowSeconds();
+  const IslandSolve rr =
+      solveWith(reference, w, nub, ctx->m_stepperArena, options, stepOptions, key, w.xAlt);
+  st.referenceSeconds = nowSeconds() - tr;
+  if (std::isfinite(rr.result.residual) && w.xAlt.size() == w.rows.size()) {
+    st.referenceResidual = rr.result.residual;
+    st.referenceDifference =
+        (w.xAlt - w.x).lpNorm<Eigen::Infinity>() / (1 + w.x.lpNorm<Eigen::Infinity>());
+  } else {
+    st.referenceResidual = st.referenceDifference = kInf;
+  }
 }

@@ -42,10 +42,9 @@ Method makeMethod(const std::string& name, RowSolverSettings settings);
 // endStep. Joints other than contacts are keyed by the joint; contacts, which are new joints
 // every step, by body pair, then by position: a contact takes the answer of the pair's last-step
 // contact nearest to it (a chain through the pair's entries, a few per pair), within the match
-// distance. Why not the rank among the pair's contacts: ODE's box-box collider culls and orders
-// a face's points differently from step to step on a resting pyramid, so the rank pairs points
-// of different corners and leaves most contacts cold (docs/benchmarks.md, "ODE's contacts
-// warm-started by position").
+// distance: ODE's box-box collider orders a face's points differently from step to step, so a
+// contact's rank among the pair's is no match (docs/decisions.md, "Adapters: warm starts and
+// rows").
 class WarmStartCache {
  public:
   // Fills lambda (size m) for the joint and returns true when a matching entry exists.
@@ -130,7 +129,16 @@ struct mlcp::ode::Stepper::Impl {
 
   // The step's options from the settings and the world (engineIterations).
   void beginStep(dxWorld* world);
+  // One island through the stages of mlcp/ode/stepper.hpp, its statistics appended to stats.
   void runIsland(const dxStepperProcessingCallContext* context);
+  // runIsland's parts: ODE's own step on the whole island (ode-step, ode-quickstep); stage 4
+  // into work.x0 (returns whether any joint matched); stage 5 into work.x; the reference
+  // method's solve into work.xAlt and its distance from work.x.
+  void forwardIsland(const dxStepperProcessingCallContext* context, IslandStats& st);
+  bool warmStartIsland(IslandWork& w);
+  void solveIsland(const dxStepperProcessingCallContext* context, int nub, IslandStats& st);
+  void compareWithReference(const dxStepperProcessingCallContext* context, int nub,
+                            std::uint64_t key, IslandStats& st);
   // Swaps the island's rows and answer into a kept IslandProblem (after integration).
   void keepProblem(IslandWork& w, int island);
   sizeint memoryFor(dxBody* const* body, unsigned nb, dxJoint* const* joint, unsigned nj) const;

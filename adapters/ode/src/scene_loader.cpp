@@ -37,6 +37,80 @@ void setLimitsAndMotor(dJointID joint, const scene::Joint& j, void (*set)(dJoint
   }
 }
 
+// A ball joint and an Euler angular motor whose stops limit each angle: twist about the axis
+// (fixed in bodies[0]), swing1 about the normal (fixed in bodies[1]), swing2 about their cross
+// product. Limits per angle make a pyramid of swings, not Bullet's elliptic cone; the middle
+// Euler angle must stay below pi/2.
+void addConeTwist(dWorldID world, const scene::Joint& j, dBodyID a, dBodyID b) {
+  const auto& p = j.anchor;
+  const auto& x = j.axis;
+  if (j.cone.swing2 >= 1.5)
+    throw scene::Unsupported("unsupported in ODE: cone_twist " + j.name +
+                             ": swing2 of 1.5 rad or more (the middle angle of ODE's Euler "
+                             "angular motor must stay below pi/2)");
+  dJointID joint = dJointCreateBall(world, nullptr);
+  dJointAttach(joint, a, b);
+  dJointSetBallAnchor(joint, p[0], p[1], p[2]);
+  dJointID motor = dJointCreateAMotor(world, nullptr);
+  dJointAttach(motor, a, b);
+  dJointSetAMotorMode(motor, dAMotorEuler);
+  dJointSetAMotorAxis(motor, 0, 1, x[0], x[1], x[2]);
+  dJointSetAMotorAxis(motor, 2, 2, j.normal[0], j.normal[1], j.normal[2]);
+  const double stops[3] = {j.cone.twist, j.cone.swing2, j.cone.swing1};
+  const int lo[3] = {dParamLoStop, dParamLoStop2, dParamLoStop3};
+  const int hi[3] = {dParamHiStop, dParamHiStop2, dParamHiStop3};
+  for (int i = 0; i < 3; ++i) {
+    dJointSetAMotorParam(motor, lo[i], -stops[i]);
+    dJointSetAMotorParam(motor, hi[i], stops[i]);
+  }
+}
+
+void addUniversal(dWorldID world, const scene::Joint& j, dBodyID a, dBodyID b) {
+  dJointID joint = dJointCreateUniversal(world, nullptr);
+  dJointAttach(joint, a, b);
+  dJointSetUniversalAnchor(joint, j.anchor[0], j.anchor[1], j.anchor[2]);
+  dJointSetUniversalAxis1(joint, j.axis[0], j.axis[1], j.axis[2]);
+  dJointSetUniversalAxis2(joint, j.axis2[0], j.axis2[1], j.axis2[2]);
+}
+
+void addHinge2(dWorldID world, double timeStep, const scene::Joint& j, dBodyID a, dBodyID b) {
+  dJointID joint = dJointCreateHinge2(world, nullptr);
+  dJointAttach(joint, a, b);
+  dJointSetHinge2Anchor(joint, j.anchor[0], j.anchor[1], j.anchor[2]);
+  dJointSetHinge2Axes(joint, j.axis.data(), j.axis2.data());
+  setLimitsAndMotor(joint, j, &dJointSetHinge2Param);
+  if (j.suspension.enabled) {
+    // ODE's spring-damper as a soft constraint: erp = h k / (h k + c), cfm = 1 / (h k + c).
+    const double hk = timeStep * j.suspension.stiffness, c = j.suspension.damping;
+    if (hk + c <= 0)
+      throw scene::Unsupported("unsupported in ODE: hinge2 " + j.name +
+                               ": a suspension without stiffness or damping");
+    dJointSetHinge2Param(joint, dParamSuspensionERP, hk / (hk + c));
+    dJointSetHinge2Param(joint, dParamSuspensionCFM, 1 / (hk + c));
+  }
+}
+
+// Parallel-axes mode turns the wheels in opposite senses about one common axis: the scene's
+// w0 . axis = -ratio w1 . axis2 with axis2 = axis.
+void addGear(dWorldID world, const scene::Joint& j, dBodyID a, dBodyID b) {
+  const auto& x = j.axis;
+  const auto& y = j.axis2;
+  const double d = x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
+  if (std::abs(d - 1) > 1e-9)
+    throw scene::Unsupported("unsupported in ODE: gear " + j.name +
+                             ": axis2 differs from axis (dTransmissionParallelAxes turns "
+                             "both wheels about one direction)");
+  dJointID joint = dJointCreateTransmission(world, nullptr);
+  dJointAttach(joint, a, b);
+  dJointSetTransmissionMode(joint, dTransmissionParallelAxes);
+  dJointSetTransmissionAnchor1(joint, j.anchor[0], j.anchor[1], j.anchor[2]);
+  dJointSetTransmissionAnchor2(joint, j.anchor2[0], j.anchor2[1], j.anchor2[2]);
+  dJointSetTransmissionAxis(joint, x[0], x[1], x[2]);
+  // ODE's ratio is the first wheel's radius over the second's (transmission.cpp), the inverse
+  // of the speed ratio the scene gives.
+  dJointSetTransmissionRatio(joint, 1 / j.ratio);
+}
+
 // A geom of ODE class `cls` around the origin (no space, no body), to probe dCollide with.
 dGeomID probeGeom(int cls) {
   // A unit cube as ODE's convex data: planes (n, d), corners, polygons (count, indices).
@@ -360,79 +434,11 @@ dGeomID OdeScene::createConvex(const scene::Shape& shape) {
 }
 
 void OdeScene::addOtherJoint(const scene::Joint& j, dBodyID a, dBodyID b) {
-  const auto& p = j.anchor;
-  const auto& x = j.axis;
-  const auto& y = j.axis2;
-  dJointID joint = nullptr;
   switch (j.type) {
-    case scene::JointType::ConeTwist: {
-      // A ball joint and an Euler angular motor whose stops limit each angle: twist about the
-      // axis (fixed in bodies[0]), swing1 about the normal (fixed in bodies[1]), swing2 about
-      // their cross product. Limits per angle make a pyramid of swings, not Bullet's elliptic
-      // cone; the middle Euler angle must stay below pi/2.
-      if (j.cone.swing2 >= 1.5)
-        throw scene::Unsupported("unsupported in ODE: cone_twist " + j.name +
-                                 ": swing2 of 1.5 rad or more (the middle angle of ODE's Euler "
-                                 "angular motor must stay below pi/2)");
-      joint = dJointCreateBall(world_, nullptr);
-      dJointAttach(joint, a, b);
-      dJointSetBallAnchor(joint, p[0], p[1], p[2]);
-      dJointID motor = dJointCreateAMotor(world_, nullptr);
-      dJointAttach(motor, a, b);
-      dJointSetAMotorMode(motor, dAMotorEuler);
-      dJointSetAMotorAxis(motor, 0, 1, x[0], x[1], x[2]);
-      dJointSetAMotorAxis(motor, 2, 2, j.normal[0], j.normal[1], j.normal[2]);
-      const double stops[3] = {j.cone.twist, j.cone.swing2, j.cone.swing1};
-      const int lo[3] = {dParamLoStop, dParamLoStop2, dParamLoStop3};
-      const int hi[3] = {dParamHiStop, dParamHiStop2, dParamHiStop3};
-      for (int i = 0; i < 3; ++i) {
-        dJointSetAMotorParam(motor, lo[i], -stops[i]);
-        dJointSetAMotorParam(motor, hi[i], stops[i]);
-      }
-      break;
-    }
-    case scene::JointType::Universal:
-      joint = dJointCreateUniversal(world_, nullptr);
-      dJointAttach(joint, a, b);
-      dJointSetUniversalAnchor(joint, p[0], p[1], p[2]);
-      dJointSetUniversalAxis1(joint, x[0], x[1], x[2]);
-      dJointSetUniversalAxis2(joint, y[0], y[1], y[2]);
-      break;
-    case scene::JointType::Hinge2:
-      joint = dJointCreateHinge2(world_, nullptr);
-      dJointAttach(joint, a, b);
-      dJointSetHinge2Anchor(joint, p[0], p[1], p[2]);
-      dJointSetHinge2Axes(joint, x.data(), y.data());
-      setLimitsAndMotor(joint, j, &dJointSetHinge2Param);
-      if (j.suspension.enabled) {
-        // ODE's spring-damper as a soft constraint: erp = h k / (h k + c), cfm = 1 / (h k + c).
-        const double hk = timeStep_ * j.suspension.stiffness, c = j.suspension.damping;
-        if (hk + c <= 0)
-          throw scene::Unsupported("unsupported in ODE: hinge2 " + j.name +
-                                   ": a suspension without stiffness or damping");
-        dJointSetHinge2Param(joint, dParamSuspensionERP, hk / (hk + c));
-        dJointSetHinge2Param(joint, dParamSuspensionCFM, 1 / (hk + c));
-      }
-      break;
-    case scene::JointType::Gear: {
-      const double d = x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
-      // Parallel-axes mode turns the wheels in opposite senses about one common axis: the
-      // scene's w0 . axis = -ratio w1 . axis2 with axis2 = axis.
-      if (std::abs(d - 1) > 1e-9)
-        throw scene::Unsupported("unsupported in ODE: gear " + j.name +
-                                 ": axis2 differs from axis (dTransmissionParallelAxes turns "
-                                 "both wheels about one direction)");
-      joint = dJointCreateTransmission(world_, nullptr);
-      dJointAttach(joint, a, b);
-      dJointSetTransmissionMode(joint, dTransmissionParallelAxes);
-      dJointSetTransmissionAnchor1(joint, p[0], p[1], p[2]);
-      dJointSetTransmissionAnchor2(joint, j.anchor2[0], j.anchor2[1], j.anchor2[2]);
-      dJointSetTransmissionAxis(joint, x[0], x[1], x[2]);
-      // ODE's ratio is the first wheel's radius over the second's (transmission.cpp), the
-      // inverse of the speed ratio the scene gives.
-      dJointSetTransmissionRatio(joint, 1 / j.ratio);
-      break;
-    }
+    case scene::JointType::ConeTwist: addConeTwist(world_, j, a, b); break;
+    case scene::JointType::Universal: addUniversal(world_, j, a, b); break;
+    case scene::JointType::Hinge2: addHinge2(world_, timeStep_, j, a, b); break;
+    case scene::JointType::Gear: addGear(world_, j, a, b); break;
     case scene::JointType::SixDof:
       throw scene::Unsupported("unsupported in ODE: six_dof joint " + j.name +
                                " (ODE has no joint with per-axis limits and springs)");
@@ -440,7 +446,6 @@ void OdeScene::addOtherJoint(const scene::Joint& j, dBodyID a, dBodyID b) {
       throw scene::Unsupported(std::string("unsupported in ODE: joint type ") +
                                scene::toString(j.type));
   }
-  (void)joint;
 }
 
 void OdeScene::nearCallback(void* data, dGeomID g1, dGeomID g2) {

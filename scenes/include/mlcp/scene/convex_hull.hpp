@@ -10,7 +10,7 @@
 // ordered counter-clockwise seen from outside. Every given point must be a corner (on at least
 // three face planes): a point inside the hull, on a face or on an edge is an error, so that the
 // file says exactly what the engines get. O(n^4) in the number of points n, which the format
-// limits to kMaxHullPoints (64: ~3 ms).
+// limits to kMaxHullPoints (64; docs/benchmarks.md, "Scenes: the convex hull of 64 points").
 //
 // Mass properties at uniform density: the solid is cut into tetrahedra (centroid of the
 // corners, face corner 0, face corners k and k+1); each tetrahedron (v0..v3) has volume

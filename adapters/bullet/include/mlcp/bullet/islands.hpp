@@ -2,37 +2,25 @@
 //
 // Input: the pools btSequentialImpulseConstraintSolver's setup fills (solver bodies; joint,
 // contact, friction and rolling-friction rows). Output: one Island per connected component of
-// the dynamic-body graph, each holding an mlcp::RowSystem (rows in Bullet's order: joints,
-// contacts, friction, rolling friction — the stock btMLCPSolver's order) and pointers back to
-// Bullet's rows for the write-back. The conversion rules are listed in constraint_solver.hpp.
+// the dynamic-body graph, each holding an mlcp::RowSystem (mlcp/island/rows.hpp; rows in
+// Bullet's order: joints, contacts, friction, rolling friction, the stock btMLCPSolver's order)
+// and pointers back to Bullet's rows for the write-back. The conversion rules are stage 3 of
+// docs/methods/adapters.md, "Bullet: the drop-in's stages".
 //
 // Static bodies (Bullet maps them all to one fixed solver body) and kinematic bodies (inverse
 // mass 0) are "the world": they couple nothing, so two boxes resting on the same ground are two
-// islands. Buffers are kept between calls so a steady scene allocates nothing per step.
+// islands.
 //
-// Two passes over Bullet's rows (288 bytes each, in double precision):
-//  1. the graph pass reads only the body indices: a union-find over the dynamic bodies, each
-//     row's bodies kept in a compact array. When the group is one component (every dynamic body
-//     under one root, no inert row: a pile, a pyramid) this pass also decides it and numbers the
-//     bodies by first use as the rows come; components are counted as the bodies the rows name
-//     less the unions that joined two, so no find() per body follows. Such an island takes the
-//     pass's row and findex arrays by swap, in Bullet's order (Island::inOrder, no rowIndex).
-//     Otherwise the numbering runs on the compact arrays in two passes: each row's island and
-//     place (no find() for a row on the previous row's bodies), then each island's arrays, sized
-//     once and written by index (rows, bodies, findex, manifold points, last step's entries).
-//     Both numberings give the same order (tested equal bit for bit).
-//  2. the conversion writes each row either into its island's RowSystem (build with system =
-//     true, or fillSystem later) or straight into RowPgs' packing through Source (the "pgs"
-//     path: read in place by RowPgs' engine entry point, view() inlined into Source::row, no
-//     copy).
-//     Both write the same values (one conversion function).
-// Both passes fetch Bullet's rows and the manifold points a few rows ahead: the passes are bound
-// by their first touch of each row, which sits out of cache after Bullet's setup. What remember()
-// needs after the solve (points' positions, friction directions) is kept in Island::memo, so
-// after the sweeps only the applied impulses are written back into Bullet's rows; without the
-// cached-impulse start the manifold points are not read at all.
-// Cost: O(rows + bodies) per group, near-linear union-find included; no allocation
-// once the buffers have grown.
+// Two passes over Bullet's rows: a graph pass (union-find on the body indices only; a group that
+// is one component is decided there and kept in Bullet's order, Island::inOrder), then the
+// conversion, into each island's RowSystem or read in place by RowPgs through Source (one
+// conversion function, view(), for both). Both passes fetch rows and manifold points a few rows
+// ahead, and what remember() needs after the solve is kept in Island::memo, so after the sweeps
+// only the applied impulses are written into Bullet's rows (docs/methods/adapters.md, "Bullet:
+// islands, the two passes").
+// Invariants: both numberings give the same island and row order; Source and fillSystem give the
+// same values bit for bit. Cost: O(rows + bodies) per group, near-linear union-find included; no
+// allocation once the buffers have grown.
 #pragma once
 
 #include <BulletDynamics/ConstraintSolver/btSequentialImpulseConstraintSolver.h>
@@ -86,8 +74,8 @@ struct Island {
   // friction row's direction (the impulse on body A per unit x; view()).
   std::vector<btVector3> memo;
   // A body's linear factor has a component other than 0 and 1, or its angular factor unequal
-  // components: Bullet's body update is not M^-1 J^T there (constraint_solver.hpp), so a
-  // per-body write-back would differ from Bullet's.
+  // components: Bullet's body update is not M^-1 J^T there (docs/methods/adapters.md, "Bullet:
+  // the pgs path"), so a per-body write-back would differ from Bullet's.
   bool perRowWriteBack = false;
   // A row's b is beyond reach (mlcp/island/row_screen.hpp: Bullet's 6-dof limit at 1e30): the
   // packed pgs, which screens nothing, leaves the island to RowSolver, whose screening fixes the
@@ -115,21 +103,9 @@ class IslandBuilder {
   // same values fillSystem writes; split: b from m_rhsPenetration, the applied push impulse as
   // start and base); base is the impulse Bullet's bodies already carry (m_appliedImpulse /
   // m_appliedPushImpulse). Reading the primary problem's rows sets island.hasSplit.
-  // J's linear part is m_contactNormal1/2 itself where the body's linear factor is (1, 1, 1)
-  // (else n times the factor, computed), the angular part m_relpos1/2CrossNormal; M^-1 J^T's
-  // angular part is Bullet's m_angularComponentA/B where the body's angular factor is (1, 1, 1).
-  // Bullet 3.24's setup (setupContactConstraint, setupFrictionConstraint,
-  // setupTorsionalFrictionConstraint, convertJoint) computes it as
-  // getInvInertiaTensorWorld() * m_relposNCrossNormal * getAngularFactor(): with the factor 1
-  // that is bit for bit our invInertia (diag(f) I^-1 diag(f) = I^-1) times the same vector, row
-  // by row left to right (double precision Bullet has no SIMD dot; neither side is built with
-  // fused multiply-adds: true of Debian's x86-64 builds; where a compiler contracts a * b + c
-  // by default, e.g. GCC on aarch64, the two may round apart and only agree to round-off).
-  // So the packing skips two 3x3 products per row and the iterates stay those of the RowSystem
-  // copy (tested bit for bit on a pyramid with contact, friction and hinge rows). Bullet's
-  // m_jacDiagABInv is
-  // not used: it is 1 / (invMass + n . (I^-1 (r x n)) x r + Bullet's own cfm), a different
-  // rounding of A_ii, and friction rows lack the cfm our CfmModel gives them.
+  // J and M^-1 J^T's angular part are Bullet's own vectors where the body's factors are
+  // (1, 1, 1): the same doubles the RowSystem's products give, bit for bit, where neither side is
+  // built with fused multiply-adds (docs/methods/adapters.md, "Bullet: rows read in place").
   class Source final : public RowPgs::RowSource {
    public:
     Source(IslandBuilder& builder, Island& island, bool split)
@@ -147,17 +123,12 @@ class IslandBuilder {
   // The island's RowSystem, start, splitB and splitStart (once per build).
   void fillSystem(Island& island);
 
-  // Warm start across steps from our own answers, per manifold point. Bullet 3 starts friction
-  // rows at 0, and with its default velocity-dependent friction direction a row's direction
-  // changes every step, so last step's value per row means nothing; and a point Bullet removes
-  // and re-creates at the same place (m_lifeTime 0, which happens every step to some points of
-  // a resting stack) has lost its cached normal impulse. remember() keeps each point's normal
-  // impulse and friction impulse (a world vector: the sum of x_r times the row's direction);
-  // the next step's build() starts the point's contact row at that normal impulse and its
-  // friction rows at the vector's components along their new directions. A point is "the
-  // same" when it sits in the same slot (pointer) with m_localPointA within
-  // gContactBreakingThreshold of the remembered one: Bullet's own rule for matching a new
-  // point to a cached one (a removed point's slot refilled by another point is farther away).
+  // Warm start across steps from our own answers, per manifold point (docs/methods/adapters.md,
+  // "Bullet: the warm start"): remember() keeps each point's normal impulse and friction impulse
+  // (a world vector: the sum of x_r times the row's direction); the next step's build() starts
+  // the point's contact row at that normal impulse and its friction rows at the vector's
+  // components along their new directions. A point is "the same" when it sits in the same slot
+  // (pointer) with m_localPointA within gContactBreakingThreshold of the remembered one.
   // Call newStep() once per simulation step, before its build() calls.
   void newStep();
   // store: also set each row's m_appliedImpulse to x (one pass over Bullet's rows for both).
@@ -198,6 +169,17 @@ class IslandBuilder {
   // The island's row r; split: the split-impulse problem's b, start and base. scratch: 12
   // doubles for J's parts that are not read in place (6 a side; see view()).
   RowPgs::RowView view(Island& island, int r, bool split, double* scratch);
+  // view()'s parts, i being the row's builder index: one side's J and M^-1's angular part
+  // (own: 6 doubles for what is not read in place); the start; b and cfm (returns the split
+  // problem's b); findex and the bounds.
+  void viewSide(int body, const btVector3& normal, const btVector3& torqueAxis,
+                const btVector3& invAngular, const double*& lin, const double*& ang,
+                const double*& invAng, double* own) const;
+  double viewStart(const Island& island, int r, int i, const btSolverConstraint& c, double base,
+                   bool split) const;
+  double viewRhs(Island& island, const btSolverConstraint& c, int findex, bool split,
+                 RowPgs::RowView& out) const;
+  void viewBounds(const btSolverConstraint& c, int i, int findex, RowPgs::RowView& out) const;
 
   std::vector<Island> islands_;
   int count_ = 0, inert_ = 0;
@@ -223,9 +205,7 @@ class IslandBuilder {
   };
   // Last step's entry for this point, or null. Points come in nearly the same order every step
   // (manifolds and their point slots persist), so the entry after the last one found is tried
-  // first; only a miss builds the address index over last_ (once per step). (An
-  // std::unordered_map cleared every step allocated a node per point per step, and a hash
-  // table probed per point cost a cache miss per lookup.)
+  // first; only a miss builds the address index over last_ (once per step).
   const Remembered* lookup(const btManifoldPoint* point);
   std::vector<Remembered> last_, this_;  // in the order remember() met the points
   std::size_t cursor_ = 0;               // where lookup() tries first

@@ -8,7 +8,7 @@
 // The stock solver hands over a dense A (it builds one for every island), Bullet's b (minus
 // ours: converted here), lo/hi (contacts [0, 1e10]), limitDependency (= findex) and x holding
 // the applied impulses (used as the warm start). The answer is checked by the drop-in's rule
-// (mlcp::acceptable, mlcp/island/row_solver.hpp); returning false makes btMLCPSolver count a
+// (mlcp::acceptable, mlcp/island/policy.hpp); returning false makes btMLCPSolver count a
 // fallback and run its SI iterations. For large problems prefer the drop-in
 // mlcp::bullet::ConstraintSolver: it never builds the dense matrix and splits islands.
 #pragma once
@@ -36,7 +36,7 @@ class MlcpBridge : public btMLCPSolverInterface {
   // Largest accepted scaled residual (dimensionless). Default mlcp::kDefaultAcceptResidual.
   double acceptResidual = kDefaultAcceptResidual;
   // Problems with more rows than this are converted to sparse storage (dropping A's zeros).
-  // Default mlcp::kDenseAssemblyRows (64).
+  // Default mlcp::kDenseAssemblyRows (64, mlcp/thresholds.hpp).
   int denseAssemblyMaxRows = kDenseAssemblyRows;
   // pgs/gs take their sweep count from the numIterations argument (as the stock PGS does),
   // checked once at the end, instead of the options' limit (RowSolverSettings::engineIterations

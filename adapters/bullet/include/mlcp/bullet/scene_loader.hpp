@@ -10,49 +10,19 @@
 //     world.setConstraintSolver(&solver);             // the one-line swap
 //     world.stepSimulation(h, 0, h);
 //
-// loadWorld's worlds are built by buildWorld: one mapping, described here.
-//
-// How the scene maps onto Bullet:
-// - shapes: plane btStaticPlaneShape(normal, offset), box btBoxShape(size / 2), sphere
-//   btSphereShape, capsule btCapsuleShapeZ(radius, length) (along the body's z axis), cylinder
-//   btCylinderShapeZ(radius, radius, length / 2), convex hull btConvexHullShape of the corners
-//   with a 1 mm margin (Bullet's 0.04 m default inflates the hull) and its polyhedral features
-//   for separating-axis contact clipping (the world's m_enableSatConvex, set when a hull is
-//   present);
-// - mass and the scene's inertia (never Bullet's own approximation, which is a box for
-//   capsules); pose, velocities; sleeping only when the scene allows it;
-// - materials: Bullet multiplies the two bodies' friction, so each body gets sqrt(mu) and a
-//   pair gets sqrt(mu_a mu_b) exactly; restitution is combined by max(e_a, e_b) through
-//   Bullet's global gCalculateCombinedRestitutionCallback, which the loader installs (it is
-//   process-wide; every world of this process then combines restitution by max);
-// - joints through frames at the anchor whose z axis is the joint axis (x for the slider):
-//   ball btPoint2PointConstraint, hinge btHingeConstraint (limits with softness 1, motor
-//   impulse max_force * dt), slider btSliderConstraint (rotation locked; linear limits and
-//   motor), fixed btFixedConstraint; joints to the world use btTypedConstraint::getFixedBody().
-//   Bullet measures the hinge angle of its body A relative to B, as the scene does, but the
-//   slider offset of B relative to A: the slider's frame axis is reversed so that its limits
-//   and motor keep the scene's signs (world_test checks both by driving the motors into the
-//   upper limits); cone_twist btConeTwistConstraint (frame x the twist axis, z the normal:
-//   setLimit(swing1, swing2, twist)); six_dof btGeneric6DofSpring2Constraint (RO_XYZ, frame
-//   x = axis, y = normal, its body B the scene's bodies[0] so that offsets and angles are
-//   bodies[0]'s relative to bodies[1]; free axes lower 1 > upper -1, springs at the creation
-//   pose; stiffness and damping as the scene gives them, setStiffness(i, k, false): by default
-//   Bullet caps a spring at m / (16 dt^2) of the lighter body, which let the vehicle's 20 kN/m
-//   suspension act as 2.2 kN/m and the chassis sink 0.23 m); universal
-//   btUniversalConstraint(anchor, axis, axis2); hinge2 btHinge2Constraint (chassis, wheel, anchor,
-//   axis, axis2), steering limits, the suspension as its spring on linear z within Bullet's +-1 m
-//   travel, or linear z locked when the scene has none; gear btGearConstraint with both axes in
-//   their bodies' frames and the ratio;
-// - settings: gravity, one fixed step of time_step per step (no substeps), m_erp = m_erp2 =
-//   erp, m_globalCfm = cfm, m_numIterations = iterations, minimumSolverBatchSize 1 (islands
-//   solved one by one, as the direct solvers want), SOLVER_USE_2_FRICTION_DIRECTIONS (two
-//   friction rows per contact like ODE's, so both engines solve problems of the same shape;
-//   Bullet's default is one row along the sliding direction), SOLVER_ENABLE_FRICTION_DIRECTION_
-//   CACHING | SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION (a contact keeps its friction
-//   directions from step to step, so last step's friction impulses are a meaningful warm start:
-//   with directions that follow the sliding velocity, the exact solvers' warm starts are off
-//   and their steps take two to three times as long on the pyramids). max_contacts_per_pair is 4 in
-//   Bullet's manifolds whatever the scene says.
+// loadWorld's worlds are built by buildWorld: one mapping, listed shape by shape and joint by
+// joint in docs/methods/adapters.md, "Bullet: the scene mapping". What it guarantees:
+// - the scene's numbers, not Bullet's approximations: the scene's inertia (Bullet's own is a box
+//   for capsules), convex hulls with a 1 mm margin, springs as stiff as the scene says (no cap);
+// - joints keep the scene's signs: angles and offsets of bodies[0] relative to bodies[1];
+// - materials by the scene's rules: each body gets friction sqrt(mu), so a pair gets
+//   sqrt(mu_a mu_b); restitution max(e_a, e_b) through Bullet's process-wide
+//   gCalculateCombinedRestitutionCallback, which the loader installs (every world of the process
+//   then combines restitution by max);
+// - problems of the shape ODE's are: one fixed step per step, islands solved one by one
+//   (minimumSolverBatchSize 1), two friction rows per contact whose directions persist from
+//   step to step (so last step's friction impulses are a warm start); at most 4 contacts per
+//   pair (Bullet's manifolds) whatever the scene says.
 //
 // Solver names: any mlcp::solverNames() name runs through mlcp::bullet::ConstraintSolver (its
 // statistics fill the measures); the stock ones are

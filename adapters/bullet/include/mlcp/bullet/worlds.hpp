@@ -10,46 +10,25 @@
 //     // (or install(*world, *pool) on a world built with other solvers)
 //     pool->lastStep();                             // every island of the step, all members
 //
-// Which world calls what (Bullet 3.24, btDiscreteDynamicsWorldMt.cpp and
-// btSimulationIslandManagerMt.cpp):
-// - btDiscreteDynamicsWorld: prepareSolve, solveGroup per island batch (islands below
-//   m_minimumSolverBatchSize merged; ConstraintSolver splits them again), one more solveGroup
-//   for what was deferred, allSolved. setConstraintSolver reaches everything.
-// - btDiscreteDynamicsWorldMt: its constructor takes a btConstraintSolverPoolMt (the
-//   m_constraintSolver slot: prepareSolve and allSolved, and the islands solved in parallel,
-//   each by a pool member locked for the call) and a "constraintSolverMt" (a protected member
-//   without a setter): btSimulationIslandManagerMt::parallelIslandDispatch hands every island
-//   with at least btSequentialImpulseConstraintSolverMt::s_minimumContactManifoldsForBatching
-//   manifolds (default 250) to that second solver, one at a time, before the parallel part; the
-//   serial dispatch and the unsplit path give it everything. Bullet's demos pass a
-//   btSequentialImpulseConstraintSolverMt there: with setConstraintSolver(&ours) alone their
-//   960-box walls never reach our solver. install() fills both slots; the pool passed as both
-//   is what every island goes to. The world puts every island of fewer than 32 bodies
-//   (m_batchIslandMinBodyCount, no setter) into one batch island, and merges islands whose batch
-//   cost (bodies + 8 manifolds + 4 constraints) is below m_minimumSolverBatchSize (taken from
-//   btContactSolverInfo at construction, 128): a member sees merged groups and splits them into
-//   connected components as in the plain world. (Debian's btSequentialImpulseConstraintSolverMt,
-//   built without BT_THREADSAFE, crashed in btBatchedConstraints::setup on a 55-box pyramid
-//   with the batching threshold lowered to 16 manifolds.)
-// - btMultiBodyDynamicsWorld (and the soft/deformable multibody worlds derived from it):
-//   setConstraintSolver keeps its btMultiBodyConstraintSolver for every island (the island
-//   callback holds it) unless the new solver is of type BT_MULTIBODY_SOLVER; it calls only
-//   prepareSolve and allSolved on ours. Not supported: install() throws, and a ConstraintSolver
-//   set there by hand throws from allSolved at the first step (constraint_solver.hpp, "Worlds
-//   served").
+// Which world reaches what (Bullet 3.24; each in full in docs/methods/adapters.md, "Bullet:
+// worlds served"):
+// - btDiscreteDynamicsWorld: setConstraintSolver reaches every solveGroup call.
+// - btDiscreteDynamicsWorldMt: besides its btConstraintSolverPoolMt slot it hands every island of
+//   at least 250 manifolds (s_minimumContactManifoldsForBatching) to a second solver, a protected
+//   member without a setter; install() fills both slots, so every island reaches the pool or
+//   solver given. Its members still see merged groups and split them into connected components.
+// - btMultiBodyDynamicsWorld (and the worlds derived from it) keeps its own solver for every
+//   island and calls only prepareSolve and allSolved on ours: install() throws, and a
+//   ConstraintSolver set there by hand throws from allSolved at the first step.
 //
-// Debian's Bullet 3.24 is built without BT_THREADSAFE: btCreateDefaultTaskScheduler returns
-// null, only the sequential task scheduler exists, btParallelFor runs on the calling thread,
-// and the pool's spin mutexes do nothing (every call takes member 0). A user's own
-// btITaskScheduler can still run btParallelFor on several threads: the pool's members then race
-// on Bullet's no-op locks, but each ConstraintSolver holds its own mutex, so a member called
-// from two threads at once solves one group after the other. A Bullet built thread-safe gives
-// each thread its own member (btGetCurrentThreadIndex() % size()).
+// Threads. Debian's Bullet 3.24 is built without BT_THREADSAFE: btParallelFor runs on the
+// calling thread and every call takes member 0. Under a user's own threaded btITaskScheduler the
+// members race on Bullet's no-op locks, but each ConstraintSolver holds its own mutex, so a member
+// called from two threads solves one group after the other. A Bullet built thread-safe gives each
+// thread its own member.
 //
-// Warm start in a pool: each member remembers the answers of the islands it solved
-// (IslandBuilder::remember); an island solved by another member than last step starts from
-// Bullet's cached impulses instead (what the plain world does for a point without a remembered
-// answer). Exact solvers do not depend on the start.
+// Warm start in a pool: each member remembers the answers of the islands it solved; an island
+// solved by another member than last step starts from Bullet's cached impulses instead.
 #pragma once
 
 #include <BulletDynamics/Dynamics/btDiscreteDynamicsWorldMt.h>

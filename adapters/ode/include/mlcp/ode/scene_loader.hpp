@@ -10,36 +10,18 @@
 //     stepper.step(built->world(), h);             // in place of dWorldStep(world, h)
 //     built->clearContacts();                      // dJointGroupEmpty
 //
-// loadWorld's worlds are built by buildWorld: one mapping, described here.
-//
-// How the scene maps onto ODE:
-// - one dWorld and a hash space; geoms dCreatePlane (a x + b y + c z = d), dCreateBox,
-//   dCreateSphere, dCreateCapsule, dCreateCylinder (along the body's z axis), dCreateConvex
-//   (planes and polygons from the scene's hull faces). Static bodies are geoms without a body
-//   (placed by their pose). A pair of geom classes this ODE build has no collider for (Debian's
-//   libode has no libccd: cylinder-cylinder, capsule-cylinder, convex-cylinder) makes
-//   collide() throw scene::Unsupported the first time such a pair's boxes overlap, rather than
-//   pass for "no contact";
-// - masses through dMassSetParameters with the scene's inertia (centre of mass at the body
-//   origin); pose, velocities; auto-disable only when the scene allows sleeping;
-// - contacts from dSpaceCollide in a near callback: at most max_contacts_per_pair points per
-//   pair, dContactApprox1 (friction bound mu times the normal force, as Bullet), mu and
-//   restitution by the scene's rules (sqrt(mu_a mu_b), max(e_a, e_b); dContactBounce with
-//   bounce_vel 0.2 m/s when e > 0), a joint group emptied after every step; pairs joined by a
-//   joint without collide_connected do not collide;
-// - joints: dJointCreateBall / Hinge (dParamLoStop, dParamHiStop, dParamVel, dParamFMax) /
-//   Slider (the same) / Fixed, attached as (A, B) or (A, 0) for the world. ODE measures the
-//   hinge angle and slider offset of body 1 relative to body 2, as the scene does;
-//   cone_twist a ball joint plus a dAMotorEuler whose stops hold twist (about the axis, fixed
-//   in A), swing2 (the middle angle, < 1.5 rad) and swing1 (about the normal, fixed in B):
-//   limits per angle, a pyramid where Bullet's is an elliptic cone; universal
-//   dJointCreateUniversal; hinge2 dJointCreateHinge2 (steering stops; a suspension of stiffness
-//   k and damping c as dParamSuspensionERP h k / (h k + c) and CFM 1 / (h k + c), ODE's
-//   spring formulas); gear dJointCreateTransmission in dTransmissionParallelAxes mode with the
-//   two centres as anchors and ODE's ratio (first radius over second) 1 / ratio. six_dof
-//   throws scene::Unsupported: ODE has no joint with per-axis springs and limits;
-// - settings: gravity, dWorldSetERP(erp), dWorldSetCFM(cfm) (ODE adds cfm / h to A's
-//   diagonal, the scene's meaning).
+// loadWorld's worlds are built by buildWorld: one mapping, listed geom by geom and joint by
+// joint in docs/methods/adapters.md, "ODE: the scene mapping". What it guarantees:
+// - the scene's numbers: its inertia (dMassSetParameters, centre of mass at the body origin),
+//   its cfm as ODE's (ODE adds cfm / h to A's diagonal, the scene's meaning);
+// - contacts by the scene's rules: dContactApprox1 (friction bound mu times the normal force,
+//   as Bullet), sqrt(mu_a mu_b), max(e_a, e_b), at most max_contacts_per_pair points a pair;
+// - joints keep the scene's signs (angles and offsets of bodies[0] relative to bodies[1]);
+// - no silent gaps: a pair of geom classes this ODE build has no collider for (Debian's libode
+//   has no libccd: cylinder-cylinder, capsule-cylinder, convex-cylinder) makes collide() throw
+//   scene::Unsupported the first time such a pair's boxes overlap, and a joint ODE cannot
+//   express (e.g. six_dof, a cone_twist swing2 of 1.5 rad or more, a gear whose two axes
+//   differ) throws scene::Unsupported when the world is built.
 //
 // Solver names: any mlcp::solverNames() name runs through mlcp::ode::Stepper (its island
 // statistics fill the measures); the stock ones are

@@ -9,45 +9,33 @@
 //
 // From C: mlcp/ode/stepper.h (every setting, errors as return codes, no exceptions).
 //
-// How it plugs in. dWorldStep is two calls into ODE's world processing:
-// dxReallocateWorldProcessContext (auto-disabling, islands, arena sized by a memory estimator)
-// then dxProcessIslands, which calls an island stepper of type dstepper_fn_t once per island.
-// Stepper::step makes the same two calls with its own estimator and island stepper, so ODE
-// still does everything around the solve: islands, auto-disable (disabled bodies are not in
-// any island), joint row generation (every joint type, every dContact surface mode, limits and
-// motors, ERP/CFM), joint feedback and body integration (dxStepBody).
+// How it plugs in: Stepper::step makes dWorldStep's two calls into ODE's world processing
+// (dxReallocateWorldProcessContext, dxProcessIslands) with its own memory estimator and island
+// stepper, so ODE still does everything around the solve: islands, auto-disable, joint rows
+// (every joint type, contact mode, limit and motor), joint feedback and integration.
 //
-// The island pipeline (src/island.cpp), by stages:
-//   1. prepare bodies: gravity into the force accumulator, world-frame inverse inertia, the
-//      implicit gyroscopic torque (Lacoursiere 2006), exactly as dxStepIsland does;
-//   2. prepare rows: getInfo1 for every joint (it must run before getInfo2), joints ordered
-//      unbounded | mixed | LCP as ODE does, getInfo2 into factored rows (mlcp::RowSystem): two
-//      6-wide Jacobian blocks per row, world-frame inverse inertia per body;
-//   3. convert to the canonical form. ODE solves A lambda = rhs + w with
-//          A   = J M^-1 J^T + diag(cfm / h),
-//          rhs = c / h - J (M^-1 f_ext + v / h),
-//      where c and cfm are getInfo2's (ODE scales both by 1/h) and lambda is a force. Ours is
-//      w = A x + b, so b = -rhs; lo, hi and findex (made island-global) are copied;
-//   4. warm start: lambda of the last step per joint (per contact: the nearest last-step
-//      contact of the same body pair, within Settings::contactMatchDistance), when the solver can
-//      use it;
-//   5. solve: mlcp::RowSolver (mlcp/island/row_solver.hpp), shared with the Bullet adapter: it
-//      classifies the island, runs the named solver or `auto`'s choice ("pgs" on the rows,
-//      others on an assembled A, dense up to denseAssemblyMaxRows rows), accepts the answer only
-//      when it is finite, not Failed and its recomputed residual is <= acceptResidual, and
-//      otherwise runs the fallback from the same start and keeps the better answer;
-//   6. store impulses: constraint force J^T lambda per body and joint feedback exactly as
-//      dxStepIsland fills it, v += h M^-1 (f_ext + J^T lambda), dxStepBody, zero accumulators.
+// The island pipeline (src/island.cpp; each stage in full in docs/methods/adapters.md, "ODE:
+// the island stepper's stages"):
+//   1. prepare bodies: forces, world-frame inverse inertia, gyroscopic torque, as dxStepIsland;
+//   2. prepare rows: getInfo1, joints ordered unbounded | mixed | LCP as ODE orders them,
+//      getInfo2 into factored rows (mlcp::RowSystem, mlcp/island/rows.hpp);
+//   3. canonical form (core/include/mlcp/problem.hpp): ODE solves A lambda = rhs + w with
+//      A = J M^-1 J^T + diag(cfm / h), rhs = c / h - J (M^-1 f_ext + v / h); so b = -rhs;
+//   4. warm start: last step's lambda per joint, per contact the nearest last-step contact of
+//      the same body pair (Settings::contactMatchDistance);
+//   5. solve: mlcp::RowSolver (mlcp/island/row_solver.hpp), shared with the Bullet adapter;
+//   6. store impulses: J^T lambda, joint feedback, v += h M^-1 (f_ext + J^T lambda), dxStepBody.
+// Stage 1 repeats dxStepIsland's operations in its order, so forces and inertias equal stock's
+// to the bit; stage 6 is dxStepIsland's. Cost: O(rows + bodies) around the solve, in a workspace
+// reused across islands and steps.
 //
-// Adapter-only solver names (not in the core registry), for diffing against stock ODE:
-//   "ode-step"      forwards each island to ODE's own dxStepIsland (bitwise equal to
-//                   dWorldStep; no statistics beyond rows and time);
-//   "ode-quickstep" forwards to dxQuickStepIsland (equal to dWorldQuickStep);
-//   "ode-lcp"       our stages 1-3 and 6 with ODE's own Dantzig solver dxSolveLCP on the dense
-//                   A (matches dWorldStep to round-off; its residual is stock's residual).
+// Adapter-only solver names, for diffing against stock ODE: "ode-step" and "ode-quickstep"
+// forward each island to dxStepIsland / dxQuickStepIsland (equal to dWorldStep /
+// dWorldQuickStep); "ode-lcp" runs stages 1-3 and 6 with ODE's dxSolveLCP on the dense A (equal
+// to dWorldStep to round-off, with its residual measured).
 //
-// Threads. ODE may run islands on several threads when the world has a threading
-// implementation; this stepper serializes its islands with a mutex.
+// Threads. ODE may run islands on several threads; the stepper serializes its islands with a
+// mutex.
 #pragma once
 
 #include <ode/ode.h>
