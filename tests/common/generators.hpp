@@ -176,7 +176,8 @@ class Generator {
   std::mt19937 rng_;
 };
 
-// The seed's worked Lemke example: x = (20/19, 21/19, 0), w = (0, 0, 12/19).
+// The worked Lemke example (a 3-row LCP solved by hand, tableau by tableau): x = (20/19, 21/19, 0),
+// w = (0, 0, 12/19).
 inline Problem seedLemkeExample() {
   DenseMatrix M(3, 3);
   M << 2, -1, 3, -1, 10, 2, -3, -2, 0;

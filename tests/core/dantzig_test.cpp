@@ -1,6 +1,7 @@
-// dantzig specifics: the seed example, random P-matrix / SPD / boxed / mixed / findex problems
-// against known solutions, FixedOnce versus Exact friction, infeasible and singular problems,
-// warm start, workspace reuse, sparse input. Every answer is checked with mlcp::accuracy().
+// dantzig specifics: the worked Lemke example, random P-matrix / SPD / boxed / mixed / findex
+// problems against known solutions, FixedOnce versus Exact friction, infeasible and singular
+// problems, warm start, workspace reuse, sparse input. Every answer is checked with
+// mlcp::accuracy().
 #include "mlcp/solvers/dantzig.hpp"
 
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Lemke: the seed's worked example and its tableaux, the seed's LP, infeasible and degenerate
+// Lemke: the worked example and its tableaux, an LP, infeasible and degenerate
 // problems, random problems with known solutions, boxed / equality / findex problems and the
 // Siconos corpus. Every answer is judged by mlcp::accuracy, recomputed here.
 #include "mlcp/solvers/lemke.hpp"
@@ -95,7 +95,7 @@ TEST(LemkeTrace, SeedPivotsAndFinalTableEqualTheNotes) {
   EXPECT_NE(text.find("pivot 2: z2 enters, w1 leaves (row 1)"), std::string::npos) << text;
   EXPECT_NE(text.find("pivot 3: z1 enters, z0 leaves (row 2)"), std::string::npos) << text;
   EXPECT_EQ(text.find("pivot 4"), std::string::npos);
-  // Tab. 3-5 of the seed notes: columns w1 w2 w3 z1 z2 z3 z0 | q.
+  // The worked example's last tableau: columns w1 w2 w3 z1 z2 z3 z0 | q.
   const std::map<std::string, std::vector<std::string>> expected = {
       {"z2", {"-1/19", "-2/19", "0", "0", "1", "7/19", "3/19", "21/19"}},
       {"z1", {"-10/19", "-1/19", "0", "1", "0", "32/19", "11/19", "20/19"}},

@@ -2,10 +2,11 @@
 //
 // Sizes choose a storage or a method for a problem of n rows; shifts decide when a pivot, a
 // diagonal or a drift counts as zero and how far a retry moves A. Each has its reason here;
-// the structs that let a user change one (NewtonParams, LemkeParams, Policy, ...) take it as
-// their default. The measurements behind the sizes are in docs/benchmarks.md ("Dense and
-// sparse crossovers"); shifts are relative to the scale named with each, so a problem in any
-// unit gets the same decisions.
+// the structs that let a user change one (NewtonParams, LemkeSolver, Policy, ...) take it as
+// their default. The measurements behind the sizes are in docs/benchmarks.md ("ldlt: the dense
+// envelope against the other factorizations", "lemke: dense tableau against the factored
+// basis", "auto's choices and the time budget"); shifts are relative to the scale named with
+// each, so a problem in any unit gets the same decisions.
 #pragma once
 
 namespace mlcp {

@@ -21,13 +21,86 @@ namespace {
 // Largest residual (residual.hpp) of a guess whose friction values set the first pass's bounds.
 constexpr double kTrustedGuess = 1e-2;
 
+// A pass that ended early (a breakdown, the pivot limit or the time budget): status and message.
+void reportStopped(Outcome o, const std::string& why, bool frictionPasses, int pass,
+                   Result& result) {
+  std::ostringstream os;
+  result.status = o == Outcome::Failed       ? Status::Failed
+                  : o == Outcome::PivotLimit ? Status::MaxIterations
+                                             : Status::TimeLimit;
+  os << why;
+  if (frictionPasses) os << " (friction pass " << pass << ")";
+  result.message = os.str();
+}
+
+// Redundant rows (a singular A) are said: their x is one of many answers.
+std::string redundantRowsNote(int redundant) {
+  return redundant > 0
+             ? "; " + std::to_string(redundant) + " redundant rows left free (A is singular)"
+             : "";
+}
+
+// After an exact friction pass with residual res: true with the result set when the bounds
+// settled (Converged) or the passes ran out (MaxIterations).
+bool frictionPassesEnd(double res, int pass, const Options& opt, const std::string& singular,
+                       Result& result) {
+  if (res <= opt.tolerance) {
+    std::ostringstream os;
+    result.status = Status::Converged;
+    os << "friction bounds settled after " << pass << " pass" << (pass > 1 ? "es" : "") << singular;
+    result.message = os.str();
+    return true;
+  }
+  if (pass >= opt.maxIterations) {
+    std::ostringstream os;
+    result.status = Status::MaxIterations;
+    os << "friction bounds still moving after " << pass << " passes (residual " << res << ")";
+    result.message = os.str();
+    return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 // ============================================================================ set-up
 
+void DantzigSolver::Workspace::setUp(const Problem& pb, const Vector& start, const Options& opt,
+                                     bool useGuess, bool trustFriction) {
+  build(pb, start, useGuess, trustFriction);
+  if (shift > 0) shiftDiagonal(shift);
+  pivTol *= opt.pivotTolerance;
+  pivots = 0;
+  pivotLimit = opt.maxPivots > 0 ? opt.maxPivots : 50 * n + 100;
+  deadline = budgetDeadline(opt);  // the solve's (Solver sets budgetStart)
+  clockEvery = std::max(1, 1024 / std::max(1, n));
+  message.clear();
+  for (int p = 0; p < n; ++p) {
+    const int i = perm[p];
+    const bool guessed =
+        isFreeRow(pb.lo[i], pb.hi[i]) || (useGuess && x[p] > lo[p] && x[p] < hi[p]);
+    set[p] = guessed ? Set::Clamped : Set::Unprocessed;
+  }
+}
+
 void DantzigSolver::Workspace::build(const Problem& pb, const Vector& guess, bool useGuess,
                                      bool exactFriction) {
   n = pb.size();
+  order(pb, guess, useGuess, exactFriction);
+  sizeVectors();
+  copyRows(pb, guess, useGuess, exactFriction);
+  sparse = pb.isSparse();
+  if (sparse)
+    buildSparse(pb);
+  else
+    buildDense(pb);
+  setScales(pb);
+}
+
+// Groups: 0 equality, 1 guessed clamped, 2 other rows, 3 friction rows; a counting sort (one
+// classification per row) keeps the caller's order within a group.
+void DantzigSolver::Workspace::order(const Problem& pb, const Vector& guess, bool useGuess,
+                                     bool exactFriction) {
   const bool hasF = pb.hasFindex();
   auto friction = [&](int i) { return hasF && pb.findex[i] >= 0; };
   auto interior = [&](int i) {
@@ -40,8 +113,6 @@ void DantzigSolver::Workspace::build(const Problem& pb, const Vector& guess, boo
     }
     return guess[i] > pb.lo[i] && guess[i] < pb.hi[i];
   };
-  // Groups: 0 equality, 1 guessed clamped, 2 other rows, 3 friction rows; a counting sort
-  // (one classification per row) keeps the caller's order within a group.
   inv.resize(n);  // the group of each row until the positions are known
   int start[5] = {0, 0, 0, 0, 0};
   for (int i = 0; i < n; ++i) {
@@ -56,9 +127,11 @@ void DantzigSolver::Workspace::build(const Problem& pb, const Vector& guess, boo
     perm[p] = i;
     inv[i] = p;
   }
+}
 
-  // Only dxFull (kept zero between steps), w, normal and diag (a sparse row may lack its
-  // diagonal) are read before they are written.
+// Only dxFull (kept zero between steps), w, normal and diag (a sparse row may lack its diagonal)
+// are read before they are written.
+void DantzigSolver::Workspace::sizeVectors() {
   for (std::vector<double>* v :
        {&b, &lo, &hi, &muLo, &muHi, &x, &xStart, &a, &r, &u, &l, &z, &dwN, &xs, &ys, &D})
     v->resize(n);
@@ -72,12 +145,19 @@ void DantzigSolver::Workspace::build(const Problem& pb, const Vector& guess, boo
   C.assign(n, -1);
   N.clear();
   N.reserve(n);
+}
+
+// b, the bounds (friction rows': mu times their normal's start) and the start x, in processing
+// order.
+void DantzigSolver::Workspace::copyRows(const Problem& pb, const Vector& guess, bool useGuess,
+                                        bool exactFriction) {
+  const bool hasF = pb.hasFindex();
   for (int p = 0; p < n; ++p) {
     const int i = perm[p];
     b[p] = pb.b[i];
     muLo[p] = lo[p] = pb.lo[i];
     muHi[p] = hi[p] = pb.hi[i];
-    if (friction(i)) {
+    if (hasF && pb.findex[i] >= 0) {
       findex[p] = inv[pb.findex[i]];
       // Bounds of the first pass: from the guess (exact, warm) or set when reached (cold).
       normal[p] = useGuess && exactFriction ? std::abs(guess[pb.findex[i]]) : 0.0;
@@ -92,16 +172,14 @@ void DantzigSolver::Workspace::build(const Problem& pb, const Vector& guess, boo
     const double g = useGuess ? guess[perm[p]] : 0.0;
     x[p] = findex[p] >= 0 && !(useGuess && exactFriction) ? 0.0 : std::clamp(g, lo[p], hi[p]);
   }
+}
 
-  sparse = pb.isSparse();
-  if (sparse)
-    buildSparse(pb);
-  else
-    buildDense(pb);
+// The zero tests' scales (pivots: max |A_ii|; w: 1 + ||b||_inf) and the factors' storage.
+void DantzigSolver::Workspace::setScales(const Problem& pb) {
   double dMax = 0;
   for (int p = 0; p < n; ++p) dMax = std::max(dMax, std::abs(diag[p]));
   const double scale = dMax > 0 ? dMax : (aMax > 0 ? aMax : 1.0);
-  pivTol = scale;  // multiplied by Options::pivotTolerance in run()
+  pivTol = scale;  // multiplied by Options::pivotTolerance in setUp()
   this->scale = scale;
   const double bNorm = n ? pb.b.lpNorm<Eigen::Infinity>() : 0.0;
   epsW = 1e-12 * (1.0 + bNorm);
@@ -499,6 +577,66 @@ void DantzigSolver::Workspace::gatherNormals(Vector& g) const {
   for (size_t k = 0; k < frictionRows.size(); ++k) g[k] = std::abs(x[findex[frictionRows[k]]]);
 }
 
+dantzig::FrictionIteration DantzigSolver::Workspace::startFrictionIteration(int depth,
+                                                                            bool exactFriction) {
+  const int nf = static_cast<int>(frictionRows.size());
+  FrictionIteration fi;
+  fi.depth = std::max(1, depth);
+  fi.g.resize(nf);
+  fi.nu.resize(nf);
+  fi.f.resize(nf);
+  if (exactFriction) {
+    histG.resize(nf, fi.depth);
+    histF.resize(nf, fi.depth);
+  }
+  return fi;
+}
+
+// Anderson acceleration of nu <- g(nu) = |x_normal(nu)|: piecewise affine, so within one active
+// set a few extrapolations find the fixed point where plain iteration may spiral.
+bool DantzigSolver::Workspace::nextFrictionBounds(FrictionIteration& fi, int it,
+                                                  const DantzigParams& params) {
+  const int nf = static_cast<int>(frictionRows.size());
+  gatherNormals(fi.g);
+  for (int k = 0; k < nf; ++k) {
+    fi.nu[k] = normal[frictionRows[k]];
+    fi.f[k] = fi.g[k] - fi.nu[k];
+  }
+  const double fNorm = fi.f.lpNorm<Eigen::Infinity>();
+  if (fNorm == 0) return false;
+  if (fNorm > 10 * fi.bestF) fi.stored = 0;  // extrapolation went astray: restart the history
+  if (fNorm < fi.bestF) {
+    fi.bestF = fNorm;
+    fi.lastGain = it;
+  } else if (it - fi.lastGain > params.andersonStall && fi.damping == 1.0) {
+    fi.damping = params.stallDamping;  // stalled (a cycle between active sets): damped iteration
+    fi.stored = 0;
+  }
+  if (fi.stored == fi.depth) {
+    for (int j = 0; j + 1 < fi.depth; ++j) {
+      histG.col(j) = histG.col(j + 1);
+      histF.col(j) = histF.col(j + 1);
+    }
+    --fi.stored;
+  }
+  histG.col(fi.stored) = fi.g;
+  histF.col(fi.stored) = fi.f;
+  ++fi.stored;
+  Vector next = fi.nu + fi.damping * fi.f;
+  if (fi.damping == 1.0 && fi.stored >= 2) {
+    const int q = fi.stored - 1;
+    DenseMatrix dF(nf, q), dG(nf, q);
+    for (int j = 0; j < q; ++j) {
+      dF.col(j) = histF.col(j + 1) - histF.col(j);
+      dG.col(j) = histG.col(j + 1) - histG.col(j);
+    }
+    const Vector gamma = dF.colPivHouseholderQr().solve(fi.f);
+    if (gamma.allFinite()) next -= dG * gamma;
+  }
+  setFrictionBounds(next.cwiseMax(0.0));
+  return true;
+}
+
 // New friction bounds from the normal magnitudes nu (one per friction row); rows at a bound
 // follow it, so that the previous index sets stay a consistent guess.
 void DantzigSolver::Workspace::setFrictionBounds(const Vector& nu) {
@@ -547,46 +685,16 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
   Workspace& ws = *ws_;
   const int n = problem.size();
   const bool exact = opt.frictionBounds == FrictionBounds::Exact;
-  const bool useGuess = !x.isZero(0.0);
-  // A guess's friction values fix the first pass's friction bounds only when the guess is
-  // close (a residual within kTrustedGuess): Bullet's cached
-  // impulses (residual 0.1-0.7, friction directions that turn between steps) gave bounds so far
-  // off that the second pass redid most pivots, where the first pass's cold bounds (as
-  // FixedOnce) needed half as many pivots in all.
-  const bool trustFriction =
-      useGuess && exact && problem.hasFindex() && residual(problem, x) <= kTrustedGuess;
-  if (ws.shift == 0) ws.guess = x;
-  ws.build(problem, x, useGuess, trustFriction);
-  if (ws.shift > 0) ws.shiftDiagonal(ws.shift);
-  ws.pivTol *= opt.pivotTolerance;
-  ws.pivots = 0;
-  ws.pivotLimit = opt.maxPivots > 0 ? opt.maxPivots : 50 * n + 100;
-  ws.deadline = budgetDeadline(opt);  // the solve's (Solver sets budgetStart)
-  ws.clockEvery = std::max(1, 1024 / std::max(1, n));
-  ws.message.clear();
-  // Pass 1 guesses the equality rows and (warm) the rows inside their bounds as clamped.
-  for (int p = 0; p < n; ++p) {
-    const int i = ws.perm[p];
-    const bool guessed = isFreeRow(problem.lo[i], problem.hi[i]) ||
-                         (useGuess && ws.x[p] > ws.lo[p] && ws.x[p] < ws.hi[p]);
-    ws.set[p] = guessed ? Set::Clamped : Set::Unprocessed;
-  }
   const bool friction = problem.hasFindex();
+  const bool useGuess = !x.isZero(0.0);
+  // A guess's friction values fix the first pass's friction bounds only when the guess is close
+  // (a residual within kTrustedGuess): an engine's cached impulses give bounds so far off that
+  // the second pass redoes most pivots (docs/methods/pivoting.md, "Dantzig: friction bounds").
+  const bool trustFriction = useGuess && exact && friction && residual(problem, x) <= kTrustedGuess;
+  ws.setUp(problem, x, opt, useGuess, trustFriction);
   const bool firstFixedOnce = friction && !trustFriction;
-  auto writeBack = [&] {
-    for (int p = 0; p < n; ++p) x[ws.perm[p]] = ws.x[p];
-  };
+  FrictionIteration fi = ws.startFrictionIteration(params_.andersonDepth, friction && exact);
   int totalPivots = 0;
-  const int nf = static_cast<int>(ws.frictionRows.size());
-  const int depth = std::max(1, params_.andersonDepth);
-  int stored = 0;
-  double bestF = kInf, damping = 1.0;
-  int lastGain = 0;
-  Vector g(nf), nu(nf), f(nf);
-  if (friction && exact) {
-    ws.histG.resize(nf, depth);
-    ws.histF.resize(nf, depth);
-  }
   for (int it = 1;; ++it) {
     ws.passes = it;
     const int before = ws.pivots;
@@ -594,13 +702,13 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
     totalPivots += ws.pivots - before;
     ws.pivots = 0;
     result.iterations = totalPivots;
-    writeBack();
+    for (int p = 0; p < n; ++p) x[ws.perm[p]] = ws.x[p];
     // The default pivot limit (50 n + 100) is reached by cycling on a singular A as well.
     const bool cycled = o == Outcome::PivotLimit && opt.maxPivots <= 0;
     if ((o == Outcome::Failed || cycled) && ws.shift == 0) {
       // Pivoting breaks down on a singular A (redundant joints, coplanar contacts): once more
-      // on A + delta I, cold (the guess led into the breakdown; from Bullet's cached impulses
-      // the regularised friction passes needed more than 50); the residual is measured on A.
+      // on A + delta I, cold (the guess led into the breakdown: docs/decisions.md, "Degenerate
+      // rows and singular islands"); the residual is measured on A.
       const std::string first = ws.message;
       const int spent = totalPivots;
       const double delta = params_.breakdownShift * ws.scale;
@@ -616,19 +724,10 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
       return;
     }
     if (o != Outcome::Done) {
-      std::ostringstream os;
-      result.status = o == Outcome::Failed       ? Status::Failed
-                      : o == Outcome::PivotLimit ? Status::MaxIterations
-                                                 : Status::TimeLimit;
-      os << ws.message;
-      if (friction && exact) os << " (friction pass " << it << ")";
-      result.message = os.str();
+      reportStopped(o, ws.message, friction && exact, it, result);
       return;
     }
-    // Redundant rows (a singular A) are said: their x is one of many answers.
-    const std::string singular = ws.redundant > 0 ? "; " + std::to_string(ws.redundant) +
-                                                        " redundant rows left free (A is singular)"
-                                                  : "";
+    const std::string singular = redundantRowsNote(ws.redundant);
     if (!friction || !exact) {
       result.status = Status::Converged;
       result.message =
@@ -636,65 +735,16 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
           singular;
       return;
     }
-    std::ostringstream os;  // only on the friction path: its set-up costs as much as a tiny solve
+    // Exact friction: the bounds settle, the passes run out, or the next pass gets new bounds.
     const double res = residual(problem, x);
-    if (res <= opt.tolerance) {
-      result.status = Status::Converged;
-      os << "friction bounds settled after " << it << " pass" << (it > 1 ? "es" : "") << singular;
-      result.message = os.str();
-      return;
-    }
-    if (it >= opt.maxIterations) {
-      result.status = Status::MaxIterations;
-      os << "friction bounds still moving after " << it << " passes (residual " << res << ")";
-      result.message = os.str();
-      return;
-    }
-    // Anderson acceleration of nu <- g(nu) = |x_normal(nu)|: piecewise affine, so within one
-    // active set a few extrapolations find the fixed point where plain iteration may spiral.
-    ws.gatherNormals(g);
-    for (int k = 0; k < nf; ++k) {
-      nu[k] = ws.normal[ws.frictionRows[k]];
-      f[k] = g[k] - nu[k];
-    }
-    const double fNorm = f.lpNorm<Eigen::Infinity>();
-    if (fNorm == 0) {
-      result.status = Status::Failed;
+    if (frictionPassesEnd(res, it, opt, singular, result)) return;
+    if (!ws.nextFrictionBounds(fi, it, params_)) {
+      std::ostringstream os;
       os << "friction bounds stopped moving but the residual is " << res;
+      result.status = Status::Failed;
       result.message = os.str();
       return;
     }
-    if (fNorm > 10 * bestF) stored = 0;  // extrapolation went astray: restart the history
-    if (fNorm < bestF) {
-      bestF = fNorm;
-      lastGain = it;
-    } else if (it - lastGain > params_.andersonStall && damping == 1.0) {
-      damping =
-          params_.stallDamping;  // stalled (a cycle between active sets): plain damped iteration
-      stored = 0;
-    }
-    if (stored == depth) {
-      for (int j = 0; j + 1 < depth; ++j) {
-        ws.histG.col(j) = ws.histG.col(j + 1);
-        ws.histF.col(j) = ws.histF.col(j + 1);
-      }
-      --stored;
-    }
-    ws.histG.col(stored) = g;
-    ws.histF.col(stored) = f;
-    ++stored;
-    Vector next = nu + damping * f;
-    if (damping == 1.0 && stored >= 2) {
-      const int q = stored - 1;
-      DenseMatrix dF(nf, q), dG(nf, q);
-      for (int j = 0; j < q; ++j) {
-        dF.col(j) = ws.histF.col(j + 1) - ws.histF.col(j);
-        dG.col(j) = ws.histG.col(j + 1) - ws.histG.col(j);
-      }
-      const Vector gamma = dF.colPivHouseholderQr().solve(f);
-      if (gamma.allFinite()) next -= dG * gamma;
-    }
-    ws.setFrictionBounds(next.cwiseMax(0.0));
     if (ws.deadline != kInf && nowSeconds() > ws.deadline) {
       result.status = Status::TimeLimit;
       result.message = "time budget spent between friction passes";

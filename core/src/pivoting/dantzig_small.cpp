@@ -7,9 +7,9 @@
 #include "linalg/symmetry.hpp"
 
 // GCC vectorizes the loops over the clamped rows (run-time length m <= n) into 2-wide code
-// with peeling, whose stack stores the next scalar loads cannot forward from: the 6-row solve
-// took 800 ns that way, 290 ns as scalar code (the same operations: no sum is reassociated
-// either way, so the answers are the same to the bit).
+// with peeling, whose stack stores the next scalar loads cannot forward from: the scalar code is
+// faster (docs/benchmarks.md, "Dantzig: the tiny-island path") and makes the same operations
+// (no sum is reassociated either way, so the answers are the same to the bit).
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC optimize("no-tree-vectorize")
 #endif
@@ -107,69 +107,81 @@ double inside(double lo, double hi) {
   return v > lo && v < hi ? v : std::numeric_limits<double>::quiet_NaN();
 }
 
-// One try from guess (the caller's order): Solved with the answer in xOut; Declined; or Again
-// with guess changed to the index sets one block-pivoting step corrects it to.
+// One try's state in processing order: 0 equality rows, 1 rows guessed clamped (the start
+// strictly inside the bounds; a cold start: the rows whose bounds contain 0), 2 the others. Its
+// stages run in the order of solveFixed, each on the state the previous ones left.
 template <int n>
-Try solveFixed(const Problem& pb, double pivotTolerance, double* guess, Vector& xOut) {
-  const DenseMatrix& A = pb.denseA();
-
-  // Processing order: 0 equality rows, 1 rows guessed clamped (the start strictly inside the
-  // bounds; a cold start: the rows whose bounds contain 0), 2 the others (counting sort).
-  int group[n], perm[n], start[4] = {0, 0, 0, 0};
-  for (int i = 0; i < n; ++i) {
-    const double lo = pb.lo[i], hi = pb.hi[i], g = guess[i];
-    group[i] = isFreeRow(lo, hi) ? 0 : g > lo && g < hi ? 1 : 2;
-    ++start[group[i] + 1];
-  }
-  start[2] += start[1];
-  start[3] += start[2];
-  const int clamped = start[2];  // groups 0 and 1: positions 0 .. clamped - 1
-  bool identity = true;
-  int groupAt[n];
-  for (int i = 0; i < n; ++i) {
-    const int p = start[group[i]]++;
-    perm[p] = i;
-    groupAt[p] = group[i];
-    identity = identity && p == i;
-  }
-
-  // Maxima are exact in any order: Eigen's vectorized reduction, and the asymmetry in two
-  // chains (one chain of maxsd was a tenth of this function's time).
-  const double* a = A.data();
-  const double aMax = A.cwiseAbs().maxCoeff();
-  double asym[2] = {0, 0};
-  for (int j = 0; j < n; ++j)
-    for (int i = j + 1; i < n; ++i)
-      asym[i & 1] = std::max(asym[i & 1], std::abs(a[i + j * n] - a[j + i * n]));
-  if (!symmetricWithin(std::max(asym[0], asym[1]), aMax)) return Try::Declined;  // non-symmetric
-
+struct Attempt {
+  // Each stage sets what it writes (order: perm, groupAt, clamped, identity; symmetric: aMax;
+  // gather: f.a, b, lo, hi, x and the tolerances), so nothing is initialized here.
+  int perm[n], groupAt[n];
+  int clamped;  // groups 0 and 1: positions 0 .. clamped - 1
+  bool identity;
   Factors<n> f;
-  double permuted[n * n];
-  if (identity) {
-    f.a = a;
-  } else {
-    for (int q = 0; q < n; ++q)
-      for (int p = 0; p < n; ++p) permuted[p + q * n] = A(perm[p], perm[q]);
-    f.a = permuted;
-  }
   double b[n], lo[n], hi[n], x[n], w[n];
-  double dMax = 0;
-  for (int p = 0; p < n; ++p) {
-    const int i = perm[p];
-    b[p] = pb.b[i];
-    lo[p] = pb.lo[i];
-    hi[p] = pb.hi[i];
-    x[p] = std::clamp(guess[i], lo[p], hi[p]);
-    dMax = std::max(dMax, std::abs(f.a[p + p * n]));
-  }
-  const double pivTol = (dMax > 0 ? dMax : aMax > 0 ? aMax : 1.0) * pivotTolerance;
-  const double bMax = pb.b.lpNorm<Eigen::Infinity>();
-  const double epsW = 1e-12 * (1.0 + bMax);
+  At at[n];
+  double aMax, bMax, pivTol, epsW;
 
+  // The processing order (a counting sort by group).
+  [[gnu::always_inline]] void order(const Problem& pb, const double* guess) {
+    int group[n], start[4] = {0, 0, 0, 0};
+    for (int i = 0; i < n; ++i) {
+      const double rowLo = pb.lo[i], rowHi = pb.hi[i], g = guess[i];
+      group[i] = isFreeRow(rowLo, rowHi) ? 0 : g > rowLo && g < rowHi ? 1 : 2;
+      ++start[group[i] + 1];
+    }
+    start[2] += start[1];
+    start[3] += start[2];
+    clamped = start[2];
+    identity = true;
+    for (int i = 0; i < n; ++i) {
+      const int p = start[group[i]]++;
+      perm[p] = i;
+      groupAt[p] = group[i];
+      identity = identity && p == i;
+    }
+  }
+  // Whether A is symmetric (sets aMax). Maxima are exact in any order: Eigen's vectorized
+  // reduction, and the asymmetry in two independent chains.
+  [[gnu::always_inline]] bool symmetric(const DenseMatrix& A) {
+    const double* a = A.data();
+    aMax = A.cwiseAbs().maxCoeff();
+    double asym[2] = {0, 0};
+    for (int j = 0; j < n; ++j)
+      for (int i = j + 1; i < n; ++i)
+        asym[i & 1] = std::max(asym[i & 1], std::abs(a[i + j * n] - a[j + i * n]));
+    return symmetricWithin(std::max(asym[0], asym[1]), aMax);
+  }
+  // A (in `permuted` unless the order is the caller's), b, the bounds and the clamped start in
+  // processing order; the zero tests' tolerances.
+  [[gnu::always_inline]] void gather(const Problem& pb, const double* guess, double pivotTolerance,
+                                     double* permuted) {
+    const DenseMatrix& A = pb.denseA();
+    if (identity) {
+      f.a = A.data();
+    } else {
+      for (int q = 0; q < n; ++q)
+        for (int p = 0; p < n; ++p) permuted[p + q * n] = A(perm[p], perm[q]);
+      f.a = permuted;
+    }
+    double dMax = 0;
+    for (int p = 0; p < n; ++p) {
+      const int i = perm[p];
+      b[p] = pb.b[i];
+      lo[p] = pb.lo[i];
+      hi[p] = pb.hi[i];
+      x[p] = std::clamp(guess[i], lo[p], hi[p]);
+      dMax = std::max(dMax, std::abs(f.a[p + p * n]));
+    }
+    pivTol = (dMax > 0 ? dMax : aMax > 0 ? aMax : 1.0) * pivotTolerance;
+    bMax = pb.b.lpNorm<Eigen::Infinity>();
+    epsW = 1e-12 * (1.0 + bMax);
+  }
   // The guessed block: factor, solve x_C with the others at their start, all inside bounds
-  // (the next try has the rows outside at the bound they crossed).
-  if (!f.factor(clamped, pivTol)) return Try::Declined;
-  if (clamped > 0) {
+  // (Again: guess has the rows outside at the bound they crossed).
+  [[gnu::always_inline]] Try solveGuessedBlock(double* guess) {
+    if (!f.factor(clamped, pivTol)) return Try::Declined;
+    if (clamped == 0) return Try::Solved;
     f.solveClamped(b, x);
     bool outside = false;
     for (int p = 0; p < clamped; ++p) {
@@ -177,53 +189,70 @@ Try solveFixed(const Problem& pb, double pivotTolerance, double* guess, Vector& 
       if (x[p] > hi[p]) guess[perm[p]] = hi[p];
       outside = outside || x[p] < lo[p] || x[p] > hi[p];
     }
-    if (outside) return Try::Again;
+    return outside ? Try::Again : Try::Solved;
   }
   // The other rows, in order, stay at their bound when their w allows it (their x is there
-  // already: the clamped start), so one w of every row serves all of them.
-  for (int p = 0; p < n; ++p) w[p] = b[p] + f.rowDot(p, x);
-  At at[n];
-  bool driven = false;  // a row at a bound whose w points inward: the next try clamps it
-  for (int p = 0; p < n; ++p) {
-    at[p] = At::Clamped;
-    if (groupAt[p] <= 1) continue;
-    const double wp = w[p];
-    if (lo[p] == hi[p]) {
-      x[p] = lo[p];
-      at[p] = At::Fixed;
-    } else if (x[p] <= lo[p] && wp >= -epsW) {
-      x[p] = lo[p];
-      at[p] = At::Lo;
-    } else if (x[p] >= hi[p] && wp <= epsW) {
-      x[p] = hi[p];
-      at[p] = At::Hi;
-    } else {
-      guess[perm[p]] = inside(lo[p], hi[p]);
-      if (std::isnan(guess[perm[p]])) return Try::Declined;
-      driven = true;
+  // already: the clamped start), so one w of every row serves all of them. Again: guess has a
+  // row at a bound whose w points inward moved inside its bounds, for the next try to clamp.
+  [[gnu::always_inline]] Try settleAtBounds(double* guess) {
+    for (int p = 0; p < n; ++p) w[p] = b[p] + f.rowDot(p, x);
+    bool driven = false;
+    for (int p = 0; p < n; ++p) {
+      at[p] = At::Clamped;
+      if (groupAt[p] <= 1) continue;
+      const double wp = w[p];
+      if (lo[p] == hi[p]) {
+        x[p] = lo[p];
+        at[p] = At::Fixed;
+      } else if (x[p] <= lo[p] && wp >= -epsW) {
+        x[p] = lo[p];
+        at[p] = At::Lo;
+      } else if (x[p] >= hi[p] && wp <= epsW) {
+        x[p] = hi[p];
+        at[p] = At::Hi;
+      } else {
+        guess[perm[p]] = inside(lo[p], hi[p]);
+        if (std::isnan(guess[perm[p]])) return Try::Declined;
+        driven = true;
+      }
     }
+    return driven ? Try::Again : Try::Solved;
   }
-  if (driven) return Try::Again;
   // One step of iterative refinement, then every row at a bound checked with a fresh w; not
   // when the clamped rows' w is within the rounding error of its own evaluation,
   // (n + 1) eps (|b| + n max|A| |x|): a correction from it would be noise (the general path
-  // refines always; the refinement was a third of this path's time on the ODE hinge).
-  double wC = 0, xMax = 0;
-  for (int p = 0; p < clamped; ++p) wC = std::max(wC, std::abs(w[p]));
-  for (int p = 0; p < n; ++p) xMax = std::max(xMax, std::abs(x[p]));
-  const double rounding = (n + 1) * kEpsilon * (bMax + n * aMax * xMax);
-  if (!(wC <= rounding)) {
+  // refines always). False when a check fails.
+  [[gnu::always_inline]] bool refine() {
+    double wC = 0, xMax = 0;
+    for (int p = 0; p < clamped; ++p) wC = std::max(wC, std::abs(w[p]));
+    for (int p = 0; p < n; ++p) xMax = std::max(xMax, std::abs(x[p]));
+    const double rounding = (n + 1) * kEpsilon * (bMax + n * aMax * xMax);
+    if (wC <= rounding) return true;
     f.solveClamped(b, x);
     for (int p = 0; p < n; ++p) w[p] = b[p] + f.rowDot(p, x);
     for (int p = 0; p < n; ++p)
-      if ((at[p] == At::Lo && w[p] < -epsW) || (at[p] == At::Hi && w[p] > epsW))
-        return Try::Declined;
+      if ((at[p] == At::Lo && w[p] < -epsW) || (at[p] == At::Hi && w[p] > epsW)) return false;
     for (int p = 0; p < clamped; ++p)  // the refined x_C must still be within its bounds
-      if (!(x[p] >= lo[p] && x[p] <= hi[p])) return Try::Declined;
+      if (!(x[p] >= lo[p] && x[p] <= hi[p])) return false;
+    return true;
   }
+};
+
+// One try from guess (the caller's order): Solved with the answer in xOut; Declined; or Again
+// with guess changed to the index sets one block-pivoting step corrects it to.
+template <int n>
+Try solveFixed(const Problem& pb, double pivotTolerance, double* guess, Vector& xOut) {
+  Attempt<n> t;
+  t.order(pb, guess);
+  if (!t.symmetric(pb.denseA())) return Try::Declined;
+  double permuted[n * n];
+  t.gather(pb, guess, pivotTolerance, permuted);
+  if (const Try r = t.solveGuessedBlock(guess); r != Try::Solved) return r;
+  if (const Try r = t.settleAtBounds(guess); r != Try::Solved) return r;
+  if (!t.refine()) return Try::Declined;
   for (int p = 0; p < n; ++p)
-    if (!std::isfinite(x[p])) return Try::Declined;  // overflow: the general path decides
-  for (int p = 0; p < n; ++p) xOut[perm[p]] = x[p];
+    if (!std::isfinite(t.x[p])) return Try::Declined;  // overflow: the general path decides
+  for (int p = 0; p < n; ++p) xOut[t.perm[p]] = t.x[p];
   return Try::Solved;
 }
 

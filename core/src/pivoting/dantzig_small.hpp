@@ -1,30 +1,28 @@
-// DantzigSolver's path for tiny dense islands (a joint or two: up to kPlainLoopRows rows, no
-// friction coupling). Internal to the library.
+// core/src/pivoting/dantzig_small.hpp (internal): DantzigSolver's path for tiny dense islands
+// (a joint or two: up to kPlainLoopRows rows, no friction coupling, symmetric A).
 //
 // A joint island's warm start nearly always guesses the index sets right: the equality rows and
 // the rows strictly inside their bounds are clamped, the others stay at their bound. For that
-// case DantzigSolver's general pivoting (dantzig.cpp) does one bordered LDL^T of the guessed
-// block, solves x_C, checks the other rows' w, refines x_C once and checks again: the method
-// costs a few hundred flops, its general workspace (permuted copy of A, index-set bookkeeping,
-// twenty reused vectors) several times that. This path is the same steps on fixed-size arrays:
-// the same processing order (equality rows, guessed clamped rows, the others; each group in
-// the caller's order), the same factor, the same tolerances, so its answer is the general
-// path's to round-off: it multiplies by reciprocal pivots where the general path divides (the
-// divisions were links of the dependent chain that sets a 6-row island's latency), and it skips
-// the general path's one step of iterative refinement when the clamped rows' w is already at
-// the rounding level of its evaluation (a third of the path's time on the ODE hinge island,
-// whose trajectory moved by under 1e-12).
+// case the general pivoting (dantzig.cpp) does one bordered LDL^T of the guessed block, solves
+// x_C, checks the other rows' w, refines x_C once and checks again: a few hundred flops, where
+// its general workspace (a permuted copy of A, index-set bookkeeping, reused vectors) costs
+// several times that. This path is the same steps on fixed-size arrays: the same processing
+// order (equality rows, guessed clamped rows, the others; each group in the caller's order), the
+// same factor, the same tolerances, so its answer is the general path's to round-off. It
+// multiplies by reciprocal pivots where the general path divides (the divisions are links of the
+// dependent chain that sets a small island's latency), and it skips the refinement when the
+// clamped rows' w is already at the rounding level of its evaluation.
 //
 // A guess whose sets are off is corrected by block-pivoting steps (at most kTries - 1 = 2, in
 // dantzig_small.cpp): a solved x_C outside its bounds puts those rows at the bound they crossed,
 // a row at a bound whose w points inward (w < 0 at lo, w > 0 at hi) is clamped, and the path
 // starts again from those sets. Any answer it returns passed every check above for its final
-// sets, so it is an answer of the problem (for a positive definite A_CC, the answer: the
-// general path's to round-off). It gives up (returns false, x untouched) on a guessed row whose
-// Schur pivot is at most the pivot tolerance, a row at a bound whose w points inward after the
-// refinement, an A that is not symmetric, or sets still off after the corrections;
-// DantzigSolver then runs the general path from the caller's start. Declining costs at most
-// this path's work three times.
+// sets, so it is an answer of the problem (for a positive definite A_CC, the answer). It gives
+// up (returns false, x untouched) on a guessed row whose Schur pivot is at most the pivot
+// tolerance, a row at a bound whose w points inward after the refinement, an A that is not
+// symmetric, or sets still off after the corrections; DantzigSolver then runs the general path
+// from the caller's start. Declining costs at most this path's work three times. Measurements:
+// docs/benchmarks.md, "Dantzig: the tiny-island path".
 #pragma once
 
 #include "mlcp/problem.hpp"

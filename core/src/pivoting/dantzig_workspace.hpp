@@ -1,6 +1,16 @@
 // core/src/pivoting/dantzig_workspace.hpp (internal): the state of DantzigSolver's pivoting
-// (dantzig.hpp) in three layers: the problem in processing order, the index sets with the factors
-// of the clamped block, and the workspace of the method (dantzig.cpp) on top.
+// (mlcp/solvers/dantzig.hpp) in three layers:
+//
+//   OrderedProblem  the problem in processing order (position p holds the caller's row perm[p]),
+//                   A dense (column-major) or sparse (CSR, plus CSC when not symmetric);
+//   ClampedSet      the index sets C and N and the factors A_CC = L D U of the clamped block;
+//   Workspace       the method's stages (dantzig.cpp) with their scratch, pivot count and budget.
+//
+// Invariants between pivots: C[0..m) are the clamped positions with slot[C[c]] = c, and L, D
+// (Ut) factor A(C, C) in that order; N lists the positions at a bound, free or fixed, with
+// slot[N[k]] = k; set[p] names the set of every position; dxFull is zero everywhere; span is
+// one past the largest position that can hold a nonzero of x's step, so products stop there.
+// Storage is sized by build() and reused by every pass and solve while n does not grow.
 #pragma once
 
 #include <Eigen/Dense>
@@ -51,7 +61,6 @@ struct OrderedProblem {
   // pivoting that broke down on a singular A: A + shift I is positive definite, its answer
   // solves A's (consistent, or nearly: engines' drift) system up to ~shift |x|.
   double shift = 0, scale = 0;
-  Vector guess;  // the caller's start, for that retry
 
   // A's row i (dense storage) and its product with v over positions 0 .. len-1.
   const double* denseRow(int i) const {
@@ -251,9 +260,19 @@ struct ClampedSet : OrderedProblem {
   }
 };
 
+// The exact friction fixed point nu <- g(nu) = |x_normal(nu)| between passes: Anderson
+// acceleration over the last `depth` passes (their g and f = g - nu are OrderedProblem::histG
+// and histF), and plain damped iteration once it stalls. nu, g, f: one entry per friction row.
+struct FrictionIteration {
+  int depth = 1, stored = 0, lastGain = 0;
+  double bestF = kInf, damping = 1.0;
+  Vector g, nu, f;
+};
+
+}  // namespace dantzig
+
 // Everything a solve keeps between its passes (and, for a warm start, between solves): the
 // problem and the index sets with their factors (above), scratch, and the pivot count and budget.
-}  // namespace dantzig
 
 struct DantzigSolver::Workspace : dantzig::ClampedSet {
   using Outcome = dantzig::Outcome;
@@ -271,9 +290,19 @@ struct DantzigSolver::Workspace : dantzig::ClampedSet {
   std::string message;
 
   // -------------------------------------------------------------------- set-up
+  // A solve's start from `start`: build(), the retry's shift, the pivot count and budget, and
+  // pass 1's guessed clamped rows (the equality rows and, warm, the rows inside their bounds).
+  void setUp(const Problem& pb, const Vector& start, const Options& opt, bool useGuess,
+             bool trustFriction);
+  // The problem in processing order, in stages: the order (perm, inv), the vectors sized, the
+  // rows' b, bounds and start, A (dense or sparse), the scales of the zero tests.
   void build(const Problem& pb, const Vector& guess, bool useGuess, bool exactFriction);
+  void order(const Problem& pb, const Vector& guess, bool useGuess, bool exactFriction);
+  void sizeVectors();
+  void copyRows(const Problem& pb, const Vector& guess, bool useGuess, bool exactFriction);
   void buildDense(const Problem& pb);
   void buildSparse(const Problem& pb);
+  void setScales(const Problem& pb);
 
   // ----------------------------------------------------------------- the method
   // Moves row i's x along the ray that keeps w_C = 0 and x_N fixed until i settles (at a bound,
@@ -313,6 +342,11 @@ struct DantzigSolver::Workspace : dantzig::ClampedSet {
   void freshW() {
     for (int p = 0; p < n; ++p) w[p] = b[p] + rowDot(p, x, n);
   }
+  // ------------------------------------------------------------ friction passes
+  // The fixed point's state for this solve (histories sized only for exact friction).
+  dantzig::FrictionIteration startFrictionIteration(int depth, bool exactFriction);
+  // The next pass's friction bounds from this pass's normals; false when they did not move.
+  bool nextFrictionBounds(dantzig::FrictionIteration& fi, int it, const DantzigParams& params);
   void setFrictionBounds(const Vector& nu);
   void gatherNormals(Vector& g) const;
   // A += delta I in the workspace's copies of A. False when a sparse A stores no diagonal entry

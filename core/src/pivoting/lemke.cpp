@@ -88,15 +88,19 @@ SparseMatrix sparseBlock(const SparseMatrix& A, const std::vector<int>& idx) {
   return B;
 }
 
-// eliminateFree: free rows leave by the Schur complement when their block is nonsingular (dense
-// G: the tableau's path); otherwise they are split.
-StandardForm toStandard(const SparseMatrix& A, const Vector& b, const Vector& lo, const Vector& hi,
-                        bool eliminateFree) {
-  StandardForm f;
+// The rows of a standard form's stages (toStandard): fixed rows, free rows, the others.
+struct RowSplit {
+  std::vector<bool> isFixed;
+  std::vector<int> freeRows;
+};
+
+// Sorts the rows into f.fixed, the free rows and f.kept (the others). Boxes narrower than
+// round-off relative to the scale of x (the largest finite bound, or ||b|| / max|A_ij|) count as
+// fixed: friction bounds from a normal value of 1e-30 would otherwise be ratio-test ties that
+// noise decides (it led to false rays).
+RowSplit splitRows(const SparseMatrix& A, const Vector& b, const Vector& lo, const Vector& hi,
+                   StandardForm& f) {
   const int n = static_cast<int>(b.size());
-  // Boxes narrower than round-off relative to the scale of x (the largest finite bound, or
-  // ||b|| / max|A_ij|) count as fixed: friction bounds from a normal value of 1e-30 would
-  // otherwise be ratio-test ties that noise decides (it led to false rays).
   double aMax = 0;
   for (int i = 0; i < n; ++i)
     for (SparseMatrix::InnerIterator it(A, i); it; ++it)
@@ -106,26 +110,33 @@ StandardForm toStandard(const SparseMatrix& A, const Vector& b, const Vector& lo
     for (double v : {lo[i], hi[i]})
       if (std::isfinite(v)) xScale = std::max(xScale, std::abs(v));
   const double narrow = kNarrowBox * xScale;
-  std::vector<int> freeRows;
-  std::vector<bool> isFixed(n, false);
+  RowSplit rows;
+  rows.isFixed.assign(n, false);
   for (int i = 0; i < n; ++i) {
     if (hi[i] - lo[i] <= narrow) {
       f.fixed.push_back(i);
-      isFixed[i] = true;
+      rows.isFixed[i] = true;
     } else if (isFree(lo[i], hi[i])) {
-      freeRows.push_back(i);
+      rows.freeRows.push_back(i);
     } else {
       f.kept.push_back(i);
     }
   }
+  return rows;
+}
+
+// The reduced problem Ar x_kept + br on f.kept after the fixed rows' x = lo is substituted:
+// free rows leave by the Schur complement when eliminateFree and their block is nonsingular
+// (dense G: the tableau's path), otherwise they join f.kept to be split.
+void reduce(const SparseMatrix& A, const Vector& b, const Vector& lo, const RowSplit& rows,
+            bool eliminateFree, StandardForm& f, SparseMatrix& Ar, Vector& br) {
+  const int n = static_cast<int>(b.size());
+  const std::vector<int>& freeRows = rows.freeRows;
   Vector b1 = b;
   if (!f.fixed.empty())
     for (int r = 0; r < n; ++r)
       for (SparseMatrix::InnerIterator it(A, r); it; ++it)
-        if (isFixed[it.col()]) b1[r] += it.value() * lo[it.col()];
-
-  SparseMatrix Ar;
-  Vector br;
+        if (rows.isFixed[it.col()]) b1[r] += it.value() * lo[it.col()];
   bool eliminate = false;
   if (eliminateFree && !freeRows.empty()) {
     Eigen::FullPivLU<DenseMatrix> lu(denseBlock(A, freeRows, freeRows));
@@ -148,11 +159,15 @@ StandardForm toStandard(const SparseMatrix& A, const Vector& b, const Vector& lo
     Ar = sparseBlock(A, f.kept);
     br = b1(f.kept);
   }
+}
 
+// The LCP variables of every kept row by its bounds (lemke.hpp), with f.offset and f.split;
+// returns each kept row's variables.
+std::vector<std::vector<int>> addVariables(const Vector& lo, const Vector& hi, StandardForm& f) {
   const int k = static_cast<int>(f.kept.size());
   f.offset = Vector::Zero(k);
   f.split.assign(k, false);
-  std::vector<std::vector<int>> varsOf(k);  // LCP variables of each kept row
+  std::vector<std::vector<int>> varsOf(k);
   for (int r = 0; r < k; ++r) {
     const int i = f.kept[r];
     auto add = [&](Role role) {
@@ -175,7 +190,14 @@ StandardForm toStandard(const SparseMatrix& A, const Vector& b, const Vector& lo
       add(Role::BoxW);
     }
   }
+  return varsOf;
+}
 
+// M and q of w = M y + q from the reduced problem: entry (a, c) is sign_a Ar(row_a, row_c)
+// sign_c, q_a = sign_a w0(row_a) with w0 the reduced w at y = 0, and each box's pair coupled.
+void assembleLcp(const SparseMatrix& Ar, const Vector& br, const Vector& lo, const Vector& hi,
+                 const std::vector<std::vector<int>>& varsOf, StandardForm& f) {
+  const int k = static_cast<int>(f.kept.size());
   const int m = static_cast<int>(f.vars.size());
   const Vector w0 = Ar * f.offset + br;  // w of the reduced problem at y = 0
   Triplets t;
@@ -201,6 +223,20 @@ StandardForm toStandard(const SparseMatrix& A, const Vector& b, const Vector& lo
   }
   f.M.resize(m, m);
   f.M.setFromTriplets(t.begin(), t.end());
+}
+
+// The boxed problem (A, b, lo, hi) as a standard LCP, in stages: the rows split into fixed, free
+// and kept; the reduced problem; the LCP variables; M and q. eliminateFree: free rows leave by
+// the Schur complement when their block is nonsingular; otherwise they are split.
+StandardForm toStandard(const SparseMatrix& A, const Vector& b, const Vector& lo, const Vector& hi,
+                        bool eliminateFree) {
+  StandardForm f;
+  const RowSplit rows = splitRows(A, b, lo, hi, f);
+  SparseMatrix Ar;
+  Vector br;
+  reduce(A, b, lo, rows, eliminateFree, f, Ar, br);
+  const std::vector<std::vector<int>> varsOf = addVariables(lo, hi, f);
+  assembleLcp(Ar, br, lo, hi, varsOf, f);
   return f;
 }
 
@@ -378,6 +414,87 @@ double boundsMove(const Problem& p, const Vector& before, const Vector& after) {
   return move;
 }
 
+// A pass's boxes: the effective bounds at `current` (a friction row's: mu |x_normal| there).
+void passBounds(const Problem& problem, const Vector& current, Vector& lo, Vector& hi) {
+  for (int i = 0; i < problem.size(); ++i) {
+    lo[i] = problem.effectiveLo(i, current);
+    hi[i] = problem.effectiveHi(i, current);
+  }
+}
+
+// A pass's LCP on the factored basis (from warmBasis unless it is empty) or the dense tableau.
+template <class Stop>
+LcpSolution solvePass(const StandardForm& f, bool revised, const ToleranceRules& rules,
+                      int maxPivots, int refactorPeriod, std::vector<int> warmBasis, Stop& stop) {
+  if (!revised) return solveDense(f, rules, maxPivots, stop);
+  detail::RevisedLemkeSettings settings;
+  settings.rules = rules;
+  settings.maxPivots = maxPivots;
+  settings.refactorPeriod = refactorPeriod;
+  settings.stop = stop;
+  settings.warmBasis = std::move(warmBasis);
+  return solveRevised(f, settings);
+}
+
+// Where a pass stands, for its messages.
+struct PassContext {
+  int outer = 0;          // the friction iteration (1 without findex)
+  bool friction = false;  // the problem has findex rows
+  bool standard = false;  // the problem is a standard LCP (no change of variables)
+  int pivotLimit = -1;    // for the whole solve, set by the first pass
+  int m = 0;              // the pass's LCP size
+  double timeBudget = 0;
+};
+
+// A pass that ended without a complementary basis (a ray, the pivot limit, the time budget):
+// true with its status and message set; false when it is solved.
+bool reportUnsolved(const LcpSolution& s, const PassContext& c, Result& result) {
+  std::ostringstream os;
+  const std::string where = c.friction ? " in friction iteration " + std::to_string(c.outer) : "";
+  const std::string lcp = c.standard ? "the LCP" : "the transformed LCP (see lemke.hpp)";
+  const char* returned = c.outer > 1 ? "the last friction iteration's answer" : "the start";
+  switch (s.outcome.end) {
+    case LemkeEnd::Solved: return false;
+    case LemkeEnd::Ray:
+      result.status = Status::Failed;
+      result.message = s.singular ? "the factored basis became singular after " +
+                                        std::to_string(s.outcome.pivots) + " pivots" + where
+                                  : detail::rayMessage(s.outcome, s.rayLabel, lcp) + where;
+      return true;
+    case LemkeEnd::PivotLimit:
+      os << "gave up: pivot limit " << c.pivotLimit << " reached" << where
+         << " (Options::maxPivots, over all friction iterations; 0 means 50 m + 100 for m = " << c.m
+         << "): " << returned << " is returned";
+      result.status = Status::MaxIterations;
+      result.message = os.str();
+      return true;
+    case LemkeEnd::Stopped:
+      os << "gave up when the time budget (" << c.timeBudget << " s) ran out after "
+         << s.outcome.pivots << " pivots" << where << ": " << returned << " is returned";
+      result.status = Status::TimeLimit;
+      result.message = os.str();
+      return true;
+  }
+  return false;
+}
+
+// The pass's answer in the original variables, replaced by the re-solve of its active set
+// (resolveActiveSet) when that is finite and no less accurate; acc: the answer's accuracy.
+Vector passAnswer(const Problem& problem, const SparseMatrix& A, const StandardForm& f,
+                  const LcpSolution& s, const Vector& lo, bool sparse, Accuracy& acc) {
+  Vector best = toOriginal(f, s.y, lo);
+  acc = accuracy(problem, best);
+  const std::vector<RowState> states = rowStates(f, s.yBasic, problem.size());
+  if (std::optional<Vector> refined = resolveActiveSet(problem, A, states, best, sparse)) {
+    const Accuracy a = accuracy(problem, *refined);
+    if (a.finite && !(a.residual > acc.residual)) {
+      best = std::move(*refined);
+      acc = a;
+    }
+  }
+  return best;
+}
+
 }  // namespace
 
 void LemkeSolver::run(const Problem& problem, Vector& x, Result& result) {
@@ -432,7 +549,6 @@ void LemkeSolver::pivot(const Problem& problem, const SparseMatrix& A, Vector& x
   const Options& opt = options();
   const int n = problem.size();
   const bool friction = problem.hasFindex();
-  const bool standard = problem.classify() == ProblemClass::StandardLcp;
   // Free rows keep the tableau (its Schur elimination, see lemke.hpp) up to
   // kLemkeFreeRowsTableauRows.
   const bool revised =
@@ -453,73 +569,33 @@ void LemkeSolver::pivot(const Problem& problem, const SparseMatrix& A, Vector& x
   Vector current = x;  // seeds the friction bounds
   BasisMemory memory(revised && friction ? n : 0);
   // The pivot limit bounds the whole solve, the friction passes together: a pass that does not
-  // settle the bounds cannot buy another full limit (50 m + 100 pivots a pass times 1000 passes
-  // ran for minutes on a 600-row contact problem).
-  int pivotLimit = -1;
+  // settle the bounds cannot buy another full limit (docs/benchmarks.md, "lemke: dense tableau
+  // against the factored basis", the findex contact problems).
+  PassContext pass;
+  pass.friction = friction;
+  pass.standard = problem.classify() == ProblemClass::StandardLcp;
+  pass.timeBudget = opt.timeBudget;
   double lastMove = 0;
   for (int outer = 1; outer <= outerLimit; ++outer) {
     Vector lo(n), hi(n);
-    for (int i = 0; i < n; ++i) {
-      lo[i] = problem.effectiveLo(i, current);
-      hi[i] = problem.effectiveHi(i, current);
-    }
+    passBounds(problem, current, lo, hi);
     const StandardForm f = toStandard(A, problem.b, lo, hi, !revised);
-    const int m = static_cast<int>(f.q.size());
-    if (pivotLimit < 0) pivotLimit = opt.maxPivots > 0 ? opt.maxPivots : 50 * m + 100;
-    const int maxPivots = std::max(1, pivotLimit - result.iterations);
-    LcpSolution s;
-    if (revised) {
-      detail::RevisedLemkeSettings settings;
-      settings.rules = rules;
-      settings.maxPivots = maxPivots;
-      settings.refactorPeriod = refactorPeriod;
-      settings.stop = stop;
-      if (outer > 1) settings.warmBasis = memory.basis(f);
-      s = solveRevised(f, settings);
-    } else {
-      s = solveDense(f, rules, maxPivots, stop);
-    }
+    pass.outer = outer;
+    pass.m = static_cast<int>(f.q.size());
+    if (pass.pivotLimit < 0)
+      pass.pivotLimit = opt.maxPivots > 0 ? opt.maxPivots : 50 * pass.m + 100;
+    const int maxPivots = std::max(1, pass.pivotLimit - result.iterations);
+    // Passes after the first start from the last pass's basis on the factored path.
+    std::vector<int> warm = revised && outer > 1 ? memory.basis(f) : std::vector<int>();
+    const LcpSolution s =
+        solvePass(f, revised, rules, maxPivots, refactorPeriod, std::move(warm), stop);
     result.iterations += s.outcome.pivots;
+    if (reportUnsolved(s, pass, result)) return;
 
-    std::ostringstream os;
-    const std::string where = friction ? " in friction iteration " + std::to_string(outer) : "";
-    const std::string lcp = standard ? "the LCP" : "the transformed LCP (see lemke.hpp)";
-    switch (s.outcome.end) {
-      case LemkeEnd::Solved: break;
-      case LemkeEnd::Ray:
-        result.status = Status::Failed;
-        result.message = s.singular ? "the factored basis became singular after " +
-                                          std::to_string(s.outcome.pivots) + " pivots" + where
-                                    : detail::rayMessage(s.outcome, s.rayLabel, lcp) + where;
-        return;
-      case LemkeEnd::PivotLimit:
-        os << "gave up: pivot limit " << pivotLimit << " reached" << where
-           << " (Options::maxPivots, over all friction iterations; 0 means 50 m + 100 for m = " << m
-           << "): " << (outer > 1 ? "the last friction iteration's answer" : "the start")
-           << " is returned";
-        result.status = Status::MaxIterations;
-        result.message = os.str();
-        return;
-      case LemkeEnd::Stopped:
-        os << "gave up when the time budget (" << opt.timeBudget << " s) ran out after "
-           << s.outcome.pivots << " pivots" << where << ": "
-           << (outer > 1 ? "the last friction iteration's answer" : "the start") << " is returned";
-        result.status = Status::TimeLimit;
-        result.message = os.str();
-        return;
-    }
-
-    Vector best = toOriginal(f, s.y, lo);
-    Accuracy acc = accuracy(problem, best);
-    const std::vector<RowState> states = rowStates(f, s.yBasic, n);
-    if (std::optional<Vector> refined = resolveActiveSet(problem, A, states, best, revised)) {
-      const Accuracy a = accuracy(problem, *refined);
-      if (a.finite && !(a.residual > acc.residual)) {
-        best = std::move(*refined);
-        acc = a;
-      }
-    }
+    Accuracy acc;
+    const Vector best = passAnswer(problem, A, f, s, lo, revised, acc);
     x = best;
+    std::ostringstream os;
     if (!friction || acc.residual <= opt.tolerance) {
       result.status = Status::Converged;
       os << "z0 left the basis after " << result.iterations << " pivots";

@@ -1,7 +1,8 @@
-// Lemke's method on a factored basis (the revised method): the same pivots as the dense tableau
-// of lemke_tableau.hpp, with every tableau column it reads computed by solves with an LU of the
-// basis matrix instead. The method, its rules and the size at which it replaces the tableau are
-// described in mlcp/solvers/lemke.hpp.
+// core/src/pivoting/lemke_revised.hpp (internal): Lemke's method on a factored basis (the
+// revised method): the same pivots as the dense tableau of lemke_tableau.hpp, with every tableau
+// column it reads computed by solves with an LU of the basis matrix instead. The method, its
+// rules and the size at which it replaces the tableau: mlcp/solvers/lemke.hpp and
+// docs/methods/pivoting.md, "Lemke: tableau or factored basis".
 //
 // Standard LCP w = M y + q with the artificial z0: [I, -M, -c] (w, y, z0) = q, c the covering
 // vector (e cold; B0 e for a warm start from the basis B0, so that z0's column reads -e in it).
@@ -12,9 +13,9 @@
 // x_B. A pivot needs one solve B d = a for the entering column a; x_B moves by the ratio step
 // (x_B -= theta d, x_B[r] = theta). Ties of the ratio test read rows of B^-1, e_i' B^-1, by
 // solves with B' for the tied rows only. Every refactorPeriod pivots B is factored again and
-// x_B recomputed as B^-1 q; when the updated x_B had drifted from it by more than 1e-9
-// (relative) the period is halved. Memory: the factor (O(nnz(L + U))) plus at most
-// refactorPeriod eta columns of m entries.
+// x_B recomputed as B^-1 q; when the updated x_B's backward error ||B x_B - q|| / (||q|| +
+// ||B|| ||x_B||) exceeded kLemkeBackwardError (1e-10) the period is halved. Memory: the factor
+// (O(nnz(L + U))) plus at most refactorPeriod eta columns of m entries.
 #pragma once
 
 #include <functional>
@@ -39,7 +40,7 @@ struct RevisedLemkeResult {
 struct RevisedLemkeSettings {
   ToleranceRules rules;
   int maxPivots = 0;
-  // Pivots between two factorizations of the basis (halved on drift). Default 50.
+  // Pivots between two factorizations of the basis (halved on inaccurate updates). Default 50.
   int refactorPeriod = 50;
   // A complementary basis to start from (m variables, one of w_i / y_i per i), or empty for the
   // slack basis. A warm start uses the covering vector B0 e.

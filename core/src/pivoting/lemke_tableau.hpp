@@ -1,6 +1,7 @@
-// Lemke's complementary pivoting on a dense tableau, generic in the number type so that the
-// solver (double, with tolerances) and the teaching trace (exact fractions) share one copy of
-// the pivoting rules. The method and its guarantees are described in mlcp/solvers/lemke.hpp.
+// core/src/pivoting/lemke_tableau.hpp (internal): Lemke's complementary pivoting on a dense
+// tableau, generic in the number type so that the solver (double, with tolerances) and the
+// teaching trace (exact fractions, rational.hpp) share one copy of the pivoting rules. The
+// method and its guarantees: mlcp/solvers/lemke.hpp and docs/methods/pivoting.md.
 //
 // Tableau of the standard LCP w = M z + q, w, z >= 0, w'z = 0, with the artificial z0:
 //
@@ -9,6 +10,7 @@
 //
 // After any sequence of pivots the w-columns hold B^-1 (B the basis matrix), which is what the
 // lexicographic ratio test compares: rows of [rhs, B^-1] divided by the pivot-column entry.
+// Cost: n x (2n + 2) entries; a Gauss-Jordan pivot O(n^2), skipping the pivot row's zeros.
 #pragma once
 
 #include <algorithm>
@@ -47,7 +49,7 @@ struct ToleranceRules {
 };
 
 // Variable v of an LCP of size n (w_i = i, z_i = n + i, z0 = 2 n) as "w3", "z1", "z0" (1-based,
-// as in the seed notes).
+// as in the textbook tableaux and traceLemke's print).
 inline std::string variableLabel(int v, int n) {
   if (v == 2 * n) return "z0";
   return (v < n ? "w" : "z") + std::to_string(v % n + 1);

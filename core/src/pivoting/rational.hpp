@@ -1,6 +1,7 @@
-// A tiny exact fraction for the Lemke tableau trace: int64 numerator and denominator, every
-// intermediate in __int128, always reduced by the gcd. A result that does not fit in int64
-// throws RationalOverflow, so the caller can fall back to decimals and say so.
+// core/src/pivoting/rational.hpp (internal): a tiny exact fraction for the Lemke tableau trace:
+// int64 numerator and denominator, every intermediate in __int128, always reduced by the gcd. A
+// result that does not fit in int64 throws RationalOverflow, so the caller can fall back to
+// decimals and say so.
 #pragma once
 
 #include <cmath>
