@@ -171,7 +171,7 @@ void bench(int levels, bool square) {
     std::printf("| %d | - | body space does not apply |\n", pyramid.boxes());
     return;
   }
-  const double minDiagonal = 1e-11 * dMax;
+  const double minDiagonal = mlcp::kBodyMinDiagonal * dMax;
   for (const bool withSliding : {true, false}) {
     const std::vector<int> sliding = withSliding ? sets.sliding : std::vector<int>{};
     const std::vector<double> coeff = withSliding ? sets.coeff : std::vector<double>{};

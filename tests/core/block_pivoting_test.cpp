@@ -32,7 +32,7 @@ using test::KnownProblem;
 // that every solve ends with an answer to compare.
 class BlockStage {
  public:
-  detail::BlockPivoting::Limits limits;
+  PivotingLimits limits;
   int maxSteps = 40;
   bool trustedSets = true;
   double setsAtGuessResidual = kInf;
@@ -203,11 +203,11 @@ TEST(BlockPivoting, SlidingPyramidWarmStart) {
 TEST(BlockPivoting, BorderedUpdatesMatchFreshFactorizations) {
   test::BoxPyramid pyramid(slidingPyramid(5));
   BlockStage updated;
-  updated.limits.woodburyRows = 200;  // the scene slides: every friction row by Woodbury
-  updated.limits.updateRows = 200;
+  updated.limits.pivotingWoodburyRows = 200;  // the scene slides: every friction row by Woodbury
+  updated.limits.pivotingUpdateRows = 200;
   BlockStage fresh;
-  fresh.limits.updateRows = 0;
-  fresh.limits.woodburyRows = 0;
+  fresh.limits.pivotingUpdateRows = 0;
+  fresh.limits.pivotingWoodburyRows = 0;
   // Sets from the natural map at the guess: more than one step per solve (from the sets where
   // the guess lies each solve settles in its first step, nothing to reuse).
   updated.trustedSets = fresh.trustedSets = false;
@@ -235,11 +235,11 @@ TEST(BlockPivoting, JoinedRowsThroughAReusedFactorTakeTheFreshSteps) {
     for (int i = 0; i < guess.size(); ++i)
       if (g.uniform(0, 1) < 0.3) guess[i] += g.uniform(-0.5, 0.5);
     BlockStage updated;
-    updated.limits.updateRows = 200;
-    updated.limits.woodburyRows = 200;
+    updated.limits.pivotingUpdateRows = 200;
+    updated.limits.pivotingWoodburyRows = 200;
     BlockStage fresh;
-    fresh.limits.updateRows = 0;
-    fresh.limits.woodburyRows = 0;
+    fresh.limits.pivotingUpdateRows = 0;
+    fresh.limits.pivotingWoodburyRows = 0;
     Vector xu, xf;
     const Result ru = updated.solveWithGuess(kp.problem, guess, xu);
     const Result rf = fresh.solveWithGuess(kp.problem, guess, xf);
@@ -400,7 +400,7 @@ TEST(BlockPivoting, DescendingFullStepsContinue) {
   BlockStage on;
   BlockStage off;
   on.trustedSets = off.trustedSets = false;
-  off.limits.descentSteps = 0;
+  off.limits.pivotingDescentSteps = 0;
   const int withDescents = pyramidSequenceSteps(on), without = pyramidSequenceSteps(off);
   EXPECT_LT(withDescents, without);
 }
@@ -463,8 +463,8 @@ TEST(BlockPivoting, TwoCyclesOfFullStepsHandOverAtOnce) {
     int steps[2];
     for (int cfg = 0; cfg < 2; ++cfg) {
       BlockStage s;
-      s.limits.breakCycles = cfg == 1;
-      s.limits.descentSteps = 0;
+      s.limits.pivotingBreakCycles = cfg == 1;
+      s.limits.pivotingDescentSteps = 0;
       Vector x;
       const Result r = s.solveWithGuess(p, guess, x);
       EXPECT_EQ(r.converged(), accuracy(p, x).residual <= s.options().tolerance) << r.message;

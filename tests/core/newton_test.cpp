@@ -336,7 +336,7 @@ TEST(Newton, NonsymmetricProblemsAreSolved) {
 // A warm sequence of a resting pyramid without cfm (Bullet's contacts), mu 0.6, b moved by 1% of
 // g dt a step: with the monotone Armijo rule no solve reaches 1e-6 in 50 steps (the steps across
 // the sliding rows' kinks are halved and the proximal weight grows); with the non-monotone rule
-// (newton.hpp, "Step") some do, in fewer steps overall.
+// (docs/methods/newton.md, "Step") some do, in fewer steps overall.
 TEST(Newton, NonmonotoneLineSearchLetsFullStepsAcrossKinks) {
   int steps[2] = {0, 0}, converged[2] = {0, 0};
   for (const int memory : {0, 1}) {

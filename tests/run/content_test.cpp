@@ -104,11 +104,6 @@ constexpr const char* kBridgePgs =
 constexpr const char* kBridgeLdlt =
     "ldlt refuses bounded rows: once the crates land (step 16) the islands have contacts, and the "
     "100-sweep pgs fallback misses the 1e-3 acceptance on the singular bridge (see kBridgePgs)";
-constexpr const char* kBridgeAuto =
-    "auto on the singular bridge in Bullet: on one step its dantzig's exact-friction passes, "
-    "after the regularised retry, still move after the scene's 50 (the same island settles "
-    "after 199 cheap passes), and the policy's demotion to pgs after that breakdown leaves the "
-    "next islands to pgs, which misses the 1e-3 acceptance here (see kBridgePgs)";
 constexpr const char* kPgsLimit =
     "pgs convergence: at the engine's count (the scene's 50 sweeps; no fallback, the same sweeps "
     "would repeat) pgs does not reach the 1e-3 acceptance on these large contact islands (a "
@@ -134,7 +129,6 @@ const KnownFailure kKnownFailures[] = {
     {"ragdoll_pile", "ode", "pgs", kPgsLimit, false},
     {"plank_bridge", "bullet", "pgs", kBridgePgs, false},
     {"plank_bridge", "bullet", "ldlt", kBridgeLdlt, false},
-    {"plank_bridge", "bullet", "auto", kBridgeAuto, false},
     {"plank_bridge", "ode", "pgs", kBridgePgs, false},
     {"plank_bridge", "ode", "ldlt", kBridgeLdlt, false},
     {"hull_stack", "bullet", "pgs", kPgsLimit, false},

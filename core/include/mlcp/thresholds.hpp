@@ -53,7 +53,8 @@ inline constexpr double kLemkeBackwardError = 1e-10;
 // The minimum-norm least-squares rank decision, times max(1, max |A_ii|): directions 1e-6
 // below the stiffest are where an exact answer would throw bodies (linalg/min_norm.hpp).
 inline constexpr double kMinNormShift = 1e-6;
-// newton's body-space factor treats a body block's diagonal below this, relative, as singular.
+// newton's body-space factors (its steps' and its pivoting phase's) treat a body block's diagonal
+// below this, relative, as singular.
 inline constexpr double kBodyMinDiagonal = 1e-11;
 // A row's A_ii below this times the size it would have outside M^-1's null space is zero
 // (the row screen: such a row moves nothing).

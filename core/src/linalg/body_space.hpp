@@ -16,20 +16,17 @@
 //     K^-1 r = D^-1 (r - U y),   S y = V^T D^-1 r,   S = I + V^T D^-1 U,
 //
 // S of size 6 x (dynamic bodies), 6 x 6 blocks on the body graph (symmetric pattern; symmetric
-// positive definite, eigenvalues >= 1, without sliding rows). Valid when every d_c is not tiny.
+// positive definite, eigenvalues >= 1, without sliding rows). Valid when every d_c is not tiny
+// (callers: at least kBodyMinDiagonal max |A_ii|, thresholds.hpp).
 //
 // Cost. S's factor is a block LU on the body graph in CHOLMOD's fill-reducing order (the lower
 // fill of AMD and nested dissection, linalg/ordering.hpp; kept while the graph is the last
 // problem's): O(sum over bodies of (fill blocks below it)^2 216) per factorization, independent
-// of how many rows each contact has; on a 210-box pyramid (4.7k rows, 1260 body coordinates) that
-// is about a tenth of a sparse LU of K on the rows. Why a block LU of our own and not a library's
-// factorization of S: on the pyramids' S (330 to 6090 coordinates) it is faster than CHOLMOD's
-// supernodal Cholesky (which would serve only S without sliding rows), KLU and UMFPACK, with
-// reference BLAS or OpenBLAS (docs/benchmarks.md, "Body space: the factorization of S"), also on
-// a square pyramid's three-dimensional body graph, whose top separators make dense blocks of
-// hundreds of coordinates. Its block updates run in AVX2 where the CPU has it (mlcp/cpu.hpp,
-// linalg/block_update.hpp). Memory is O(fill blocks + elimination updates); no limit on the
-// bodies.
+// of how many rows each contact has. Its block updates run in AVX2 where the CPU has it
+// (mlcp/cpu.hpp, linalg/block_update.hpp). Memory is O(fill blocks + elimination updates); no
+// limit on the bodies. Why a block LU of our own: it is faster on the pyramids' S than CHOLMOD,
+// KLU and UMFPACK (docs/benchmarks.md, "Body space: the factorization of S"; docs/decisions.md,
+// "body space").
 #pragma once
 
 #include <Eigen/Dense>

@@ -7,8 +7,9 @@
 // the order whose Cholesky factor has fewer entries. Why both: on the body graph of a 210-box
 // pyramid the two are within 5% of each other, while on a 1000-box pyramid nested dissection
 // leaves about 0.6x of AMD's fill in the block LU of linalg/body_space.hpp (docs/benchmarks.md,
-// "Body space: the factorization of S"). Cost: AMD O(edges) (0.14 ms at 210 nodes, 0.9 ms at
-// 1015), nested dissection a few times that (0.4 ms, 3.3 ms).
+// "Body space: the factorization of S"). Cost: AMD O(edges), nested dissection a few times
+// that (docs/benchmarks.md,
+// "Body space: S against the rows' LU, and the cost of the ordering").
 #pragma once
 
 #include <vector>

@@ -34,6 +34,12 @@ class SymmetricPatternLu {
  private:
   bool run(int m, const std::vector<int>& outer, const std::vector<int>& inner,
            const std::vector<double>& k, const std::vector<double>* kt, double pivotTolerance);
+  // run's stages: the symbolic pass, then per column the scatter and the elimination (both
+  // inlined into run's loop).
+  void analyze(int m, const std::vector<int>& outer, const std::vector<int>& inner);
+  int scatter(int m, int col, const std::vector<int>& outer, const std::vector<int>& inner,
+              const std::vector<double>& k, const std::vector<double>* kt, double& dk);
+  void eliminate(int m, int col, int top, double& dk);
   // Column c of L (and row c of U) at [start_[c], start_[c + 1]): rows_, l_ = L(row, c),
   // u_ = U(c, row) (unused when symmetric_), sized by a symbolic pass over the elimination tree.
   std::vector<int> start_, fill_, rows_;

@@ -25,6 +25,26 @@ bool isFriction(const Problem& pb, int i) { return !pb.findex.empty() && pb.find
 double signOf(double v) { return v < 0 ? -1.0 : 1.0; }
 // The value a non-clamped, uncoupled row is held at.
 double heldValue(double lo, double hi, bool atHi) { return atHi ? hi : lo; }
+// Appends to a sparse column list (idx, val, start) row `row` of A restricted to the base set
+// (basePos), scaled (a column of G or H in buildCapacitance).
+void pushColumn(const SparseMatrix& A, const std::vector<int>& basePos, std::vector<int>& idx,
+                std::vector<double>& val, std::vector<int>& start, int row, double scale) {
+  for (SparseMatrix::InnerIterator it(A, row); it; ++it)
+    if (basePos[it.index()] >= 0) {
+      idx.push_back(basePos[it.index()]);
+      val.push_back(scale * it.value());
+    }
+  start.push_back(static_cast<int>(idx.size()));
+}
+// Appends the column with the single entry v at `at` (empty when at < 0).
+void pushUnit(std::vector<int>& idx, std::vector<double>& val, std::vector<int>& start, int at,
+              double v) {
+  if (at >= 0) {
+    idx.push_back(at);
+    val.push_back(v);
+  }
+  start.push_back(static_cast<int>(idx.size()));
+}
 }  // namespace
 
 BlockPivoting::BlockPivoting() : body_(std::make_unique<BodySpaceSystem>()) {}
@@ -86,17 +106,10 @@ void BlockPivoting::guess(const Problem& pb, const Vector& x0, const Vector& w0,
   }
 }
 
-// Sets x to the solution of the linear equations of the current index sets:
-//   clamped rows:         (A x + b)_i = 0
-//   uncoupled at a bound: x_i = lo_i or hi_i
-//   friction at a bound:  x_t = mu_t s_j x_j (s_j = sign of the normal, mu_t = lo_t or hi_t)
-// with a proximal term: clamped rows solve w_i + rho (x_i - prev_i) = 0 (rho = 0: the exact
-// equations). Substituting the sliding rows (normal clamped) gives K y = r with K = A_CC + rho I
-// plus the sliding columns scaled by their coefficients added to their normals' columns: the
-// sparse LDL^T of A_CC + rho I with the sliding rows bordered (Woodbury), reused by the next
-// steps while their sets stay close (buildCapacitance); many sliding rows: the LU of K.
-bool BlockPivoting::solveClamped(const Problem& pb, Vector& x, const Vector& prev, double rho,
-                                 std::string& why) {
+// The index sets' unknowns: order_ (the clamped rows in the fill-reducing order), pos_, and the
+// sliding rows with their coefficients (sliding_, coeff_); x takes the held values, zero on the
+// clamped and sliding rows, and x_t = c_t x_j on a friction row held with its normal.
+void BlockPivoting::gatherSets(const Problem& pb, Vector& x) {
   const int n = pb.size();
   order_.clear();
   for (int k = 0; k < n; ++k) {
@@ -124,46 +137,68 @@ bool BlockPivoting::solveClamped(const Problem& pb, Vector& x, const Vector& pre
     }
   }
   for (int i : order_) x[i] = 0;
+}
 
+// The factor of the current sets' K: in body space when it applies (a fresh factor there costs
+// less than reusing one here, so no base is kept then); with many sliding rows the LU of K;
+// otherwise the base factor bordered by the changes (buildCapacitance), or a new base.
+bool BlockPivoting::factorClamped(const Problem& pb, double rho, std::string& why) {
   const int m = static_cast<int>(order_.size());
-  Vector r(m);
-  clampedTimes(x, ax_);
-  for (int c = 0; c < m; ++c) r[c] = -(pb.b[order_[c]] + ax_[c]) + rho * prev[order_[c]];
   const int s = static_cast<int>(sliding_.size());
-  useLu_ = s > limits_.woodburyRows && m > 0;
+  useLu_ = s > limits_.pivotingWoodburyRows && m > 0;
   useBody_ = false;
-  // Body space (linalg/body_space.hpp) whenever it applies: a fresh factor there costs less than
-  // reusing one here (no base is kept for the bordered updates then).
-  if (m > 0 && bodyReady_) {
+  if (m == 0) return true;
+  if (bodyReady_) {
     useBody_ = body_->factor(order_, pos_, sliding_, coeff_, problemFindex_, rho,
-                             limits_.bodyMinDiagonal * dMax_);
+                             kBodyMinDiagonal * dMax_);
     if (useBody_) {
       haveBase_ = false;
       ++factorizations_;
       ++bodyFactorizations_;
+      return true;
     }
   }
-  if (m > 0 && !useBody_) {
-    if (useLu_) {
-      haveBase_ = false;
-      ++factorizations_;
-      if (!factorCoupled(rho, true, why)) return false;
-    } else if (!(haveBase_ && limits_.updateRows > 0 && rho == baseRho_ &&
-                 buildCapacitance(pb, rho, limits_.updateRows))) {
-      // A new base: B = A_CC + rho I for the current set, the sliding rows by Woodbury.
-      ++factorizations_;
-      haveBase_ = false;
-      if (!factorCoupled(rho, false, why)) return false;
-      haveBase_ = true;
-      baseRho_ = rho;
-      basePos_ = pos_;
-      baseOrder_ = order_;
-      if (!buildCapacitance(pb, rho, m + s)) {
-        why = "the clamped system with its sliding rows is singular";
-        return false;
-      }
-    }
+  if (useLu_) {
+    haveBase_ = false;
+    ++factorizations_;
+    return factorCoupled(rho, true, why);
   }
+  if (haveBase_ && limits_.pivotingUpdateRows > 0 && rho == baseRho_ &&
+      buildCapacitance(pb, rho, limits_.pivotingUpdateRows))
+    return true;
+  // A new base: B = A_CC + rho I for the current set, the sliding rows by Woodbury.
+  ++factorizations_;
+  haveBase_ = false;
+  if (!factorCoupled(rho, false, why)) return false;
+  haveBase_ = true;
+  baseRho_ = rho;
+  basePos_ = pos_;
+  baseOrder_ = order_;
+  if (!buildCapacitance(pb, rho, m + s)) {
+    why = "the clamped system with its sliding rows is singular";
+    return false;
+  }
+  return true;
+}
+
+// Sets x to the solution of the linear equations of the current index sets:
+//   clamped rows:         (A x + b)_i = 0
+//   uncoupled at a bound: x_i = lo_i or hi_i
+//   friction at a bound:  x_t = mu_t s_j x_j (s_j = sign of the normal, mu_t = lo_t or hi_t)
+// with a proximal term: clamped rows solve w_i + rho (x_i - prev_i) = 0 (rho = 0: the exact
+// equations). Substituting the sliding rows (normal clamped) gives K y = r with K = A_CC + rho I
+// plus the sliding columns scaled by their coefficients added to their normals' columns: the
+// sparse LDL^T of A_CC + rho I with the sliding rows bordered (Woodbury), reused by the next
+// steps while their sets stay close (buildCapacitance); many sliding rows: the LU of K.
+bool BlockPivoting::solveClamped(const Problem& pb, Vector& x, const Vector& prev, double rho,
+                                 std::string& why) {
+  gatherSets(pb, x);
+  const int m = static_cast<int>(order_.size());
+  Vector r(m);
+  clampedTimes(x, ax_);
+  for (int c = 0; c < m; ++c) r[c] = -(pb.b[order_[c]] + ax_[c]) + rho * prev[order_[c]];
+  if (!factorClamped(pb, rho, why)) return false;
+  const int s = static_cast<int>(sliding_.size());
   auto place = [&](const Vector& y, bool add) {
     for (int c = 0; c < m; ++c) x[order_[c]] = (add ? x[order_[c]] : 0.0) + y[c];
     for (int k = 0; k < s; ++k) x[sliding_[k]] = coeff_[k] * x[pb.findex[sliding_[k]]];
@@ -255,8 +290,7 @@ void BlockPivoting::applySolve(Vector& y) {
 // local to a few bodies, so their reach in the elimination tree is short). False when there
 // are more than maxExtra unknowns beyond C0 or S is singular.
 bool BlockPivoting::buildCapacitance(const Problem& pb, double rho, int maxExtra) {
-  const SparseMatrix& A = *a_;
-  const int n = pb.size(), m0 = static_cast<int>(baseOrder_.size());
+  const int n = pb.size();
   extraRow_.clear();
   extraOf_.assign(n, -1);
   for (int i : order_)
@@ -270,36 +304,31 @@ bool BlockPivoting::buildCapacitance(const Problem& pb, double rho, int maxExtra
   if (p > maxExtra) return false;
   for (int a = 0; a < left; ++a) extraOf_[extraRow_[a]] = a;
   DenseMatrix S = DenseMatrix::Zero(p, p);
+  borderColumns(rho, joined, left, S);
+  subtractSchur(left, S);
+  if (p == 0) return true;
+  capacitance_.setThreshold(pivTolRelative_);
+  capacitance_.compute(S);
+  return S.allFinite() && capacitance_.isInvertible();
+}
+
+// buildCapacitance's columns of G and H as sparse lists (gStart_/gIdx_/gVal_,
+// hStart_/hIdx_/hVal_) and F's entries in S, for the extra unknowns extraRow_ (joined rows
+// first, then the rows that left, then the sliding rows).
+void BlockPivoting::borderColumns(double rho, int joined, int left, DenseMatrix& S) {
+  const SparseMatrix& A = *a_;
+  const int p = static_cast<int>(extraRow_.size());
   gStart_.assign(1, 0);
   hStart_.assign(1, 0);
   gIdx_.clear();
   gVal_.clear();
   hIdx_.clear();
   hVal_.clear();
-  work_.setZero(m0);
-  // Column a of G (and of H when given) as sparse lists; F's entries in S.
-  auto pushColumn = [&](std::vector<int>& idx, std::vector<double>& val, std::vector<int>& start,
-                        int row, double scale) {
-    for (SparseMatrix::InnerIterator it(A, row); it; ++it)
-      if (basePos_[it.index()] >= 0) {
-        idx.push_back(basePos_[it.index()]);
-        val.push_back(scale * it.value());
-      }
-    start.push_back(static_cast<int>(idx.size()));
-  };
-  auto pushUnit = [](std::vector<int>& idx, std::vector<double>& val, std::vector<int>& start,
-                     int at, double v) {
-    if (at >= 0) {
-      idx.push_back(at);
-      val.push_back(v);
-    }
-    start.push_back(static_cast<int>(idx.size()));
-  };
   for (int a = 0; a < p; ++a) {
     const int i = extraRow_[a];
     if (a < joined) {
-      pushColumn(gIdx_, gVal_, gStart_, i, 1.0);
-      pushColumn(hIdx_, hVal_, hStart_, i, 1.0);
+      pushColumn(A, basePos_, gIdx_, gVal_, gStart_, i, 1.0);
+      pushColumn(A, basePos_, hIdx_, hVal_, hStart_, i, 1.0);
       for (SparseMatrix::InnerIterator it(A, i); it; ++it)
         if (extraOf_[it.index()] >= 0 && extraOf_[it.index()] < joined)
           S(a, extraOf_[it.index()]) += it.value();
@@ -310,7 +339,7 @@ bool BlockPivoting::buildCapacitance(const Problem& pb, double rho, int maxExtra
     } else {
       const double c = coeff_[a - left];
       const int j = problemFindex_[i];
-      pushColumn(gIdx_, gVal_, gStart_, i, c);
+      pushColumn(A, basePos_, gIdx_, gVal_, gStart_, i, c);
       for (SparseMatrix::InnerIterator it(A, i); it; ++it)
         if (extraOf_[it.index()] >= 0 && extraOf_[it.index()] < joined)
           S(extraOf_[it.index()], a) += c * it.value();
@@ -319,8 +348,14 @@ bool BlockPivoting::buildCapacitance(const Problem& pb, double rho, int maxExtra
       S(a, a) += 1;
     }
   }
-  // L^-1 H and D^-1 L^-1 H column by column (applySolve uses H itself, on B^-1 r0); a joined or
-  // left row's column of G equals its column of H, so L^-1 G is only solved for sliding rows.
+}
+
+// S -= (L^-1 H)^T D^-1 (L^-1 G), from sparse forward solves on the base factor: L^-1 H and
+// D^-1 L^-1 H column by column (applySolve uses H itself, on B^-1 r0); a joined or left row's
+// column of G equals its column of H, so L^-1 G is only solved for sliding rows.
+void BlockPivoting::subtractSchur(int left, DenseMatrix& S) {
+  const int p = static_cast<int>(extraRow_.size());
+  work_.setZero(static_cast<Eigen::Index>(baseOrder_.size()));
   std::vector<int> hsStart(1, 0), hsIdx;
   std::vector<double> hsVal, hlVal;
   for (int a = 0; a < p; ++a) {
@@ -351,10 +386,6 @@ bool BlockPivoting::buildCapacitance(const Problem& pb, double rho, int maxExtra
     }
     for (int i : reach_) work_[i] = 0;
   }
-  if (p == 0) return true;
-  capacitance_.setThreshold(pivTolRelative_);
-  capacitance_.compute(S);
-  return S.allFinite() && capacitance_.isInvertible();
 }
 
 // Factors K = A_CC + rho I, when coupled with each sliding row's column c_t A_{C,t} added to its
@@ -533,9 +564,10 @@ bool BlockPivoting::symmetricValues() const {
   return symmetricWithin(gap, scale);
 }
 
-BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Options& opt,
-                                         int maxSteps, bool atGuess, bool symmetryKnown) {
-  Report rep;
+// The per-pattern and per-problem preparation of a run: A's sparse rows, the fill-reducing order
+// and mirror of a new pattern, the symmetry check (false: A is not symmetric), the tolerances and
+// the body-space factor of rows given since the last run.
+bool BlockPivoting::prepare(const Problem& pb, const Options& opt, bool symmetryKnown) {
   const int n = pb.size();
   if (pb.isSparse()) {
     a_ = &pb.sparseA();
@@ -553,10 +585,7 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
     aPattern_.remember(*a_);
     mirrorPattern();
   }
-  if (!symmetryKnown && !(mirror_.empty() ? isSymmetric(*a_) : symmetricValues())) {
-    rep.message = "A is not symmetric";
-    return rep;
-  }
+  if (!symmetryKnown && !(mirror_.empty() ? isSymmetric(*a_) : symmetricValues())) return false;
   problemFindex_ = pb.findex.empty() ? std::vector<int>(n, -1) : pb.findex;
   double dMax = 0;
   for (int i = 0; i < n; ++i) dMax = std::max(dMax, std::abs(pb.diagonal(i)));
@@ -573,141 +602,179 @@ BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Opt
   pos_.assign(n, -1);
   haveBase_ = false;  // A's values are new
   factorizations_ = 0;
-  const bool cold = x.isZero(0.0);
-  Vector w(n), xOld(n), wOld(n), wNew(n);
-  times(x, w);
-  w += pb.b;
-  guess(pb, x, w, cold, atGuess);
+  return true;
+}
 
-  // Full steps (block principal pivoting) while they keep finding new lowest merits
-  // ||H(x)||^2 (H_i = x_i - clamp(x_i - w_i, lo', hi')); then damped Newton steps on the natural
-  // map: a proximal term in the equations and backtracking until the merit decreases (Armijo),
-  // which keeps degenerate scenes (coplanar contacts: nearly singular clamped blocks whose
-  // equations throw the null-space part far away) from jumping between set guesses. When no
-  // step length descends the stage hands over the best iterate.
-  const double regularization = kProximal * (dMax > 0 ? dMax : 1.0);
-  double merit = meritAt(pb, x, w), bestRes = kInf;
+// One run's iterate bookkeeping: the slack w = A x + b, the last step's point and the new slack,
+// the merit ||H||^2, the full steps' best point and the run's best point by residual.
+struct BlockPivoting::RunState {
+  explicit RunState(int n) : w(n), xOld(n), wOld(n), wNew(n) {}
+  Vector w, xOld, wOld, wNew;
+  double merit = 0, bestRes = kInf, fullBest = 0;
   int uphill = 0;
   bool damped = false;
   // Full steps without a new lowest merit that still descend from the step before (at most
-  // Limits::descentSteps per run) do not count as uphill: from a guess that is the best point so
+  // pivotingDescentSteps per run) do not count as uphill: from a guess that is the best point so
   // far the full steps often descend over several steps before beating it (Bullet's pyramid).
   int descents = 0;
-  double fullBest = merit;
-  Vector fullBestX = x;
+  Vector fullBestX, bestX;
+};
+
+// Damped steps from here on, from the full steps' best point.
+void BlockPivoting::toDamped(const Problem& pb, Vector& x, RunState& st) {
+  x = st.fullBestX;
+  times(x, st.w);
+  st.w += pb.b;
+  st.merit = st.fullBest;
+  st.damped = true;
+}
+
+// Short steps leave rows within the tolerance of their bounds but not on them: x projected
+// (friction after its normal) when the projection is still within tolerance.
+void BlockPivoting::project(const Problem& pb, double tolerance, Vector& x) {
+  const int n = pb.size();
+  Vector p = x;
+  for (int i = 0; i < n; ++i)
+    if (!isFriction(pb, i)) p[i] = std::clamp(p[i], pb.lo[i], pb.hi[i]);
+  for (int t = 0; t < n; ++t)
+    if (isFriction(pb, t)) p[t] = std::clamp(p[t], pb.effectiveLo(t, p), pb.effectiveHi(t, p));
+  Vector wp(n);
+  times(p, wp);
+  wp += pb.b;
+  if (accuracy(pb, p, wp).residual <= tolerance) x = p;
+}
+
+// The sets of the next step: after a full step from where x lies (setsAt), a 2-cycle of sets
+// (which would repeat the step two back) handing over to damped steps at once; damped steps
+// take the natural map's sets at x.
+void BlockPivoting::nextSets(const Problem& pb, Vector& x, RunState& st) {
+  if (!st.damped) {
+    setsAt(pb, x, st.w);
+    if (limits_.pivotingBreakCycles && set_ == setPrev2_) toDamped(pb, x, st);
+    setPrev2_.swap(setPrev1_);
+    setPrev1_ = set_;
+  }
+  if (st.damped) guess(pb, x, st.w, false);
+}
+
+// After a full step (block principal pivoting; the merit may rise for a step or two): a new
+// lowest merit, a free descent, or one more step uphill; too many: damped steps from the best.
+void BlockPivoting::fullStep(const Problem& pb, Vector& x, RunState& st) {
+  st.w = st.wNew;
+  const double before = st.merit;
+  st.merit = meritAt(pb, x, st.w);
+  if (st.merit < st.fullBest) {
+    st.fullBest = st.merit;
+    st.fullBestX = x;
+    st.uphill = 0;
+  } else if (st.merit < before && st.descents < limits_.pivotingDescentSteps) {
+    ++st.descents;
+  } else if (++st.uphill > kUphill) {  // no new best: damped steps from the best point
+    st.uphill = 0;
+    toDamped(pb, x, st);
+  }
+}
+
+// After a damped step's solve: backtracking from the full step until ||H||^2 decreases
+// (Armijo). False when no step length descends kUphill + 1 times in a row (the run ends).
+bool BlockPivoting::dampedStep(const Problem& pb, Vector& x, RunState& st) {
+  const Vector dx = x - st.xOld;
+  double alpha = 1, trial = kInf;
+  for (; alpha >= kMinStep; alpha *= 0.5) {
+    x = st.xOld + alpha * dx;
+    st.w = st.wOld + alpha * (st.wNew - st.wOld);
+    trial = meritAt(pb, x, st.w);
+    if (trial <= (1 - 2e-4 * alpha) * st.merit) break;
+  }
+  if (!(trial <= (1 - 2e-4 * alpha) * st.merit)) {
+    // Watchdog: at a kink no short step descends, but the full step (the block pivoting
+    // exchange) often settles the sets; take it a few times in a row, keeping the best point.
+    if (++st.uphill > kUphill) return false;
+    x = st.xOld + dx;
+    st.w = st.wNew;
+    trial = meritAt(pb, x, st.w);
+  } else {
+    st.uphill = 0;
+  }
+  st.merit = trial;
+  return true;
+}
+
+// Full steps (block principal pivoting) while they keep finding new lowest merits ||H(x)||^2;
+// then damped Newton steps on the natural map: a proximal term in the equations and
+// backtracking until the merit decreases (Armijo), which keeps degenerate scenes (coplanar
+// contacts: nearly singular clamped blocks whose equations throw the null-space part far away)
+// from jumping between set guesses. When no step length descends the run hands over the best
+// iterate.
+BlockPivoting::Report BlockPivoting::run(const Problem& pb, Vector& x, const Options& opt,
+                                         int maxSteps, bool atGuess, bool symmetryKnown) {
+  Report rep;
+  if (!prepare(pb, opt, symmetryKnown)) {
+    rep.message = "A is not symmetric";
+    return rep;
+  }
+  const bool cold = x.isZero(0.0);
+  RunState st(pb.size());
+  times(x, st.w);
+  st.w += pb.b;
+  guess(pb, x, st.w, cold, atGuess);
+
+  // Full steps while they find new lowest merits, then damped steps (the header's "Steps").
+  const double regularization = kProximal * (dMax_ > 0 ? dMax_ : 1.0);
+  st.merit = meritAt(pb, x, st.w);
+  st.fullBest = st.merit;
+  st.fullBestX = x;
   setPrev1_ = set_;
   setPrev2_.clear();
-  auto toDamped = [&] {
-    x = fullBestX;
-    times(x, w);
-    w += pb.b;
-    merit = fullBest;
-    damped = true;
-  };
-  Vector bestX = x;
+  st.bestX = x;
   const double deadline = budgetDeadline(opt);
   std::ostringstream os;
   for (;;) {
-    double res = accuracy(pb, x, w).residual;
+    const double res = accuracy(pb, x, st.w).residual;
     if (res <= opt.tolerance) {
-      // Short steps leave rows within the tolerance of their bounds but not on them: project
-      // (friction after its normal) and keep the projection when it is still within tolerance.
-      Vector p = x;
-      for (int i = 0; i < n; ++i)
-        if (!isFriction(pb, i)) p[i] = std::clamp(p[i], pb.lo[i], pb.hi[i]);
-      for (int t = 0; t < n; ++t)
-        if (isFriction(pb, t)) p[t] = std::clamp(p[t], pb.effectiveLo(t, p), pb.effectiveHi(t, p));
-      Vector wp(n);
-      times(p, wp);
-      wp += pb.b;
-      const double resP = accuracy(pb, p, wp).residual;
-      if (resP <= opt.tolerance) {
-        x = p;
-        res = resP;
-      }
+      project(pb, opt.tolerance, x);
       rep.settled = true;
       os << "block pivoting settled after " << rep.steps << " step" << (rep.steps != 1 ? "s" : "");
       break;
     }
-    if (res < bestRes) {
-      bestRes = res;
-      bestX = x;
+    if (res < st.bestRes) {
+      st.bestRes = res;
+      st.bestX = x;
     }
     if (rep.steps >= maxSteps) {
-      x = bestX;
-      os << "residual " << bestRes << " after " << rep.steps << " block steps";
+      x = st.bestX;
+      os << "residual " << st.bestRes << " after " << rep.steps << " block steps";
       break;
     }
     if (opt.timeBudget > 0 && nowSeconds() > deadline) {
-      x = bestX;
+      x = st.bestX;
       os << "time budget spent after " << rep.steps << " block steps";
       break;
     }
-    if (rep.steps > 0 && !damped) {
-      setsAt(pb, x, w);
-      // The sets of two steps ago again (a 2-cycle of full steps, which would repeat that step's
-      // x): damped steps from the best point at once.
-      if (limits_.breakCycles && set_ == setPrev2_) toDamped();
-      setPrev2_.swap(setPrev1_);
-      setPrev1_ = set_;
-    }
-    if (rep.steps > 0 && damped) guess(pb, x, w, false);
+    if (rep.steps > 0) nextSets(pb, x, st);
     ++rep.steps;
-    xOld = x;
-    wOld = w;
+    st.xOld = x;
+    st.wOld = st.w;
     std::string why;
-    const double rho = damped ? regularization * std::min(1.0, std::sqrt(merit)) : 0.0;
-    if (!solveClamped(pb, x, xOld, rho, why)) {
-      if (!damped) {  // a singular block: the proximal term regularizes it
-        toDamped();
+    const double rho = st.damped ? regularization * std::min(1.0, std::sqrt(st.merit)) : 0.0;
+    if (!solveClamped(pb, x, st.xOld, rho, why)) {
+      if (!st.damped) {  // a singular block: the proximal term regularizes it
+        toDamped(pb, x, st);
         continue;
       }
       os << why << " (block step " << rep.steps << ")";
-      x = bestX;
+      x = st.bestX;
       break;
     }
-    times(x, wNew);
-    wNew += pb.b;
-    if (!damped) {
-      // Block principal pivoting: full steps; the merit may rise for a step or two.
-      w = wNew;
-      const double before = merit;
-      merit = meritAt(pb, x, w);
-      if (merit < fullBest) {
-        fullBest = merit;
-        fullBestX = x;
-        uphill = 0;
-      } else if (merit < before && descents < limits_.descentSteps) {
-        ++descents;
-      } else if (++uphill > kUphill) {  // no new best: damped steps from the best point
-        uphill = 0;
-        toDamped();
-      }
-      continue;
+    times(x, st.wNew);
+    st.wNew += pb.b;
+    if (!st.damped) {
+      fullStep(pb, x, st);
+    } else if (!dampedStep(pb, x, st)) {
+      x = st.bestX;
+      os << "residual " << st.bestRes << " after " << rep.steps << " block steps (no descent)";
+      break;
     }
-    const Vector dx = x - xOld;
-    double alpha = 1, trial = kInf;
-    for (; alpha >= kMinStep; alpha *= 0.5) {
-      x = xOld + alpha * dx;
-      w = wOld + alpha * (wNew - wOld);
-      trial = meritAt(pb, x, w);
-      if (trial <= (1 - 2e-4 * alpha) * merit) break;
-    }
-    if (!(trial <= (1 - 2e-4 * alpha) * merit)) {
-      // Watchdog: at a kink no short step descends, but the full step (the block pivoting
-      // exchange) often settles the sets; take it a few times in a row, keeping the best point.
-      if (++uphill > kUphill) {
-        x = bestX;
-        os << "residual " << bestRes << " after " << rep.steps << " block steps (no descent)";
-        break;
-      }
-      x = xOld + dx;
-      w = wNew;
-      trial = meritAt(pb, x, w);
-    } else {
-      uphill = 0;
-    }
-    merit = trial;
   }
   rep.message = os.str();
   rep.factorizations = factorizations_;

@@ -1,58 +1,41 @@
 // Block principal pivoting on the natural map of a sparse symmetric MLCP with findex: the
 // pivoting phase of NewtonSolver (mlcp/solvers/newton.hpp, "Pivoting phase"). Internal to the
-// library.
+// library. The long form: docs/methods/newton.md, "Block pivoting".
 //
-// Method. Whole index sets are guessed and exchanged at once: semismooth Newton steps on the
-// natural map H(x) = x - clamp(x - w, lo', hi') (block principal pivoting, Kostreva /
-// Judice-Pires, when every step is full). Each row is clamped (w_i = 0), held at lo or hi, or
-// fixed; a friction row at a bound is the linear equation x_t = mu_t s_j x_j coupling it to its
-// normal j (s_j the normal's sign), so findex is exact, and friction rows whose normal is held at
-// 0 are fixed at 0. One step solves those equations.
+// Method. Whole index sets are guessed and exchanged at once: semismooth Newton steps on
+// H(x) = x - clamp(x - w, lo', hi') (block principal pivoting, Kostreva / Judice-Pires, when
+// every step is full). Each row is clamped (w_i = 0), held at lo or hi, or fixed; a friction row
+// at a bound is the equation x_t = mu_t s_j x_j on its normal j (findex exact), and friction rows
+// whose normal is held at 0 are fixed at 0. One step solves those equations.
 //
-// Steps. First the steps are full: the next sets change only rows violated beyond 0.01 tolerance
-// (1 + |b|) (setsAt), so that degenerate rows do not flip on rounding. A full step that brings no
-// new lowest merit ||H||^2 but is below the step before is free (up to Limits::descentSteps per
-// run: from a guess that is itself the best point so far, Bullet's full steps often descend for
-// several steps, residual 5e-2 -> 1e-2 -> 2e-3 -> ..., before beating it); a full step whose sets
-// are those of two steps before (a 2-cycle, which would repeat that step's x) ends the full steps
-// at once (Limits::breakCycles). When 3 other full steps in a row bring no new lowest merit (or a
-// block is singular), the run goes back to the best point and continues damped: sets from the
-// natural map at x, a proximal term rho (x_C - x_C,prev) on the clamped rows (rho = 1e-2
-// max|A_ii| min(1, ||H||): coplanar contacts make clamped blocks nearly singular, and far from
-// the answer their exact equations throw the null-space part far away), and the step shortened
-// by backtracking until ||H||^2 decreases (Armijo); at a kink where no step length descends the
-// full step is taken up to 2 times in a row. A run ends when the residual (residual.hpp) is within
-// Options::tolerance (then x is projected onto the bounds when that keeps it within tolerance),
-// or after maxSteps, no descent, a singular damped block or the time budget, with the best
-// iterate (the start included).
+// Steps. Full steps first: the next sets change only rows violated beyond 0.01 tolerance
+// (1 + |b|) (setsAt), so degenerate rows do not flip on rounding. A full step without a new lowest
+// merit ||H||^2 that descends from the step before is free (pivotingDescentSteps per run); a
+// 2-cycle of sets ends the full steps at once (pivotingBreakCycles); 3 other full steps without a
+// new best (or a singular block) go back to the best point and continue damped: a proximal term
+// rho (x_C - x_C,prev), rho = 1e-2 max |A_ii| min(1, ||H||), and Armijo backtracking on ||H||^2.
+// First sets: cold, every row clamped; warm, from the natural map at the guess, or with atGuess
+// from where the guess lies (a row within 1e-6 of a bound held there).
 //
-// First sets. Cold (x = 0): every row clamped. Warm: from the natural map at the guess, or, with
-// atGuess (newton's phase, whose guess is its damped steps' best iterate), from where the guess
-// lies: a row within 1e-6 of a bound held there, the others clamped. An engine hands a sliding
-// friction row's last answer back rotated onto the new friction direction, so its relative change
-// is of the order of the rotation squared.
-//
-// Linear algebra. A_CC + rho I is factored by an up-looking sparse LDL^T (SymmetricPatternLu,
-// linalg/symmetric_pattern_lu.hpp) in a fill-reducing AMD order of the whole A, computed once per
-// pattern of A and inherited by every clamped block. Sliding rows (at a bound, normal clamped) are
-// substituted, which makes K = B + U E^T nonsymmetric (B = A_CC + rho I; U's column c_t A_{C,t}
-// per sliding row t, E's the unit vector of t's normal); up to Limits::woodburyRows of them are
-// bordered onto B's factor (Woodbury: a k x k capacitance S = I + E^T B^-1 U from sparse forward
-// solves, whose reach in the elimination tree is short), more are factored as K = L D U without
-// pivoting (K keeps A_CC's pattern: a contact's friction and normal rows touch the same bodies;
-// a K outside that pattern falls back to Eigen's SparseLU). A later step whose sets differ from
-// the last factored ones by at most Limits::updateRows rows (joined, left, sliding), with the same
-// rho, reuses that factor: the joined rows are bordered on, a left row's x is held at 0 by a
-// multiplier that frees its equation, and the p x p Schur complement of the border is factored
-// densely. One step of iterative refinement follows. Why not KLU (newton's reduced system): the
-// full steps run at rho = 0, where the coplanar contacts' clamped blocks are singular up to cfm;
-// the LDL^T's pivot tolerance reports such a block at once (the run then goes damped), and the
-// bordered updates make most full steps near the answer a few sparse forward solves.
+// Linear algebra. A_CC + rho I is factored by an up-looking sparse LDL^T
+// (linalg/symmetric_pattern_lu.hpp) in an AMD order of the whole A, computed once per pattern.
+// Sliding rows (at a bound, normal clamped) make K = B + U E^T nonsymmetric: up to
+// pivotingWoodburyRows of them are bordered onto B's factor (Woodbury, capacitance from sparse
+// forward solves), more factor K = L D U without pivoting (Eigen's SparseLU when K leaves A_CC's
+// pattern). A step whose sets differ from the last factored ones by at most pivotingUpdateRows
+// rows, at the same rho, borders the changes onto that factor (a p x p dense Schur complement).
+// One step of iterative refinement follows. Why an LDL^T with a pivot tolerance: full steps run
+// at rho = 0, where coplanar contacts' clamped blocks are singular up to cfm, and it reports such
+// a block at once.
 //
 // Body space. With the rows (setRows; A = J W J^T + diag(cfm)), a step whose every cfm_c + rho is
-// at least Limits::bodyMinDiagonal max |A_ii| is solved by Woodbury in body space instead
-// (linalg/body_space.hpp, the factor newton's damped steps use), with two steps of refinement
-// against the true K; with every cfm > 0 the products with A go through the rows too.
+// at least kBodyMinDiagonal max |A_ii| (thresholds.hpp) is solved in body space
+// (linalg/body_space.hpp), with two steps of refinement against the true K.
+//
+// Invariants and cost. A run ends settled (residual within Options::tolerance; x then projected
+// onto the bounds when that stays within it) or with the best iterate, the start included, after
+// maxSteps, no descent, a singular damped block or the time budget. A step costs one assembly of
+// K and a factorization, or a few sparse forward solves when the factor is reused.
 #pragma once
 
 #include <Eigen/SparseLU>
@@ -65,6 +48,7 @@
 #include "linalg/symmetry.hpp"
 #include "mlcp/problem.hpp"
 #include "mlcp/result.hpp"
+#include "mlcp/solvers/newton.hpp"
 #include "mlcp/thresholds.hpp"
 
 namespace mlcp {
@@ -95,31 +79,34 @@ class BlockPivoting {
     std::string message;
   };
 
-  // Runs from x (all zero: the cold guess "every row clamped"; atGuess: "First sets" above);
+  // Runs from x (all zero: the cold guess "every row clamped"; atGuess: "Steps" above);
   // leaves in x the solution when settled, else the best iterate by residual (the start
   // included). A must be symmetric (checked unless symmetryKnown: the caller has checked it).
   Report run(const Problem& problem, Vector& x, const Options& options, int maxSteps,
              bool atGuess = false, bool symmetryKnown = false);
 
-  // Most sliding rows handled by Woodbury on the symmetric factor (more: the LU), and most
-  // unknowns by which a step's sets may differ from the last factored ones (joined, left and
-  // sliding rows) for the step to reuse that factor; descentSteps and breakCycles: "Steps" above;
-  // bodyMinDiagonal: "Body space" above. NewtonParams documents the first four.
-  struct Limits {
-    int woodburyRows = 16;
-    int updateRows = 40;
-    int descentSteps = 8;
-    bool breakCycles = true;
-    double bodyMinDiagonal = 1e-11;
-  };
-  void setLimits(const Limits& limits) { limits_ = limits; }
+  // The block steps' limits (mlcp/solvers/newton.hpp, PivotingLimits; NewtonParams passes its
+  // own).
+  void setLimits(const PivotingLimits& limits) { limits_ = limits; }
 
  private:
   enum class Set : unsigned char { Clamped, AtLo, AtHi, Fixed };
   using ColMajor = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 
+  struct RunState;
+  // run()'s stages: the preparation, the first sets (guess), each step's sets, its linear solve
+  // (solveClamped), and the full or damped step's bookkeeping.
+  bool prepare(const Problem& pb, const Options& opt, bool symmetryKnown);
   void guess(const Problem& pb, const Vector& x0, const Vector& w0, bool cold,
              bool atGuess = false);
+  void nextSets(const Problem& pb, Vector& x, RunState& st);
+  void toDamped(const Problem& pb, Vector& x, RunState& st);
+  void fullStep(const Problem& pb, Vector& x, RunState& st);
+  bool dampedStep(const Problem& pb, Vector& x, RunState& st);
+  void project(const Problem& pb, double tolerance, Vector& x);
+  // solveClamped's stages: the sets' unknowns, the factor, then the solve with refinement.
+  void gatherSets(const Problem& pb, Vector& x);
+  bool factorClamped(const Problem& pb, double rho, std::string& why);
   bool solveClamped(const Problem& pb, Vector& x, const Vector& prev, double rho, std::string& why);
   bool factorCoupled(double rho, bool coupled, std::string& why);
   void applySolve(Vector& y);
@@ -145,7 +132,7 @@ class BlockPivoting {
   std::vector<Set> set_, setPrev1_, setPrev2_;
   std::vector<int> pos_, order_, sliding_;  // pos_: row -> unknown index in K, or -1
   std::vector<double> coeff_;               // sliding row t: x_t = coeff_ * x_normal
-  bool useLu_ = false;  // more than Limits::woodburyRows sliding rows: K is factored as it is
+  bool useLu_ = false;  // more than pivotingWoodburyRows sliding rows: K is factored as it is
   std::vector<Eigen::Triplet<double>> triplets_;
   // K with its sliding rows substituted: A_CC's pattern (compressed columns) with the values of
   // K and of K^T, factored by symLu_; when a sliding row touches an entry outside that pattern,
@@ -158,11 +145,13 @@ class BlockPivoting {
   Eigen::SparseLU<ColMajor, Eigen::NaturalOrdering<int>> lu_;
   bool factorGeneral(double rho, std::string& why);
   bool buildCapacitance(const Problem& pb, double rho, int maxExtra);
+  void borderColumns(double rho, int joined, int left, DenseMatrix& S);
+  void subtractSchur(int left, DenseMatrix& S);
   // Block steps reuse the factor of the last factored clamped set C0 (the base) while the sets
-  // differ from it by at most Limits::updateRows unknowns (joined, left, sliding rows) and rho is
+  // differ from it by at most pivotingUpdateRows unknowns (joined, left, sliding rows) and rho is
   // the same: a bordered system with a small dense Schur complement (buildCapacitance). Sliding
   // rows on the symmetric B = A_CC + rho I (K = B + U E^T, Woodbury) are bordered the same way.
-  Limits limits_;
+  PivotingLimits limits_;
   const RowSystem* rows_ = nullptr;
   std::unique_ptr<BodySpaceSystem> body_;
   bool rowsPrepared_ = false;      // bodyReady_ and factoredProducts_ decided for rows_

@@ -73,7 +73,7 @@ int NewtonSolver::lineSearch(const Problem& pb, double slope) {
 }
 
 // Records the current merit and sets the line search's reference to the largest of it and the
-// last NewtonParams::nonmonotoneMemory merits before it (newton.hpp "Step").
+// last NewtonParams::nonmonotoneMemory merits before it (docs/methods/newton.md, "Step").
 void NewtonSolver::setReference() {
   Work& wk = *work_;
   wk.merits.push_back(wk.at.theta);
@@ -89,8 +89,8 @@ double NewtonSolver::slope() {
   return 2 * wk.g.dot(wk.dx);
 }
 
-// One Newton step from wk.at (linearized) (newton.hpp "Step"). On success wk.trial holds the new
-// point and mu is adapted to the step length found.
+// One Newton step from wk.at (linearized) (docs/methods/newton.md, "Step"). On success wk.trial
+// holds the new point and mu is adapted to the step length found.
 bool NewtonSolver::newtonStep(const Problem& pb, double res, double rhoScale, double& mu) {
   Work& wk = *work_;
   const bool sparse = wk.system.isSparse();
@@ -115,8 +115,8 @@ bool NewtonSolver::newtonStep(const Problem& pb, double res, double rhoScale, do
   return false;
 }
 
-// The fallback when no Newton step descends (newton.hpp "Fallback"). Returns false when it does
-// not move x.
+// The fallback when no Newton step descends (docs/methods/newton.md, "Fallback"). Returns false
+// when it does not move x.
 bool NewtonSolver::fallbackStep(const Problem& pb, bool sweeps) {
   Work& wk = *work_;
   if (sweeps) {
@@ -133,8 +133,9 @@ bool NewtonSolver::fallbackStep(const Problem& pb, bool sweeps) {
   return lineSearch(pb, -2 * gg * gg / jgjg) >= 0;
 }
 
-// The start (newton.hpp "Starts"), where sweeps apply: from zero coldSweeps sweeps; a warm start
-// whose scaled residual exceeds warmSweepsResidual warmSweeps sweeps; otherwise x as given.
+// The start (docs/methods/newton.md, "Starts"), where sweeps apply: from zero coldSweeps sweeps; a
+// warm start whose scaled residual exceeds warmSweepsResidual warmSweeps sweeps; otherwise x as
+// given.
 void NewtonSolver::start(const Problem& pb, Vector& x, bool sweeps) {
   if (!sweeps) return;
   const bool cold = x.isZero(0.0);
@@ -220,7 +221,7 @@ void NewtonSolver::run(const Problem& pb, Vector& x, Result& result) {
   result.message = os.str();
 }
 
-// The pivoting phase (newton.hpp "Pivoting phase"): block principal pivoting from x, the damped
+// The pivoting phase (newton.hpp, "Pivoting phase"): block principal pivoting from x, the damped
 // steps' best iterate, with its first index sets from where x lies. x and result take its answer
 // when it settles, else its best iterate (never worse than x: its start counts as an iterate).
 void NewtonSolver::pivotingPhase(const Problem& pb, Vector& x, Result& result, std::ostream& os) {
@@ -230,8 +231,7 @@ void NewtonSolver::pivotingPhase(const Problem& pb, Vector& x, Result& result, s
   const int steps = body ? params_.bodyPivotingSteps : params_.pivotingSteps;
   if (steps <= 0 || !wk.system.isSparse() || !wk.system.symmetric() || outOfTime()) return;
   wk.pivoting.setRows(body ? rows : nullptr);
-  wk.pivoting.setLimits({params_.pivotingWoodburyRows, params_.pivotingUpdateRows,
-                         params_.pivotingDescentSteps, params_.pivotingBreakCycles});
+  wk.pivoting.setLimits(params_);
   const detail::BlockPivoting::Report rep = wk.pivoting.run(pb, x, options(), steps, true, true);
   pivotingSteps_ = rep.steps;
   result.iterations += rep.steps;

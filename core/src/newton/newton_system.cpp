@@ -138,7 +138,7 @@ bool NewtonSystem::factorDense(double rho) {
   return true;
 }
 
-// The reduced system on the free rows C (newton.hpp "Linear algebra"): row i of K holds A_ij for
+// The reduced system on the free rows C (newton.hpp, "Linear algebra"): row i of K holds A_ij for
 // free j and A_it c_t at the normal j = findex[t] of each bound friction row t whose normal is
 // free (c_t = -cf_t), plus rho on the diagonal; columns sorted, duplicates summed.
 bool NewtonSystem::factorSparse(double rho) {

@@ -1,5 +1,6 @@
-// The generalized Jacobian of the natural map and its linear solves for NewtonSolver (see
-// "Jacobian" and "Linear algebra" in mlcp/solvers/newton.hpp). Internal to the library.
+// The generalized Jacobian of the natural map and its linear solves for NewtonSolver
+// (docs/methods/newton.md, "Jacobian" and "Linear algebra"; mlcp/solvers/newton.hpp). Internal
+// to the library.
 #pragma once
 
 #include <memory>

@@ -1,9 +1,9 @@
 // core/src/projection/row_pack.hpp (internal): RowPgs' packed rows and body velocities, and the
-// passes over them (rows.hpp's three stages): the packing pass as a template over the row
-// source, so that solve(RowSystem) and the engine entry point (rows.cpp) share one packing code
-// with each source's row() inlined into the loop; the sweep and check bodies are in
-// row_sweep.hpp. Each pass runs as compiled for the baseline or, where cpuPath() says so, its
-// AVX2 variant (cpu_dispatch.hpp): the same source, the same bits.
+// passes over them (the three stages of mlcp/solvers/row_pgs.hpp): the packing pass as a template
+// over the row source, so that solve(RowSystem) and the engine entry point (row_pgs.cpp) share
+// one packing code with each source's row() inlined into the loop; the sweep and check bodies
+// are in row_sweep.hpp. Each pass runs as compiled for the baseline or, where cpuPath() says so,
+// its AVX2 variant (cpu_dispatch.hpp): the same source, the same bits.
 #pragma once
 
 #include <algorithm>
@@ -142,7 +142,7 @@ struct RunCursor {
 
 // Row i joins the current run or starts one; p takes its slots. "The world" (-1) becomes a
 // zero-velocity slot (its J meets v = 0, its M^-1 J^T is 0); ground rows take the world slots in
-// turn (per run): one shared slot would chain them all through its store and load (rows.hpp).
+// turn (per run): one shared slot would chain them all through its store and load (row_pgs.hpp).
 // (lastA starts at -2: no body, no world: row 0 starts a run.)
 template <class PackedRow>
 [[gnu::always_inline]] inline void joinRun(PackedRow* packed, PackedRow& p, int i,
@@ -245,6 +245,26 @@ template <class PackedRow>
   }
 }
 
+// The packed row written a few rows ahead, fetched for writing: after the engine's own setup
+// the packed rows are mostly out of L2, and ~30 stores a row waiting on their lines would fill
+// the store buffer.
+template <class PackedRow>
+[[gnu::always_inline]] inline void fetchForWrite(const PackedRow* ahead) {
+  const char* bytes = reinterpret_cast<const char*>(ahead);
+  for (int line = 0; line < static_cast<int>(sizeof(PackedRow)); line += 64)
+    __builtin_prefetch(bytes + line, 1);
+}
+
+// base_ += M^-1 J^T (base - start) of a row (extra = base - start); the start's velocities are
+// added after the pass (an engine's base is mostly its start: no second 12-wide update per row).
+[[gnu::always_inline]] inline void addBase(double* ba, double* bb, const double* mA,
+                                           const double* mB, double extra) {
+  for (int k = 0; k < 6; ++k) {
+    ba[k] += mA[k] * extra;
+    bb[k] += mB[k] * extra;
+  }
+}
+
 }  // namespace pack
 
 inline void RowPgs::Packing::beginPack(int n, int world, bool withBase) {
@@ -301,14 +321,7 @@ template <class RowAt>
         ((r.bodyA < 0 || r.bodyB < 0) && !detail::jacobiansFinite(jA, jB)))
       return stop(i, std::nan(""));
     PackedRow& p = packed[i];
-    // The packed rows written a few rows ahead are fetched for writing: after the engine's own
-    // setup they are mostly out of L2, and ~30 stores a row waiting on their lines would fill
-    // the store buffer.
-    if (i + kPackAhead < n) {
-      const char* ahead = reinterpret_cast<const char*>(&packed[i + kPackAhead]);
-      for (int line = 0; line < static_cast<int>(sizeof(PackedRow)); line += 64)
-        __builtin_prefetch(ahead + line, 1);
-    }
+    if (i + kPackAhead < n) pack::fetchForWrite(&packed[i + kPackAhead]);
     p.findex = r.findex;
     // Each row's findex again in a compact array, for the check that a friction row's normal
     // row has none: reading it from the normal's packed row (thousands of rows back, out of L1)
@@ -341,17 +354,8 @@ template <class RowAt>
     const double xi = warm ? r.start : 0.0;
     if (xOut) xOut[i] = xi;
     if (xi != 0) pack::addStart(velocity[run.runA].v.data(), velocity[run.runB].v.data(), mJ, xi);
-    // base_ holds M^-1 J^T (base - start) here; the start's velocities are added after the
-    // pass (an engine's base is mostly its start: no second 12-wide update per row).
-    if (withBase && r.base != xi) {
-      const double extra = r.base - xi;
-      double* ba = base[run.runA].v.data();
-      double* bb = base[run.runB].v.data();
-      for (int k = 0; k < 6; ++k) {
-        ba[k] += mA[k] * extra;
-        bb[k] += mB[k] * extra;
-      }
-    }
+    if (withBase && r.base != xi)
+      pack::addBase(base[run.runA].v.data(), base[run.runB].v.data(), mA, mB, r.base - xi);
   }
   return endPack(n, world, later, withBase);
 }

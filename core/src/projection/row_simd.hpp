@@ -32,8 +32,9 @@ using D4 = double __attribute__((vector_size(32)));
 [[gnu::always_inline]] inline void store2(double* p, D2 v) { std::memcpy(p, &v, sizeof v); }
 
 // A 6-vector in registers: entries 0-3 and 4-5 (Wide, for the AVX2 variants), or three pairs
-// (the baseline: GCC compiles 4-wide generic vectors without AVX through the stack, which made
-// the baseline sweeps 1.6x slower). Every function below does the same operations on both.
+// (the baseline: GCC compiles 4-wide generic vectors without AVX through the stack;
+// docs/decisions.md, "RowPgs: packing, sweeps and check"). Every function below does the same
+// operations on both.
 template <bool Wide>
 struct Six;
 template <>

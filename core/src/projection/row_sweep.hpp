@@ -1,8 +1,9 @@
-// core/src/projection/row_sweep.hpp (internal): the bodies of RowPgs' sweep and check (rows.hpp),
-// always inlined into the functions that run them: rows.cpp's baseline sweepOnce and
-// packedAccuracy, and rows_avx2.cpp's AVX2 variants (cpu_dispatch.hpp). Each of the two files holds
-// one copy: two copies of the unrolled sweep in one file made GCC stop inlining Eigen's 6-vector
-// operations into them (its unit growth limit), which the sweep's speed depends on.
+// core/src/projection/row_sweep.hpp (internal): the bodies of RowPgs' sweep and check
+// (mlcp/solvers/row_pgs.hpp), always inlined into the functions that run them: row_pgs.cpp's
+// baseline sweepOnce and packedAccuracy, and row_pgs_avx2.cpp's AVX2 variants (cpu_dispatch.hpp).
+// Each of the two files holds one copy: two copies of the unrolled sweep in one file made GCC stop
+// inlining Eigen's 6-vector operations into them (its unit growth limit), which the sweep's speed
+// depends on.
 #pragma once
 
 #include <algorithm>
@@ -19,7 +20,7 @@ namespace mlcp {
 template <bool Wide>
 [[gnu::always_inline]] inline Accuracy RowPgs::Packing::checkRows(const Vector& x,
                                                                   double bNorm) const {
-  // step_i w_i = (1 - keep) x_i + shift + sA va + sB vb, the sweep's own terms (rows.hpp),
+  // step_i w_i = (1 - keep) x_i + shift + sA va + sB vb, the sweep's own terms (row_pack.hpp),
   // scaled back by scale_i = 1 / step_i; the bounds with findex applied at x. In blocks of rows
   // that stay in L1 (w in a small buffer, the rows read twice): one loop for both spilled the
   // accumulators to the stack and chained every row through a store and a load (perf).

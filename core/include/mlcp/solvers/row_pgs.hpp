@@ -15,52 +15,34 @@ namespace mlcp {
 //
 // A solve runs three stages over buffers kept between solves (no allocation once they have
 // grown), each one pass over the rows:
-//  1. pack: each row becomes a packed row (core/src/projection/row_pack.hpp) holding step J, M^-1
-//  J^T and the constants of
-//     its update. The pass is also the validation: each row is checked by the one-pass rule of
-//     RowSystem::validate as it is packed (the bodies and array sizes before), and only a row
-//     that fails calls validate() itself to say what is wrong; the caller's x is untouched until
-//     every row has passed. Engines that hold their rows in their own form pack them straight
-//     from there (solve with a RowSource: no RowSystem copy in between; same packing, same
-//     validation).
+//  1. pack: each row becomes a packed row (core/src/projection/row_pack.hpp) holding step J,
+//     M^-1 J^T and the constants of its update. The pass is also the validation, by the one-pass
+//     rule of RowSystem::validate; only a row that fails calls validate() to say what is wrong,
+//     and the caller's x is untouched until every row has passed. Engines pack straight from
+//     their own rows (solve with a RowSource: no RowSystem copy; same packing, same validation).
 //  2. sweep: up to Options::maxIterations sweeps over the packed rows in row order (fewer when a
 //     check meets Options::tolerance).
-//  3. check: every Options::checkEvery sweeps, the natural-map residual of residual.hpp at the
-//     current x, with w = J v + cfm x + b taken from the velocities the sweeps maintain (v changes
-//     by M^-1 J_i^T dx_i with every change dx_i of x, so w = A x + b up to round-off). It reads
-//     the packed rows only: step_i w_i = (1 - keep) x_i + shift + sA v, scaled back by 1 / step,
-//     so no second pass over the engine's rows rebuilds v (tests compare it with accuracy() on
-//     the assembled problem). It runs in blocks of 64 rows: w of the block into an L1 buffer,
-//     then the block through AccuracyAccumulator (the per-row rule of accuracy(); bounds and
-//     findex read from the packed rows, so the engine path keeps no copies of them). Two short
-//     loops rather than one: a single loop holds too many accumulators and spills them to the
-//     stack, chaining every row through a store and a load.
+//  3. check: every Options::checkEvery sweeps, the natural-map residual of residual.hpp at x,
+//     with w = J v + cfm x + b from the velocities the sweeps maintain (w = A x + b up to
+//     round-off), read from the packed rows only, in blocks of 64 rows through
+//     AccuracyAccumulator (the per-row rule of accuracy()).
 //
-// Cost: O(rows) to pack (a division, M^-1 J^T and the couplings: a row costs several sweeps of
-// it), O(rows) per sweep, O(rows) per check; memory 240 bytes a packed row (plus its check
-// scale and couplings) and one cache line a body. The sweep is bound by the latency chain through
-// the velocities of bodies shared by consecutive rows (load v, dot, clamp, update v, store), not by
-// memory bandwidth, and four things keep that chain short:
-//  - ground rows take kWorldSlots zero-velocity world slots in turn (one shared slot would chain
-//    every ground row through its store and load);
+// Cost: O(rows) to pack (a row costs several sweeps of it), O(rows) per sweep and per check;
+// memory 240 bytes a packed row (plus its check scale and couplings) and one cache line a body.
+// The sweep is bound by the latency chain through the velocities of bodies shared by
+// consecutive rows (load v, dot, clamp, update v, store), and four things keep it short:
+//  - ground rows take kWorldSlots zero-velocity world slots in turn;
 //  - a run of up to kMaxRun consecutive rows on the same two bodies (a manifold's normals, its
-//    friction rows; a contact's rows in ODE's order) is swept through its couplings: row i's
-//    step J_i v is step J_i v_start + sum over the run's earlier rows k of c_ik dx_k, with
-//    c_ik = step_i J_i M^-1 J_k^T computed when packing, so a row waits for the last one only
-//    through a multiply-add, and v takes the run's changes at its end;
+//    friction rows) is swept through its couplings c_ik = step_i J_i M^-1 J_k^T, computed when
+//    packing, so a row waits for the last one only through a multiply-add;
 //  - the run's loop is unrolled per length, so its changes stay in registers;
-//  - the update is regrouped so that only the product with v sits on the chain, and the change
-//    that moves v is clamped on its own (the packed row's update).
-// The packing, sweeps and check are compiled for the baseline and for AVX2 and chosen at run
-// time (mlcp/cpu.hpp); the 12-wide products are written in the order of Eigen's Vector6
-// expressions (core/src/projection/row_simd.hpp), so both variants, solve(RowSystem) and the engine
-// entry point give the same iterates bit for bit.
-//
-// The first sweep is not fused into the packing: with a warm start, row i's first update needs
-// v = M^-1 J^T x_start over all rows, later ones included, which exists only after the pass.
-// The step is divided here rather than taken from an engine's own 1 / A_ii (Bullet's
-// m_jacDiagABInv): an engine's number is another rounding of A_ii, lacks our friction CFM, and
-// the RowSystem path has no such number.
+//  - the update is regrouped so that only the product with v sits on the chain.
+// Invariant: packing, sweeps and check are compiled for the baseline and for AVX2 and chosen at
+// run time (mlcp/cpu.hpp); the 12-wide products keep the order of Eigen's Vector6 expressions
+// (core/src/projection/row_simd.hpp), so both variants, solve(RowSystem) and the engine entry
+// point give the same iterates bit for bit. The step is omega / A_ii from our own A_ii, not an
+// engine's 1 / A_ii. Alternatives not taken: docs/decisions.md, "RowPgs: packing, sweeps and
+// check".
 class RowPgs {
  public:
   Options& options() { return options_; }
