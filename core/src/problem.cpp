@@ -157,8 +157,10 @@ bool certainlyValid(const Problem& p) {
   if (rows != n || cols != n || p.lo.size() != n || p.hi.size() != n) return false;
   if (!p.findex.empty() && static_cast<Eigen::Index>(p.findex.size()) != n) return false;
   bool ok = true;
-  for (Eigen::Index i = 0; i < n; ++i)  // lo <= hi is false for a NaN bound
-    ok &= std::isfinite(p.b[i]) & (p.lo[i] <= p.hi[i]) & (p.lo[i] < kInf) & (p.hi[i] > -kInf);
+  // Bitwise & on ints (no branch per term); lo <= hi is false for a NaN bound.
+  for (Eigen::Index i = 0; i < n; ++i)
+    ok &= static_cast<bool>(int{std::isfinite(p.b[i])} & int{p.lo[i] <= p.hi[i]} &
+                            int{p.lo[i] < kInf} & int{p.hi[i] > -kInf});
   const std::vector<int>& fx = p.findex;
   for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(fx.size()); ++i) {
     const int f = fx[i];
