@@ -70,6 +70,12 @@ constexpr const char* kStartChoice = "start";
 // body's velocity by about the errors of the rows on it (a landing ragdoll: 1-2x); an answer
 // along nearly dependent rows, exact to 1e-7, by thousands of times. Dimensionless.
 constexpr double kSpeedFactor = 10;
+// Stage 0's bound on a start: it is dropped when it changes some body's linear velocity by more
+// than this multiple of ||b||_inf. A step's answer changes velocities by up to ~10 ||b|| where
+// the rows are unsettled (ODE's 10-box stack at QuickStep's 7 sweeps: a start above 10x, rightly
+// kept); last step's impulses along nearly dependent rows matched to rows that moved, by 1e5 and
+// more (Bullet's ragdolls: 9e6 m/s against ||b|| = 21). Dimensionless.
+constexpr double kStartSpeedFactor = 1000;
 // Stage 5's bound: a judged answer is applied when its impulse energy is at most this multiple
 // of pgs's (keepSafe), 2x in speed: "no worse than the engine's own method at its cost". 100
 // (10x in speed) let an unsettled answer on Bullet's Bridge through that threw the planks in
@@ -457,10 +463,16 @@ void RowSolver::Impl::continueWithNewton(const RowSystem& rows, Vector& x, Slot&
   out.choice = "newton";
 }
 
+const Vector& RowSolver::Impl::saneStart(const RowSystem& rows, const Vector& start) {
+  if (!throwsBodies(rows, start, kStartSpeedFactor)) return start;
+  coldStart_.setZero(rows.size());
+  return coldStart_;
+}
+
 // Stage 5's trigger for acceptable answers (kSpeedFactor).
-bool RowSolver::Impl::throwsBodies(const RowSystem& rows, const Vector& x) {
+bool RowSolver::Impl::throwsBodies(const RowSystem& rows, const Vector& x, double factor) {
   if (x.size() != rows.size()) return false;
-  const double limit = kSpeedFactor * rows.b.lpNorm<Eigen::Infinity>();
+  const double limit = factor * rows.b.lpNorm<Eigen::Infinity>();
   for (const Vector6& v : rows.bodyVelocities(x))
     if (v.head<3>().squaredNorm() > limit * limit) return true;
   return false;
@@ -505,7 +517,7 @@ void RowSolver::Impl::keepSafe(const RowSystem& rows, const Vector& start, Vecto
       out.energyGuard = true;
     }
   }
-  if (throwsBodies(rows, x)) holdStill(rows, start, x, out, r);
+  if (throwsBodies(rows, x, kSpeedFactor)) holdStill(rows, start, x, out, r);
 }
 
 // Stage 5's last resort: the applied answer, pgs's included, still changes a body's velocity by
@@ -515,7 +527,7 @@ void RowSolver::Impl::keepSafe(const RowSystem& rows, const Vector& start, Vecto
 void RowSolver::Impl::holdStill(const RowSystem& rows, const Vector& start, Vector& x,
                                 IslandSolve& out, Result& r) {
   const bool useStart =
-      start.size() == rows.size() && start.allFinite() && !throwsBodies(rows, start);
+      start.size() == rows.size() && start.allFinite() && !throwsBodies(rows, start, kSpeedFactor);
   x = useStart ? start : Vector::Zero(rows.size());
   r.status = Status::Failed;
   r.message += std::string("; every answer throws a body (pgs's too): ") +
@@ -625,6 +637,7 @@ IslandSolve RowSolver::Impl::solveScreened(const RowSystem& rows, const Vector& 
   primaryWasFallback_ = false;
   coneNote_.clear();
   if (rows.size() == 0) return noRows(x);
+  const Vector& from = saneStart(rows, start);
   IslandSolve out;
   out.problemClass = classify(rows);
   Plan plan;
@@ -634,20 +647,20 @@ IslandSolve RowSolver::Impl::solveScreened(const RowSystem& rows, const Vector& 
   // The cone is tried on every solve: the demotion to pgs is the box's rule (the cone is a model
   // the caller asked for, and pgs cannot take its LCP).
   const bool cone = settings_.friction == FrictionModel::Cone &&
-                    out.problemClass == ProblemClass::Findex && buildCone(rows, start, out);
+                    out.problemClass == ProblemClass::Findex && buildCone(rows, from, out);
   if (!capturePrefix_.empty()) cone ? capture(cone_.problem()) : capture(rows);
 
   Result r;
   if (cone) {
-    r = solveCone(start, x, island, out, plan.share, t0);
+    r = solveCone(from, x, island, out, plan.share, t0);
   } else {
     if (autoChoice)
-      chooseForAuto(rows, start, island, out, plan);
+      chooseForAuto(rows, from, island, out, plan);
     else
       out.requested = settings_.solver;
-    r = solvePrimary(rows, start, x, island, out, plan, t0);
+    r = solvePrimary(rows, from, x, island, out, plan, t0);
   }
-  if (r.status == Status::InvalidInput || r.status == Status::Unsupported) x = start;
+  if (r.status == Status::InvalidInput || r.status == Status::Unsupported) x = from;
   out.choice = plan.fromStart ? kStartChoice : out.requested;
   if (autoChoice && !cone && !plan.fromStart && out.problemClass == ProblemClass::Findex &&
       equals(out.requested, "dantzig") && !acceptable(r, settings_.acceptResidual))
@@ -655,11 +668,12 @@ IslandSolve RowSolver::Impl::solveScreened(const RowSystem& rows, const Vector& 
   if (autoChoice && !cone) remember(island, out, r, plan);
   // Stages 4 and 5.
   if (!acceptable(r, settings_.acceptResidual))
-    r = fallBack(rows, start, x, island, out, std::move(r), plan.share, t0);
-  else if (!plan.fromStart && !equals(out.choice, "pgs") && throwsBodies(rows, x))
-    keepSafe(rows, start, x, island, out, r, nullptr, plan.share, t0);
+    r = fallBack(rows, from, x, island, out, std::move(r), plan.share, t0);
+  else if (!plan.fromStart && !equals(out.choice, "pgs") && throwsBodies(rows, x, kSpeedFactor))
+    keepSafe(rows, from, x, island, out, r, nullptr, plan.share, t0);
   out.accepted = acceptable(r, settings_.acceptResidual);
   if (!coneNote_.empty()) r.message = coneNote_ + r.message;
+  if (&from != &start) r.message = "start discarded (it throws a body): solved cold; " + r.message;
   r.solver = out.choice;
   r.fallbacks = out.fellBack ? 1 : 0;
   r.seconds = nowSeconds() - t0;

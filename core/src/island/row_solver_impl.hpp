@@ -93,9 +93,15 @@ class RowSolver::Impl {
   void continueWithNewton(const RowSystem& rows, Vector& x, Slot& island, IslandSolve& out,
                           Result& r, double share, double t0);
   // Stage 5: an unacceptable answer moving the bodies far more than pgs's is replaced by pgs's.
-  // throwsBodies: an acceptable answer changes some body's linear velocity by more than 10
-  // ||b||_inf (then keepSafe judges it too).
-  static bool throwsBodies(const RowSystem& rows, const Vector& x);
+  // throwsBodies: x changes some body's linear velocity by more than factor ||b||_inf (an
+  // acceptable answer beyond kSpeedFactor = 10 is judged by keepSafe too).
+  static bool throwsBodies(const RowSystem& rows, const Vector& x, double factor);
+  // Stage 0's start: `start`, or zeros (coldStart_) when it throws a body by 1000 ||b||_inf, far
+  // beyond any answer's 10 (kStartSpeedFactor, row_solver.cpp). A start is the last
+  // step's impulses matched to this step's rows; where last step's rows were nearly dependent
+  // they can be huge and cancel, and matched to rows that moved they no longer do (Bullet's
+  // ragdolls: a start at 9e6 m/s, pgs diverging from it, a body at 122 m/s two steps later).
+  const Vector& saneStart(const RowSystem& rows, const Vector& start);
   // Stage 5's last resort when pgs's answer throws a body too: the start, or no impulses.
   void holdStill(const RowSystem& rows, const Vector& start, Vector& x, IslandSolve& out,
                  Result& r);
@@ -132,6 +138,7 @@ class RowSolver::Impl {
   Vector xFallback_;
   RowScreen screen_;
   Vector keptStart_, keptX_;  // the kept rows' start and answer when rows were screened
+  Vector coldStart_;          // zeros: the start that replaces one that throws a body
   std::unordered_map<std::uint64_t, std::unique_ptr<Slot>> slots_;
   std::uint64_t lastKey_ = 0;  // the key of lastSlot_
   Slot* lastSlot_ = nullptr;   // the island solved last (slots_ owns it)

@@ -8,9 +8,11 @@
 //
 // The problem: an island's rows (rows.hpp), w = A x + b with A = J M^-1 J^T + diag(cfm),
 // lo <= x <= hi, friction bounds through findex (problem.hpp's canonical form). Each solve runs
-// five stages: 0. screen degenerate rows (row_screen.hpp); 1. classify the rows by bounds and
-// findex alone; 2. choose the solver (the requested name, or Policy::choose for "auto", with a
-// per-island memory that sends an island whose exact answer broke down to pgs for a while);
+// five stages: 0. screen degenerate rows (row_screen.hpp), and drop a start that would change
+// a body's velocity by more than 1000 ||b||_inf (not a warm start: solved cold); 1. classify the
+// rows by bounds and findex alone; 2. choose the solver (the requested name, or Policy::choose for
+// "auto", with a per-island memory that sends an island whose exact answer broke down to pgs for a
+// while);
 // 3. solve from the caller's start, "pgs" on the rows themselves (RowPgs), every other method
 // on A assembled once (dense up to denseAssemblyMaxRows rows); 4. verify the answer by the
 // fallback rule of policy.hpp and run the fallback when it is not acceptable; 5. apply safely:
