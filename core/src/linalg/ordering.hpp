@@ -8,8 +8,7 @@
 // pyramid the two are within 5% of each other, while on a 1000-box pyramid nested dissection
 // leaves about 0.6x of AMD's fill in the block LU of linalg/body_space.hpp (docs/benchmarks.md,
 // "Body space: the factorization of S"). Cost: AMD O(edges), nested dissection a few times
-// that (docs/benchmarks.md,
-// "Body space: S against the rows' LU, and the cost of the ordering").
+// that (docs/benchmarks.md, "Body space: S against the rows' LU, and the cost of the ordering").
 #pragma once
 
 #include <vector>
