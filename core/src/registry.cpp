@@ -6,6 +6,7 @@
 #include "mlcp/solvers/lemke.hpp"
 #include "mlcp/solvers/newton.hpp"
 #include "mlcp/solvers/pgs.hpp"
+#include "mlcp/solvers/proximal.hpp"
 
 namespace mlcp {
 
@@ -29,6 +30,10 @@ std::vector<SolverInfo>& registered() {
        "Lemke's lexicographic complementary pivoting (dense tableau, or a factored basis above "
        "50 rows); boxes, findex by fixed point",
        &make<LemkeSolver>},
+      {"proximal",
+       "proximal point on the impulses: newton on A + alpha I from the last iterate, alpha falling "
+       "with the residual; exact where A is singular (piles without CFM)",
+       &make<ProximalSolver>},
       {"ldlt", "sparse LDL^T (or LU) direct solve for problems without bounds; pattern reused",
        &make<LdltSolver>},
       {"auto", "picks a chain per problem class and size, with verified fallback",

@@ -33,6 +33,7 @@ const std::map<std::string, Declared> kExpectations = {
     {"lemke", {{"standard", "degenerate", "boxed", "linear", "friction", "seed"}, {}}},
     {"dantzig", {{"standard", "degenerate", "boxed", "linear", "friction", "seed"}, {}}},
     {"newton", {{"standard", "degenerate", "boxed", "linear", "friction", "seed"}, {}}},
+    {"proximal", {{"standard", "degenerate", "boxed", "linear", "friction", "seed"}, {}}},
     {"ldlt", {{"linear"}, {"standard", "boxed", "friction", "seed"}}},
     {"auto", {{"standard", "degenerate", "boxed", "linear", "friction", "seed"}, {}}},
 };

@@ -10,6 +10,7 @@
 #include <filesystem>
 
 #include "common/broken_solvers.hpp"
+#include "common/contact_scenes.hpp"
 #include "mlcp/io.hpp"
 #include "mlcp/residual.hpp"
 #include "mlcp/solvers/dantzig.hpp"
@@ -516,11 +517,9 @@ TEST(RowSolver, CaptureWritesEachIslandsProblem) {
   std::filesystem::remove_all(dir);
 }
 
-// Bullet's BasicDemo: on its resting pile newton's solves end short of 1e-6 and cost 20-40x SI's
-// step under the 50 ms budget alone. An island whose uncapped newton solve ended short runs its
-// next newton solves under the engine-relative cap; a factor of 1 leaves newton no time (it
-// stops before its first step), and the island then runs pgs at the engine's sweeps.
-TEST(RowSolver, BasicDemoPileMissedByNewtonRunsUnderTheEngineCostCap) {
+// A box on six copies of its four corner contacts, no cfm: 72 rows on one body, A singular as on
+// Bullet's resting piles.
+RowSystem redundantCorners() {
   RowSystem rows = boxOnGround(true);
   const RowSystem corners = rows;
   for (int copy = 1; copy < 6; ++copy)  // 72 rows on one body: redundant contacts
@@ -528,6 +527,15 @@ TEST(RowSolver, BasicDemoPileMissedByNewtonRunsUnderTheEngineCostCap) {
       addRow(rows, corners.rows[i].jA.head<3>(), corners.rows[i].jA.tail<3>(), corners.b[i],
              corners.lo[i], corners.hi[i], corners.cfm[i],
              corners.findex[i] < 0 ? -1 : corners.findex[i] + corners.size() * copy);
+  return rows;
+}
+
+// Bullet's BasicDemo: on its resting pile newton's solves end short of 1e-6 and cost 20-40x SI's
+// step under the 50 ms budget alone. An island whose uncapped newton solve ended short runs its
+// next newton solves under the engine-relative cap; a factor of 1 leaves newton no time (it
+// stops before its first step), and the island then runs pgs at the engine's sweeps.
+TEST(RowSolver, BasicDemoPileMissedByNewtonRunsUnderTheEngineCostCap) {
+  const RowSystem rows = redundantCorners();
   Vector start;
   RowSolver().solve(rows, Vector::Zero(rows.size()), start);
   start.array() += 1e-6;  // near the answer: newton's answer below is acceptable, not converged
@@ -539,6 +547,7 @@ TEST(RowSolver, BasicDemoPileMissedByNewtonRunsUnderTheEngineCostCap) {
   settings.options.maxIterations = 0;  // newton ends short at once, deterministically
   settings.newton.pivotingSteps = settings.newton.bodyPivotingSteps = 0;
   settings.engineCostFactor = 1;
+  settings.policy.singularIslandSolver = "";  // newton's answers as they end
   RowSolver solver(settings);
   solver.setEngineSweeps(10);
   Vector x;
@@ -561,6 +570,31 @@ TEST(RowSolver, BasicDemoPileMissedByNewtonRunsUnderTheEngineCostCap) {
   const IslandSolve second = uncapped.solve(rows, start, x, 7);
   EXPECT_EQ(second.requested, "newton");
   EXPECT_EQ(second.result.status, Status::MaxIterations) << second.result.message;
+}
+
+// A pile without cfm (36 boxes, A singular, the contacts' depths inconsistent where all hold):
+// newton's answer ends short of the tolerance, proximal goes on from it and ends exact, and the
+// island's next solve runs proximal first.
+TEST(RowSolver, SingularIslandMissedByNewtonIsFinishedByProximal) {
+  test::PyramidSpec spec;
+  spec.levels = 8;
+  spec.cfm = 0;
+  const RowSystem rows = test::BoxPyramid(spec).rows();
+  RowSolverSettings settings;
+  settings.timeBudget = 0;  // the same path on any machine
+  RowSolver solver(settings);
+  Vector x;
+  const IslandSolve first = solver.solve(rows, Vector::Zero(rows.size()), x, 7);
+  EXPECT_EQ(first.requested, "newton");
+  EXPECT_EQ(first.choice, "proximal") << first.result.message;
+  EXPECT_EQ(first.result.status, Status::Converged) << first.result.message;
+  EXPECT_NEAR(first.result.residual, rowResidual(rows, x), 1e-15);
+  EXPECT_LE(rowResidual(rows, x), kDefaultIslandTolerance);
+  const Vector last = x + Vector::Constant(rows.size(), 1e-6);  // the next step's start
+  const IslandSolve next = solver.solve(rows, last, x, 7);
+  EXPECT_EQ(next.requested, "proximal") << next.result.message;
+  EXPECT_EQ(next.result.status, Status::Converged) << next.result.message;
+  EXPECT_LE(rowResidual(rows, x), kDefaultIslandTolerance);
 }
 
 TEST(RowSolver, UnknownNamesAreClearErrors) {

@@ -101,7 +101,8 @@ void addSolverSettings(CLI::App& cmd, SolverSettings& s) {
                  "normal, as stock ODE and Bullet do)")
       ->check(settingCheck("friction_bounds"))
       ->capture_default_str();
-  for (const char* solver : {"newton", "dantzig", "lemke"}) addParamOption(cmd, s, solver);
+  for (const char* solver : {"newton", "dantzig", "lemke", "proximal"})
+    addParamOption(cmd, s, solver);
 }
 
 namespace {

@@ -15,6 +15,7 @@
 #include "mlcp/solvers/dantzig.hpp"
 #include "mlcp/solvers/lemke.hpp"
 #include "mlcp/solvers/newton.hpp"
+#include "mlcp/solvers/proximal.hpp"
 
 namespace mlcp::cli {
 
@@ -32,6 +33,10 @@ DantzigParams* dantzigOf(Solver& s) {
   return d ? &d->params() : nullptr;
 }
 LemkeSolver* lemkeOf(Solver& s) { return dynamic_cast<LemkeSolver*>(&s); }
+ProximalParams* proximalOf(Solver& s) {
+  auto* p = dynamic_cast<ProximalSolver*>(&s);
+  return p ? &p->params() : nullptr;
+}
 
 // The accessors of one field of the parameters `Of` finds in a solver.
 template <auto Of, auto Field>
@@ -129,6 +134,23 @@ std::vector<SolverParam> dantzigAndLemkeParams() {
   };
 }
 
+std::vector<SolverParam> proximalParams() {
+  constexpr auto X = &proximalOf;
+  using P = ProximalParams;
+  const char* s = "proximal";
+  return {
+      param<X, &P::sigma>(s, "sigma", kPositive, "alpha = sigma r^nu mean(A_ii)"),
+      param<X, &P::nu>(s, "nu", kPositive, "the residual's power in alpha"),
+      param<X, &P::alphaMin>(s, "alpha_min", kPositive, "smallest alpha / mean(A_ii)"),
+      param<X, &P::alphaMax>(s, "alpha_max", kPositive, "largest alpha / mean(A_ii)"),
+      param<X, &P::alphaGrowth>(s, "alpha_growth", kPositive,
+                                "factor on alpha after an inner solve ended short"),
+      param<X, &P::innerFactor>(s, "inner_factor", kPositive,
+                                "inner tolerance = max(tol / 10, this x residual)"),
+      param<X, &P::maxOuter>(s, "max_outer", kCount, "most outer steps"),
+  };
+}
+
 // Options' numeric fields and their accepted values (tol and max_iter as `mlcp solve` checks
 // them: the same words).
 struct SettingCheck {
@@ -190,12 +212,13 @@ const std::vector<SolverParam>& solverParams() {
   static const std::vector<SolverParam> all = [] {
     std::vector<SolverParam> v = newtonParams();
     for (const SolverParam& p : dantzigAndLemkeParams()) v.push_back(p);
+    for (const SolverParam& p : proximalParams()) v.push_back(p);
     return v;
   }();
   return all;
 }
 
-std::string paramSolverNames() { return "newton, dantzig, lemke"; }
+std::string paramSolverNames() { return "newton, dantzig, lemke, proximal"; }
 
 std::string paramList(const std::string& solver, bool kebab) {
   const std::unique_ptr<Solver> fresh = makeSolver(solver);

@@ -95,6 +95,9 @@ struct RowSolver::Impl::Slot {
   // More solves by the large-island solver under the engine-relative cap: set after an uncapped
   // one ended short of the tolerance.
   int cappedSolves = 0;
+  // More solves by the policy's singular-island solver first: set after an exact method ended
+  // short of the tolerance on the island's contact rows.
+  int singularFirst = 0;
 };
 
 namespace {
@@ -440,12 +443,11 @@ Result RowSolver::Impl::fallBack(const RowSystem& rows, const Vector& start, Vec
   return r;
 }
 
-// Stage 3's hand-over under auto: a dantzig answer on friction rows that is not acceptable
-// (its friction fixed point did not settle, or its regularised retry ended short) is continued
-// by newton from it, in what is left of the island's share: newton has the friction bounds'
-// exact Jacobian, where the fixed point re-solves with lagged bounds. The better answer stands.
-void RowSolver::Impl::continueWithNewton(const RowSystem& rows, Vector& x, Slot& island,
-                                         IslandSolve& out, Result& r, double share, double t0) {
+// Stage 3's hand-over under auto: x, r (an answer that is not good enough) continued by `name`
+// from x in what is left of the island's share. The better answer stands.
+void RowSolver::Impl::continueWith(const std::string& name, const RowSystem& rows, Vector& x,
+                                   Slot& island, IslandSolve& out, Result& r, double share,
+                                   double t0) {
   if (x.size() != rows.size() || !x.allFinite()) return;
   Options o = settings_.options;
   if (share > 0) {
@@ -453,14 +455,36 @@ void RowSolver::Impl::continueWithNewton(const RowSystem& rows, Vector& x, Slot&
     o = withBudget(o, std::max(share - (now - t0), settings_.minShare * settings_.timeBudget), now);
   }
   const Vector from = x;
-  Result n = run(rows, "newton", o, from, xFallback_, island, out);
+  Result n = run(rows, name, o, from, xFallback_, island, out);
   if (!better(n, r)) return;
   n.iterations += r.iterations;
-  n.message = "dantzig ended at " + shortNumber(r.residual) + " (" + r.message +
-              "); newton from its answer: " + n.message;
+  n.message = out.choice + " ended at " + shortNumber(r.residual) + " (" + r.message + "); " +
+              name + " from its answer: " + n.message;
   r = std::move(n);
   x.swap(xFallback_);
-  out.choice = "newton";
+  out.choice = name;
+}
+
+// A dantzig answer on friction rows that is not acceptable (its friction fixed point did not
+// settle, or its regularised retry ended short) goes on with newton, which has the friction
+// bounds' exact Jacobian where the fixed point re-solves with lagged bounds. An exact method's
+// answer still short of the tolerance on contact rows (a pile without cfm, whose A is singular)
+// goes on with the policy's singular-island solver, which then answers the island first for its
+// next solves.
+void RowSolver::Impl::continueShort(const RowSystem& rows, Vector& x, Slot& island,
+                                    IslandSolve& out, Result& r, const Plan& plan, double t0) {
+  const Policy& policy = settings_.policy;
+  const bool contacts = out.problemClass == ProblemClass::Findex ||
+                        out.problemClass == ProblemClass::Boxed ||
+                        out.problemClass == ProblemClass::StandardLcp;
+  if (plan.fromStart || !contacts) return;
+  if (out.problemClass == ProblemClass::Findex && equals(out.requested, "dantzig") &&
+      !acceptable(r, settings_.acceptResidual))
+    continueWith("newton", rows, x, island, out, r, plan.share, t0);
+  const bool exact = equals(out.requested, "dantzig") || out.requested == policy.largeIslandSolver;
+  if (!exact || policy.singularIslandSolver.empty() || r.status == Status::Converged) return;
+  continueWith(policy.singularIslandSolver, rows, x, island, out, r, plan.share, t0);
+  island.singularFirst = policy.singularIslandSolves;
 }
 
 const Vector& RowSolver::Impl::saneStart(const RowSystem& rows, const Vector& start) {
@@ -569,6 +593,13 @@ IslandSolve RowSolver::Impl::noRows(Vector& x) {
   return out;
 }
 
+// Whether the engine-relative cap bounds this primary: the large-island solver, and the
+// singular-island solver that replaces it or dantzig on islands where they end short.
+bool RowSolver::Impl::cappable(const std::string& name) const {
+  const Policy& policy = settings_.policy;
+  return name == policy.largeIslandSolver || name == policy.singularIslandSolver;
+}
+
 // Stage 2 under auto: the policy's choice, the island's pgs-first memory and the engine-relative
 // cap (which may shorten the share).
 void RowSolver::Impl::chooseForAuto(const RowSystem& rows, const Vector& start, Slot& island,
@@ -584,7 +615,12 @@ void RowSolver::Impl::chooseForAuto(const RowSystem& rows, const Vector& start, 
     out.requested = "pgs";
     plan.enginePgs = true;
   }
-  if (out.requested == policy.largeIslandSolver && island.cappedSolves > 0) {
+  if (island.singularFirst > 0 && !policy.singularIslandSolver.empty() &&
+      (equals(out.requested, "dantzig") || out.requested == policy.largeIslandSolver)) {
+    --island.singularFirst;
+    out.requested = policy.singularIslandSolver;
+  }
+  if (cappable(out.requested) && island.cappedSolves > 0) {
     const double cap = engineShare(rows, start);
     plan.capped = cap > 0;
     if (plan.capped) --island.cappedSolves;
@@ -617,8 +653,7 @@ void RowSolver::Impl::remember(Slot& island, const IslandSolve& out, const Resul
                                const Plan& plan) {
   const Policy& policy = settings_.policy;
   island.cutsInRow = r.status == Status::TimeLimit ? island.cutsInRow + 1 : 0;
-  if (!plan.capped && !plan.fromStart && out.requested == policy.largeIslandSolver &&
-      r.status != Status::Converged)
+  if (!plan.capped && !plan.fromStart && cappable(out.requested) && r.status != Status::Converged)
     island.cappedSolves = policy.pgsAfterBreakdown;
   if (plan.capped && r.status == Status::TimeLimit && r.iterations == 0)
     island.pgsFirst = policy.pgsAfterBreakdown;
@@ -662,9 +697,7 @@ IslandSolve RowSolver::Impl::solveScreened(const RowSystem& rows, const Vector& 
   }
   if (r.status == Status::InvalidInput || r.status == Status::Unsupported) x = from;
   out.choice = plan.fromStart ? kStartChoice : out.requested;
-  if (autoChoice && !cone && !plan.fromStart && out.problemClass == ProblemClass::Findex &&
-      equals(out.requested, "dantzig") && !acceptable(r, settings_.acceptResidual))
-    continueWithNewton(rows, x, island, out, r, plan.share, t0);
+  if (autoChoice && !cone) continueShort(rows, x, island, out, r, plan, t0);
   if (autoChoice && !cone) remember(island, out, r, plan);
   // Stages 4 and 5.
   if (!acceptable(r, settings_.acceptResidual))

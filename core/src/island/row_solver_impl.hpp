@@ -78,6 +78,7 @@ class RowSolver::Impl {
                      Plan& plan);
   Result solvePrimary(const RowSystem& rows, const Vector& start, Vector& x, Slot& island,
                       IslandSolve& out, Plan& plan, double t0);
+  bool cappable(const std::string& name) const;
   void remember(Slot& island, const IslandSolve& out, const Result& r, const Plan& plan);
   // Stages 1-4 on rows that passed the screen.
   IslandSolve solveScreened(const RowSystem& rows, const Vector& start, Vector& x,
@@ -89,9 +90,15 @@ class RowSolver::Impl {
              const Vector& start, Vector& x, Slot& island, IslandSolve& report);
   Result fallBack(const RowSystem& rows, const Vector& start, Vector& x, Slot& island,
                   IslandSolve& out, Result r, double share, double t0);
-  // Stage 3 under auto: an unacceptable dantzig answer on friction rows continued by newton.
-  void continueWithNewton(const RowSystem& rows, Vector& x, Slot& island, IslandSolve& out,
-                          Result& r, double share, double t0);
+  // Stage 3 under auto: an answer continued by `name` from it, in what is left of the share; the
+  // better answer stands.
+  void continueWith(const std::string& name, const RowSystem& rows, Vector& x, Slot& island,
+                    IslandSolve& out, Result& r, double share, double t0);
+  // Stage 3 under auto after the primary: dantzig's unacceptable answer on friction rows
+  // continued by newton, and an exact primary's answer short of the tolerance by the policy's
+  // singular-island solver.
+  void continueShort(const RowSystem& rows, Vector& x, Slot& island, IslandSolve& out, Result& r,
+                     const Plan& plan, double t0);
   // Stage 5: an unacceptable answer moving the bodies far more than pgs's is replaced by pgs's.
   // throwsBodies: x changes some body's linear velocity by more than factor ||b||_inf (an
   // acceptable answer beyond kSpeedFactor = 10 is judged by keepSafe too).

@@ -16,7 +16,10 @@
 //     -> "dantzig" (exact pivoting, fast while the pivot count is small);
 //   larger contact islands -> "pgs" when the budget is spent or the tolerance is loose
 //     (>= looseTolerance), else largeIslandSolver ("newton", whose cost grows more slowly than
-//     pivoting's with the rows).
+//     pivoting's with the rows);
+//   a contact island whose dantzig or newton answer ended short of the tolerance (a singular A:
+//     a pile without cfm) -> singularIslandSolver ("proximal") from that answer, and first for
+//     that island's next singularIslandSolves solves (RowSolver's per-island memory).
 //
 // The fallback rule (a registry chain "a>b>c" and RowSolver's primary and fallback alike):
 //  1. an answer is acceptable when its status is not a breakdown and its residual, recomputed
@@ -43,6 +46,10 @@ namespace mlcp {
 // The solver for contact islands above Policy::smallIslandRows rows (smallContactRows without
 // free rows) at a tight tolerance.
 inline constexpr const char* kLargeIslandSolver = "newton";
+// The solver of contact islands whose exact primary (dantzig, newton) ended short of the
+// tolerance: a singular A (a pile without cfm), where the proximal point loop on the impulses
+// still reaches the exact answer (mlcp/solvers/proximal.hpp).
+inline constexpr const char* kSingularIslandSolver = "proximal";
 
 // What the policy picked, and why in words (for Result::message). Static strings, or (solver)
 // the Policy's largeIslandSolver: choosing allocates nothing (it runs for every island).
@@ -64,6 +71,12 @@ struct Policy {
   // Solver of larger contact islands at tolerances below looseTolerance. Default
   // kLargeIslandSolver ("newton").
   std::string largeIslandSolver = kLargeIslandSolver;
+  // Solver that continues an island's exact primary (dantzig, newton) that ended short of the
+  // tolerance, from its answer, and that answers that island first for its next
+  // singularIslandSolves solves (RowSolver keeps the count per island); "" for none. Default
+  // kSingularIslandSolver ("proximal").
+  std::string singularIslandSolver = kSingularIslandSolver;
+  int singularIslandSolves = 30;
   // Requested tolerance (scaled residual) at or above which large contact islands go to pgs.
   // Default 1e-4.
   double looseTolerance = 1e-4;

@@ -1,0 +1,177 @@
+// The proximal point solver (mlcp/solvers/proximal.hpp) on singular contact problems: piles
+// without cfm, whose exact answer exists but is not unique. Every answer is checked with
+// mlcp::accuracy on the assembled problem, never by the solver's own claim.
+#include "mlcp/solvers/proximal.hpp"
+
+#include <gtest/gtest.h>
+
+#include "common/contact_scenes.hpp"
+#include "common/cube_on_ground.hpp"
+#include "mlcp/io.hpp"
+#include "mlcp/registry.hpp"
+#include "mlcp/residual.hpp"
+#include "mlcp/solvers/newton.hpp"
+
+namespace mlcp {
+namespace {
+
+// A cube on four corner contacts, no cfm: 12 rows on 6 degrees of freedom, A of rank 6.
+RowSystem restingCube(double cfm = 0) {
+  const std::vector<Eigen::Vector3d> corners = {
+      {0.5, 0.5, -0.5}, {-0.5, 0.5, -0.5}, {0.5, -0.5, -0.5}, {-0.5, -0.5, -0.5}};
+  Vector6 v;
+  v << 0.3, -0.1, -9.81 / 60, 0, 0, 0.2;  // falling, sliding and spinning a little
+  return test::cubeOnGround(corners, v, 0.5, cfm);
+}
+
+RowSystem pile(int levels, bool square = false) {
+  test::PyramidSpec spec;
+  spec.levels = levels;
+  spec.cfm = 0;  // Bullet's default: no cfm on contacts
+  spec.square = square;
+  return test::BoxPyramid(spec).rows();
+}
+
+Result solveWithRows(ProximalSolver& s, const RowSystem& rows, const Problem& p, Vector& x) {
+  s.useRows(&rows);
+  Result r = s.solveWithGuess(p, Vector::Zero(p.size()), x);
+  s.useRows(nullptr);
+  return r;
+}
+
+TEST(Proximal, RestingCubeWithoutCfmIsExact) {
+  const RowSystem rows = restingCube();
+  const Problem p = rows.assemble(false);
+  ProximalSolver s;
+  s.options().tolerance = 1e-10;
+  Vector x;
+  const Result r = s.solve(p, x);
+  EXPECT_EQ(r.status, Status::Converged) << r.message;
+  EXPECT_LE(accuracy(p, x).residual, 1e-10);
+  EXPECT_GE(r.iterations, 1);
+}
+
+TEST(Proximal, SingularPileIsExactOnRowsAndOnTheMatrix) {
+  const RowSystem rows = pile(8);  // 36 boxes, rows > newton's dense limit: the sparse paths
+  for (bool withRows : {false, true}) {
+    const Problem p = rows.assemble(true);
+    ProximalSolver s;
+    s.options().tolerance = 1e-9;
+    Vector x;
+    const Result r = withRows ? solveWithRows(s, rows, p, x) : s.solve(p, x);
+    EXPECT_EQ(r.status, Status::Converged) << (withRows ? "rows: " : "matrix: ") << r.message;
+    EXPECT_LE(accuracy(p, x).residual, 1e-9) << r.message;
+    EXPECT_GT(s.innerIterations(), 0);
+  }
+}
+
+TEST(Proximal, SquarePileWithoutCfmIsExact) {
+  const RowSystem rows = pile(4, true);  // 30 boxes, each upper box on four below
+  const Problem p = rows.assemble(true);
+  ProximalSolver s;
+  s.options().tolerance = 1e-9;
+  Vector x;
+  const Result r = solveWithRows(s, rows, p, x);
+  EXPECT_EQ(r.status, Status::Converged) << r.message;
+  EXPECT_LE(accuracy(p, x).residual, 1e-9);
+}
+
+TEST(Proximal, StartAtTheAnswerTakesNoOuterStep) {
+  const RowSystem rows = pile(5);
+  const Problem p = rows.assemble(true);
+  ProximalSolver s;
+  s.options().tolerance = 1e-8;
+  Vector x;
+  ASSERT_EQ(s.solve(p, x).status, Status::Converged);
+  Vector again;
+  const Result r = s.solveWithGuess(p, x, again);
+  EXPECT_EQ(r.status, Status::Converged);
+  EXPECT_EQ(r.iterations, 0);
+}
+
+TEST(Proximal, NextStepFromTheLastAnswerTakesFewOuterSteps) {
+  test::PyramidSpec spec;
+  spec.levels = 6;
+  spec.cfm = 0;
+  test::BoxPyramid pyramid(spec);
+  ProximalSolver s;
+  s.options().tolerance = 1e-8;
+  Vector x = Vector::Zero(pyramid.rows().size());
+  for (int step = 0; step < 5; ++step) {
+    const RowSystem& rows = pyramid.rows();
+    const Problem p = rows.assemble(true);
+    s.useRows(&rows);
+    Vector next;
+    const Result r = s.solveWithGuess(p, x, next);
+    s.useRows(nullptr);
+    ASSERT_EQ(r.status, Status::Converged) << "step " << step << ": " << r.message;
+    EXPECT_LE(accuracy(p, next).residual, 1e-8);
+    if (step > 0) {
+      EXPECT_LE(r.iterations, 4) << "step " << step << ": " << r.message;
+    }
+    x = next;
+    pyramid.nextStep();
+  }
+}
+
+TEST(Proximal, DantzigInnerSolvesTheCubeToo) {
+  const Problem p = restingCube().assemble(false);
+  ProximalSolver s;
+  s.params().inner = "dantzig";
+  s.options().tolerance = 1e-9;
+  Vector x;
+  const Result r = s.solve(p, x);
+  EXPECT_EQ(r.status, Status::Converged) << r.message;
+  EXPECT_LE(accuracy(p, x).residual, 1e-9);
+}
+
+TEST(Proximal, AnInnerSolverThatCannotBeUsedIsInvalidInput) {
+  const Problem p = restingCube().assemble(false);
+  for (const char* inner : {"proximal", "auto", "pgs>newton", "nonsense"}) {
+    ProximalSolver s;
+    s.params().inner = inner;
+    Vector x = Vector::Constant(p.size(), 7.0);
+    const Result r = s.solve(p, x);
+    EXPECT_EQ(r.status, Status::InvalidInput) << inner;
+    EXPECT_NE(r.message.find("inner"), std::string::npos) << r.message;
+  }
+}
+
+TEST(Proximal, OuterStepLimitReturnsTheBestIterateHonestly) {
+  const RowSystem rows = pile(8);
+  const Problem p = rows.assemble(true);
+  ProximalSolver s;
+  s.options().tolerance = 1e-14;  // out of reach in one step
+  s.params().maxOuter = 1;
+  Vector x;
+  const Result r = solveWithRows(s, rows, p, x);
+  EXPECT_EQ(r.iterations, 1);
+  EXPECT_NE(r.status, Status::Converged);
+  EXPECT_DOUBLE_EQ(r.residual, accuracy(p, x).residual);
+  EXPECT_LT(r.residual, accuracy(p, Vector::Zero(p.size())).residual);
+}
+
+TEST(Proximal, TimeBudgetIsHonoured) {
+  const RowSystem rows = pile(10);
+  const Problem p = rows.assemble(true);
+  ProximalSolver s;
+  s.options().tolerance = 1e-14;
+  s.options().timeBudget = 1e-4;
+  Vector x;
+  const Result r = s.solve(p, x);
+  EXPECT_EQ(r.status, Status::TimeLimit) << r.message;
+  EXPECT_LE(r.residual, accuracy(p, Vector::Zero(p.size())).residual);
+}
+
+TEST(Proximal, RegisteredByName) {
+  auto s = makeSolver("proximal");
+  ASSERT_NE(s, nullptr);
+  EXPECT_STREQ(s->name(), "proximal");
+  const Problem p = restingCube().assemble(false);
+  s->options().tolerance = 1e-9;
+  Vector x;
+  EXPECT_EQ(s->solve(p, x).status, Status::Converged);
+}
+
+}  // namespace
+}  // namespace mlcp
