@@ -185,14 +185,15 @@ class Problem:
               max_pivots: int = 0, check_every: int = 1, pivot_tolerance: float = 1e-12,
               friction_bounds: str = "exact", newton: Optional[Mapping[str, Any]] = None,
               dantzig: Optional[Mapping[str, Any]] = None,
-              lemke: Optional[Mapping[str, Any]] = None) -> Result:
+              lemke: Optional[Mapping[str, Any]] = None,
+              proximal: Optional[Mapping[str, Any]] = None) -> Result:
         """Solves with a registered solver (see solvers()); `guess` is the start point; the
         settings are those of `mlcp solve`, snake_case (see solve())."""
         g = _vector("guess", guess, self.n, None)
         options = dict(tol=tol, max_iter=max_iter, relaxation=relaxation,
                        time_budget=time_budget, max_pivots=max_pivots, check_every=check_every,
                        pivot_tolerance=pivot_tolerance, friction_bounds=friction_bounds)
-        params = _params(newton=newton, dantzig=dantzig, lemke=lemke)
+        params = _params(newton=newton, dantzig=dantzig, lemke=lemke, proximal=proximal)
         return Result(**self._core.solve(solver, options, params, g))
 
     def __repr__(self) -> str:
@@ -205,7 +206,8 @@ def solve(A: Any, b: Any = None, lo: Any = None, hi: Any = None, findex: Any = N
           relaxation: float = 1.0, time_budget: float = 0.0, max_pivots: int = 0,
           check_every: int = 1, pivot_tolerance: float = 1e-12, friction_bounds: str = "exact",
           newton: Optional[Mapping[str, Any]] = None, dantzig: Optional[Mapping[str, Any]] = None,
-          lemke: Optional[Mapping[str, Any]] = None) -> Result:
+          lemke: Optional[Mapping[str, Any]] = None,
+          proximal: Optional[Mapping[str, Any]] = None) -> Result:
     """Solves w = A x + b, lo <= x <= hi (findex) with the named solver ("auto" chooses).
 
     A may also be a Problem (then b, lo, hi and findex are not given). The settings are those of
@@ -217,7 +219,7 @@ def solve(A: Any, b: Any = None, lo: Any = None, hi: Any = None, findex: Any = N
     methods, pivot_tolerance the pivot magnitude treated as zero, friction_bounds "exact" or
     "fixed-once" (stock ODE's and Bullet's friction handling).
 
-    newton, dantzig and lemke are dicts of that solver's typed parameters (`mlcp solve --newton
+    newton, dantzig, lemke and proximal are dicts of that solver's typed parameters (`mlcp solve --newton
     KEY=VALUE,...`; names and defaults in the stub, mlcp/__init__.pyi), e.g.
     newton={"pivoting_steps": 0, "cold_sweeps": 0}; they apply wherever that solver runs (named,
     in a chain "a>b", or chosen by auto). An unknown name or a value out of range raises
@@ -231,7 +233,8 @@ def solve(A: Any, b: Any = None, lo: Any = None, hi: Any = None, findex: Any = N
     else:
         problem = Problem(A, b, lo, hi, findex)
     return problem.solve(solver, tol, guess, max_iter, relaxation, time_budget, max_pivots,
-                         check_every, pivot_tolerance, friction_bounds, newton, dantzig, lemke)
+                         check_every, pivot_tolerance, friction_bounds, newton, dantzig, lemke,
+                         proximal)
 
 
 def _params(**groups: Optional[Mapping[str, Any]]) -> List[Tuple[str, str, float, str]]:

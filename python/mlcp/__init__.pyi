@@ -16,8 +16,8 @@ __all__ = ["Problem", "Result", "Run", "solve", "run", "solvers", "engines", "sw
 
 # The typed solver parameters of solve() and Problem.solve() (`mlcp solve --newton KEY=VALUE,...`
 # with the names kebab-case), each with its default and accepted values; the fields of
-# NewtonParams, DantzigParams (core/include/mlcp/solvers/newton.hpp, dantzig.hpp) and LemkeSolver
-# (lemke.hpp). Any subset may be given; an unknown name or a value out of range raises ValueError.
+# NewtonParams, DantzigParams (core/include/mlcp/solvers/newton.hpp, dantzig.hpp), LemkeSolver
+# (lemke.hpp) and ProximalParams (proximal.hpp). Any subset may be given; an unknown name or a value out of range raises ValueError.
 class _NewtonParams(TypedDict, total=False):
     cold_sweeps: int  # 10, >= 0: pgs sweeps over a cold start
     warm_sweeps: int  # 20, >= 0: pgs sweeps over a warm start above warm_sweeps_residual
@@ -48,6 +48,15 @@ class _LemkeParams(TypedDict, total=False):
     dense_rows: int  # 50, >= 0: most rows of the dense tableau (above: factored basis)
     refactor_period: int  # 50, >= 1: pivots between refactorizations of the basis
     max_rows: int  # 5000000, >= 1: largest problem accepted, rows
+
+class _ProximalParams(TypedDict, total=False):
+    sigma: float  # 1, > 0: alpha = sigma r^nu mean(A_ii)
+    nu: float  # 1, > 0: the residual's power in alpha
+    alpha_min: float  # 1e-12, > 0: smallest alpha / mean(A_ii)
+    alpha_max: float  # 0.01, > 0: largest alpha / mean(A_ii)
+    alpha_growth: float  # 10, > 0: factor on alpha after an inner solve ended short
+    inner_factor: float  # 0.1, > 0: inner tolerance = max(tol / 10, this x residual)
+    max_outer: int  # 200, >= 0: most outer steps
 
 _FrictionBounds = Literal["exact", "fixed-once"]
 
@@ -98,7 +107,8 @@ class Problem:
               max_pivots: int = 0, check_every: int = 1, pivot_tolerance: float = 1e-12,
               friction_bounds: _FrictionBounds = "exact",
               newton: Optional[_NewtonParams] = None, dantzig: Optional[_DantzigParams] = None,
-              lemke: Optional[_LemkeParams] = None) -> Result: ...
+              lemke: Optional[_LemkeParams] = None,
+              proximal: Optional[_ProximalParams] = None) -> Result: ...
 
 def solve(A: Union[_Matrix, Problem], b: _Vector = None, lo: _Vector = None,
           hi: _Vector = None, findex: _Vector = None, solver: str = "auto", tol: float = 1e-10,
@@ -106,7 +116,8 @@ def solve(A: Union[_Matrix, Problem], b: _Vector = None, lo: _Vector = None,
           time_budget: float = 0.0, max_pivots: int = 0, check_every: int = 1,
           pivot_tolerance: float = 1e-12, friction_bounds: _FrictionBounds = "exact",
           newton: Optional[_NewtonParams] = None, dantzig: Optional[_DantzigParams] = None,
-          lemke: Optional[_LemkeParams] = None) -> Result: ...
+          lemke: Optional[_LemkeParams] = None,
+          proximal: Optional[_ProximalParams] = None) -> Result: ...
 
 class Run:
     scene: str

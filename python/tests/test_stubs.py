@@ -64,12 +64,12 @@ def test_class_members_match():
 
 
 def test_typed_solver_parameters_are_stubbed_with_their_types_and_defaults():
-    """_NewtonParams, _DantzigParams and _LemkeParams list every typed parameter the module
+    """_NewtonParams, _DantzigParams, _LemkeParams and _ProximalParams list every typed parameter the module
     takes, with its type and, first in its comment, its default."""
     lines = STUB.read_text().splitlines()
     stubs = stub_tree()
     stubbed = {}
-    for solver in ("newton", "dantzig", "lemke"):
+    for solver in ("newton", "dantzig", "lemke", "proximal"):
         for node in stubs[f"_{solver.capitalize()}Params"].body:
             if isinstance(node, ast.AnnAssign):
                 default = lines[node.lineno - 1].split("#", 1)[1].split(",")[0].strip()
