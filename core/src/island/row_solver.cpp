@@ -646,14 +646,16 @@ Result RowSolver::Impl::solvePrimary(const RowSystem& rows, const Vector& start,
 }
 
 // The island's memory under auto after its primary: the budget's cuts in a row, the capped
-// solves after an uncapped large-island solve ended short, and pgs first after a capped solve
+// solves after an uncapped large-island (or singular-island) solve ended short by itself, whatever
+// the continuation found (the continuation costs more than the engine: the next solves are held
+// to its cost), and pgs first after a capped solve
 // that spent its share before its first step (assembly and set-up alone cost more than the cap:
 // it cannot improve on pgs within the engine's cost) or after a breakdown.
 void RowSolver::Impl::remember(Slot& island, const IslandSolve& out, const Result& r,
                                const Plan& plan) {
   const Policy& policy = settings_.policy;
   island.cutsInRow = r.status == Status::TimeLimit ? island.cutsInRow + 1 : 0;
-  if (!plan.capped && !plan.fromStart && cappable(out.requested) && r.status != Status::Converged)
+  if (!plan.capped && !plan.fromStart && cappable(out.requested) && plan.primaryShort)
     island.cappedSolves = policy.pgsAfterBreakdown;
   if (plan.capped && r.status == Status::TimeLimit && r.iterations == 0)
     island.pgsFirst = policy.pgsAfterBreakdown;
@@ -697,6 +699,7 @@ IslandSolve RowSolver::Impl::solveScreened(const RowSystem& rows, const Vector& 
   }
   if (r.status == Status::InvalidInput || r.status == Status::Unsupported) x = from;
   out.choice = plan.fromStart ? kStartChoice : out.requested;
+  plan.primaryShort = r.status != Status::Converged;
   if (autoChoice && !cone) continueShort(rows, x, island, out, r, plan, t0);
   if (autoChoice && !cone) remember(island, out, r, plan);
   // Stages 4 and 5.

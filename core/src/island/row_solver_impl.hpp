@@ -68,10 +68,11 @@ class RowSolver::Impl {
   struct Slot;
   // What stage 2 decided for this solve and what stage 3 found.
   struct Plan {
-    double share = 0;        // the island's time share, seconds (0: no budget)
-    bool enginePgs = false;  // pgs that auto runs for cost: the fallback's options
-    bool capped = false;     // under the engine-relative cap
-    bool fromStart = false;  // the start already solves the rows
+    double share = 0;           // the island's time share, seconds (0: no budget)
+    bool enginePgs = false;     // pgs that auto runs for cost: the fallback's options
+    bool capped = false;        // under the engine-relative cap
+    bool fromStart = false;     // the start already solves the rows
+    bool primaryShort = false;  // the primary's own answer ended short of the tolerance
   };
   static IslandSolve noRows(Vector& x);
   void chooseForAuto(const RowSystem& rows, const Vector& start, Slot& island, IslandSolve& out,
