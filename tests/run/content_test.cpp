@@ -359,3 +359,26 @@ TEST(SceneContentPhysics, SixDofSpringIsUnsupportedInOde) {
 }
 
 }  // namespace
+
+namespace {
+
+// Bullet's default cfm 0 on a 10-box stack: A is singular once the boxes rest (four coplanar
+// contacts a face), as on Bullet's BasicDemo pile. With proximal named and no budget, every island
+// of every step converges to the island tolerance (1e-6).
+TEST(SceneContentPhysics, RestingStackWithoutCfmIsExactWithProximal) {
+  const mlcp::test::SceneLoader bullet = loaderOf("bullet");
+  if (!bullet) GTEST_SKIP() << "needs Bullet";
+  Scene s = load("stack_10");
+  s.settings.cfm = 0;
+  RunSettings run = unbudgeted(s);
+  run.solver = "proximal";
+  auto world = bullet(s, run);
+  for (int i = 0; i < 120; ++i) {
+    world->step();
+    const auto& m = world->last();
+    ASSERT_TRUE(mlcp::scene::isFinite(world->states())) << "non-finite state at step " << i;
+    EXPECT_EQ(m.status, "converged") << "step " << i << ": residual " << m.residual;
+  }
+}
+
+}  // namespace

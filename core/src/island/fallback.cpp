@@ -107,8 +107,39 @@ void AutoSolver::run(const Problem& problem, Vector& x, Result& result) {
   solver->setOptions(options());
   Vector out;
   result = solver->solveWithGuess(problem, x, out);
-  if (result.status != Status::InvalidInput && result.status != Status::Unsupported) x = out;
+  const bool answered =
+      result.status != Status::InvalidInput && result.status != Status::Unsupported;
+  if (answered) x = out;
   result.message = "auto (" + why + " -> " + chain + "): " + result.message;
+  if (answered) continueSingular(problem, c, choice, x, result);
+}
+
+// An exact method's answer on contact rows that ended short of the tolerance (a singular A: a
+// pile without cfm) goes on with the policy's singular-island solver from it, in the time left;
+// the better answer stands (RowSolver does the same for engine islands).
+void AutoSolver::continueSingular(const Problem& problem, ProblemClass c, const Choice& choice,
+                                  Vector& x, Result& result) {
+  const std::string& singular = policy.singularIslandSolver;
+  const bool contacts =
+      c == ProblemClass::Findex || c == ProblemClass::Boxed || c == ProblemClass::StandardLcp;
+  const bool exact = std::string(choice.solver) == "dantzig" ||
+                     std::string(choice.solver) == policy.largeIslandSolver;
+  if (!contacts || !exact || singular.empty() || !registered(singular.c_str()) ||
+      result.status == Status::Converged || x.size() != problem.size() || !x.allFinite() ||
+      outOfTime())
+    return;
+  Solver* s = cachedChain(cache_, singular, configure);
+  s->setOptions(options());
+  Vector out;
+  Result r = s->solveWithGuess(problem, x, out);
+  if (!better(r, result)) {
+    result.message += "; " + singular + " from its answer no better (" + toString(r.status) + ")";
+    return;
+  }
+  r.message = result.message + "; " + singular + " from its answer: " + r.message;
+  r.iterations += result.iterations;
+  result = std::move(r);
+  x = out;
 }
 
 }  // namespace mlcp

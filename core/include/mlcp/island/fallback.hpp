@@ -12,7 +12,9 @@
 // start).
 //
 // AutoSolver classifies the problem, asks Policy (policy.hpp) for a solver and its fallback and
-// runs that two-member chain. The choice and its reason open Result::message. Solvers missing
+// runs that two-member chain; an exact method's answer on contact rows still short of the
+// tolerance then goes on with Policy::singularIslandSolver (proximal) from it, in the time left.
+// The choice and its reason open Result::message. Solvers missing
 // from the registry are skipped. `configure` reaches the solvers it makes (to set their typed
 // parameters, e.g. NewtonParams): each chain is passed to it once, when made.
 #pragma once
@@ -54,6 +56,8 @@ class AutoSolver : public Solver {
   void run(const Problem& problem, Vector& x, Result& result) override;
 
  private:
+  void continueSingular(const Problem& problem, ProblemClass c, const Choice& choice, Vector& x,
+                        Result& result);
   // Chains are kept per choice so that solver workspaces (and ldlt's analysis) are reused.
   std::vector<std::pair<std::string, std::unique_ptr<Solver>>> cache_;
 };
