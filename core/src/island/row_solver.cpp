@@ -443,17 +443,19 @@ Result RowSolver::Impl::fallBack(const RowSystem& rows, const Vector& start, Vec
   return r;
 }
 
+// o: the island's options bounded by what is left of its share (at least the minimal share).
+Options RowSolver::Impl::leftOfShare(double share, double t0) const {
+  if (!(share > 0)) return settings_.options;
+  const double now = nowSeconds();
+  return withBudget(settings_.options,
+                    std::max(share - (now - t0), settings_.minShare * settings_.timeBudget), now);
+}
+
 // Stage 3's hand-over under auto: x, r (an answer that is not good enough) continued by `name`
-// from x in what is left of the island's share. The better answer stands.
+// from x with the options o (their budget set by the caller). The better answer stands.
 void RowSolver::Impl::continueWith(const std::string& name, const RowSystem& rows, Vector& x,
-                                   Slot& island, IslandSolve& out, Result& r, double share,
-                                   double t0) {
+                                   Slot& island, IslandSolve& out, Result& r, const Options& o) {
   if (x.size() != rows.size() || !x.allFinite()) return;
-  Options o = settings_.options;
-  if (share > 0) {
-    const double now = nowSeconds();
-    o = withBudget(o, std::max(share - (now - t0), settings_.minShare * settings_.timeBudget), now);
-  }
   const Vector from = x;
   Result n = run(rows, name, o, from, xFallback_, island, out);
   if (!better(n, r)) return;
@@ -467,10 +469,11 @@ void RowSolver::Impl::continueWith(const std::string& name, const RowSystem& row
 
 // A dantzig answer on friction rows that is not acceptable (its friction fixed point did not
 // settle, or its regularised retry ended short) goes on with newton, which has the friction
-// bounds' exact Jacobian where the fixed point re-solves with lagged bounds. An exact method's
-// answer still short of the tolerance on contact rows (a pile without cfm, whose A is singular)
-// goes on with the policy's singular-island solver, which then answers the island first for its
-// next solves.
+// bounds' exact Jacobian where the fixed point re-solves with lagged bounds, in what is left of
+// the share. An exact method's answer still short of the tolerance on contact rows (a pile
+// without cfm, whose A is singular) goes on with the policy's singular-island solver, under the
+// engine-relative cap when the engine's cost is known, and that solver answers the island first
+// for its next solves.
 void RowSolver::Impl::continueShort(const RowSystem& rows, Vector& x, Slot& island,
                                     IslandSolve& out, Result& r, const Plan& plan, double t0) {
   const Policy& policy = settings_.policy;
@@ -480,10 +483,13 @@ void RowSolver::Impl::continueShort(const RowSystem& rows, Vector& x, Slot& isla
   if (plan.fromStart || !contacts) return;
   if (out.problemClass == ProblemClass::Findex && equals(out.requested, "dantzig") &&
       !acceptable(r, settings_.acceptResidual))
-    continueWith("newton", rows, x, island, out, r, plan.share, t0);
+    continueWith("newton", rows, x, island, out, r, leftOfShare(plan.share, t0));
   const bool exact = equals(out.requested, "dantzig") || out.requested == policy.largeIslandSolver;
   if (!exact || policy.singularIslandSolver.empty() || r.status == Status::Converged) return;
-  continueWith(policy.singularIslandSolver, rows, x, island, out, r, plan.share, t0);
+  Options o = leftOfShare(plan.share, t0);
+  if (const double cap = engineShare(rows, x); cap > 0 && !(o.timeBudget > 0 && o.timeBudget < cap))
+    o = withBudget(settings_.options, cap, nowSeconds());
+  continueWith(policy.singularIslandSolver, rows, x, island, out, r, o);
   island.singularFirst = policy.singularIslandSolves;
 }
 
@@ -615,16 +621,20 @@ void RowSolver::Impl::chooseForAuto(const RowSystem& rows, const Vector& start, 
     out.requested = "pgs";
     plan.enginePgs = true;
   }
-  if (island.singularFirst > 0 && !policy.singularIslandSolver.empty() &&
-      (equals(out.requested, "dantzig") || out.requested == policy.largeIslandSolver)) {
+  // The singular-island solver answers under the cap whenever the engine's cost is known: it
+  // runs on islands no exact method finishes, every step.
+  const bool singular =
+      island.singularFirst > 0 && !policy.singularIslandSolver.empty() &&
+      (equals(out.requested, "dantzig") || out.requested == policy.largeIslandSolver);
+  if (singular) {
     --island.singularFirst;
     out.requested = policy.singularIslandSolver;
   }
-  if (cappable(out.requested) && island.cappedSolves > 0) {
+  if (singular || (cappable(out.requested) && island.cappedSolves > 0)) {
     const double cap = engineShare(rows, start);
     plan.capped = cap > 0;
-    if (plan.capped) --island.cappedSolves;
-    if (plan.capped && cap < plan.share) plan.share = cap;
+    if (plan.capped && !singular) --island.cappedSolves;
+    if (plan.capped && (cap < plan.share || !(plan.share > 0))) plan.share = cap;
   }
 }
 

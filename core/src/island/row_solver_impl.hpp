@@ -91,10 +91,12 @@ class RowSolver::Impl {
              const Vector& start, Vector& x, Slot& island, IslandSolve& report);
   Result fallBack(const RowSystem& rows, const Vector& start, Vector& x, Slot& island,
                   IslandSolve& out, Result r, double share, double t0);
-  // Stage 3 under auto: an answer continued by `name` from it, in what is left of the share; the
-  // better answer stands.
+  // The primary's options bounded by what is left of the island's share.
+  Options leftOfShare(double share, double t0) const;
+  // Stage 3 under auto: an answer continued by `name` from it with the options o; the better
+  // answer stands.
   void continueWith(const std::string& name, const RowSystem& rows, Vector& x, Slot& island,
-                    IslandSolve& out, Result& r, double share, double t0);
+                    IslandSolve& out, Result& r, const Options& o);
   // Stage 3 under auto after the primary: dantzig's unacceptable answer on friction rows
   // continued by newton, and an exact primary's answer short of the tolerance by the policy's
   // singular-island solver.
