@@ -241,5 +241,20 @@ TEST(LemkeFrictionLcp, BulletRestingBoxesTheFixedPointDidNotSettle) {
   }
 }
 
+// Bullet's plank bridge at step 41 (ball-joint pairs on one axis: free rows, A singular; contacts
+// of the crates): the LCP ended with z0 out of the basis at residual 6e-5, the fixed point after
+// it on a ray, and the solve returned that answer without the retry on A + delta I that a ray
+// gets (the scene's lemke run left the island unsolved). The retry now follows and solves it.
+TEST(LemkeFrictionLcp, PlankBridgeInexactAnswerGetsTheRegularisedRetry) {
+  const Problem p = io::readProblem(std::string(MLCP_SOURCE_DIR) +
+                                    "/tests/data/islands/plank_bridge-bullet-step41-island0.json");
+  ASSERT_TRUE(p.hasFindex());
+  ASSERT_TRUE(hasFreeRows(p.lo, p.hi));
+  Vector x;
+  const Result r = solveLemke(p, x, true);
+  EXPECT_EQ(r.status, Status::Converged) << r.message;
+  EXPECT_LE(residual(p, x), 1e-9);
+}
+
 }  // namespace
 }  // namespace mlcp

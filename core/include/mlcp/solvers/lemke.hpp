@@ -33,13 +33,13 @@
 // the lower residual on A stands ("regularised"). Friction (findex): by default one LCP, each
 // tangent row written as l+ - l- with a slack (the Stewart-Trinkle / Anitescu-Potra box form,
 // core/src/pivoting/box_friction_lcp.hpp), which needs no fixed point; its answer's active set
-// is re-solved in the original problem. When it ends short (a ray, or z0 out at values above the
-// tolerance), it runs once more on the dense tableau if it was factored (up to
-// kLemkeFreeRowsTableauRows rows), then the fixed point from the start, within one pivot limit. The
-// fixed point (frictionLcp = false, or a normal row whose bounds straddle 0): each pass a boxed LCP
-// on the bounds of the previous answer, its active set re-solved with the true coupled bounds; a
-// guess only seeds those bounds. Details: docs/methods/pivoting.md, the "Lemke: ..." sections (the
-// standard form, the choice by size, the friction passes, friction as one LCP).
+// is re-solved in the original problem. When it ends short (a ray, or z0 out at values above
+// the tolerance), it runs once more on the dense tableau if it was factored (up to 500 rows),
+// then the fixed point from the start, within one pivot limit. The fixed point (frictionLcp =
+// false, or a normal row whose bounds straddle 0): each pass a boxed LCP on the bounds of the
+// previous answer, its active set re-solved with the true coupled bounds; a guess only seeds
+// those bounds. Details: docs/methods/pivoting.md, the "Lemke: ..." sections (the standard
+// form, the choice by size, the friction passes, friction as one LCP).
 #pragma once
 
 #include <iosfwd>
