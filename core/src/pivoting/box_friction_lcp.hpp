@@ -22,10 +22,12 @@
 //     w' = [ A S u + b ;  -(A S u + b)_T + g ;  mu s x_N - l+ - l- ],   plus g in the rows T,
 //
 // S the map x = S u (x_t = u_t - u_(n+k) for the k-th tangent row t), T the tangent rows, N their
-// normals. Over u >= 0, u' M u = (S u)' A (S u) + sum_k g_k mu s x_n (the g terms of the tangent
-// rows cancel those of the g rows): PSD A gives a copositive M, and lemke ends with an answer
-// whenever the friction problem has one, on a ray only when it has none (Anitescu and Potra).
-// The answer maps back to x = S u exactly, so its residual is measured on the original problem.
+// normals. Over u >= 0 (normals with lo_n = 0), u' M u = (S u)' A (S u) + sum_k g_k mu x_n (the
+// g terms of the tangent rows cancel those of the g rows): PSD A gives a copositive M, and in
+// exact arithmetic lemke ends with an answer whenever the friction problem has one (Anitescu and
+// Potra); b = J v (no stabilisation) always has one. In floating point a singular A can still end
+// it short (lemke.hpp says what follows). The answer maps back to x = S u exactly, so its
+// residual is measured on the original problem.
 //
 // Invariants: only rows with findex and mu > 0 are expanded; mu = 0 rows stay as rows fixed at
 // 0 (lo = hi = 0). A normal row whose bounds straddle 0 (a free row) has no linear |x_n|: build()
