@@ -66,6 +66,14 @@ bool isFree(double lo, double hi) { return lo == -kInf && hi == kInf; }
 // kLemkeFreeRowsTableauRows.
 constexpr int kLemkeFrictionTableauRows = 500;
 
+// On the factored basis the friction LCP's pivots are tested at this multiple of
+// Options::pivotTolerance: its slack rows (q = 0) and a singular A leave round-off entries near
+// 1e-12 of their column in the entering columns, and a pivot on one of them led BasicDemo's
+// 1137-row pile to a false ray. The tableau keeps the option as it is: at 100x a plank bridge's
+// island (free rows) ran to its pivot limit (docs/benchmarks.md, "lemke: friction as one LCP
+// against the fixed point").
+constexpr double kFrictionLcpPivotScale = 100;
+
 // Relative width below which a box [lo, hi] is treated as the point lo (see toStandard).
 constexpr double kNarrowBox = 1e-13;
 
@@ -586,14 +594,14 @@ void LemkeSolver::pivot(const Problem& problem, const SparseMatrix& A, Vector& x
   const Problem& p = lcp.problem();
   const int m = p.size();
   Vector u = Vector::Zero(m);
-  pivotPasses(p, p.sparseA(), u, result, denseRows);
+  const bool factored =
+      m > denseRows && (!hasFreeRows(p.lo, p.hi) || m > kLemkeFreeRowsTableauRows);
+  pivotPasses(p, p.sparseA(), u, result, denseRows, factored ? kFrictionLcpPivotScale : 1);
   std::ostringstream os;
   os << "friction as one LCP (" << lcp.tangentRows() << " tangent rows as l+ - l-, " << m
      << " rows): ";
   const double tolerance = options().tolerance;
   bool solved = result.status == Status::Converged;
-  const bool factored =
-      m > denseRows && (!hasFreeRows(p.lo, p.hi) || m > kLemkeFreeRowsTableauRows);
   // A ray, or z0 out of the basis at values that are not the answer; the pivot limit and the
   // time budget end the solve.
   auto endedShort = [&](bool solvedNow, const Vector& answer) {
@@ -642,7 +650,7 @@ void LemkeSolver::pivot(const Problem& problem, const SparseMatrix& A, Vector& x
 }
 
 void LemkeSolver::pivotPasses(const Problem& problem, const SparseMatrix& A, Vector& x,
-                              Result& result, int tableauRows) {
+                              Result& result, int tableauRows, double pivotScale) {
   const Options& opt = options();
   const int n = problem.size();
   const bool friction = problem.hasFindex();
@@ -652,7 +660,7 @@ void LemkeSolver::pivotPasses(const Problem& problem, const SparseMatrix& A, Vec
       n > tableauRows && (!hasFreeRows(problem.lo, problem.hi) || n > kLemkeFreeRowsTableauRows);
   const int outerLimit = friction ? std::max(1, opt.maxIterations) : 1;
   ToleranceRules rules;
-  rules.pivotTolerance = opt.pivotTolerance;
+  rules.pivotTolerance = opt.pivotTolerance * pivotScale;
   // A tableau pivot costs O(m^2) with m >= n, a factored one at least O(m): the clock is read
   // once per ~4096 / n^2 (tableau) or 4096 / n (factored) pivots, at most ~2% of their cost.
   const int clockEvery = std::max(1, 4096 / std::max(1, revised ? n : n * n));

@@ -76,9 +76,9 @@ class LemkeSolver : public Solver {
   // frictionLcp and the problem fits it, otherwise pivotPasses.
   void pivot(const Problem& problem, const SparseMatrix& A, Vector& x, Result& result);
   // The standard form's pivoting, with the friction passes when the problem has findex; the
-  // dense tableau up to tableauRows rows.
+  // dense tableau up to tableauRows rows; pivots tested at pivotScale x Options::pivotTolerance.
   void pivotPasses(const Problem& problem, const SparseMatrix& A, Vector& x, Result& result,
-                   int tableauRows);
+                   int tableauRows, double pivotScale = 1);
 };
 
 // Runs Lemke on a standard LCP (lo = 0, hi = +inf, no findex) and prints every tableau to out:
