@@ -28,18 +28,19 @@
 // passes together (MaxIterations); Options::timeBudget stops it between pivots (TimeLimit); the
 // start or the last pass's answer is then returned, never a half-pivoted tableau.
 //
-// Singular A (redundant joints) ends on a ray in floating point: the solve runs once more from
-// the same start on A + delta I, delta = kLemkeRayShift max(1, max |A_ii|), and the answer with
-// the lower residual on A stands ("regularised"). Friction (findex): by default one LCP, each
-// tangent row written as l+ - l- with a slack (the Stewart-Trinkle / Anitescu-Potra box form,
-// core/src/pivoting/box_friction_lcp.hpp), which needs no fixed point; its answer's active set
-// is re-solved in the original problem. When it ends short (a ray, or z0 out at values above
-// the tolerance), it runs once more on the dense tableau if it was factored (up to 500 rows),
-// then the fixed point from the start, within one pivot limit. The fixed point (frictionLcp =
-// false, or a normal row whose bounds straddle 0): each pass a boxed LCP on the bounds of the
-// previous answer, its active set re-solved with the true coupled bounds; a guess only seeds
-// those bounds. Details: docs/methods/pivoting.md, the "Lemke: ..." sections (the standard
-// form, the choice by size, the friction passes, friction as one LCP).
+// Singular A (redundant joints) ends on a ray in floating point: the solve runs once more from the
+// same start on A + delta I, delta = kLemkeRayShift max(1, max |A_ii|), and the answer with the
+// lower residual on A stands ("regularised"). Friction (findex): by default one LCP, each tangent
+// row written as l+ - l- with a slack (the Stewart-Trinkle / Anitescu-Potra box form,
+// core/src/pivoting/box_friction_lcp.hpp), which needs no fixed point (on the factored basis its
+// pivots are tested at 100x Options::pivotTolerance); its answer's active set is re-solved in the
+// original problem. When it ends short (a ray, or z0 out at values above the tolerance), it runs
+// once more on the dense tableau if it was factored (up to 500 rows), then the fixed point from the
+// start, within one pivot limit. The fixed point (frictionLcp = false, or a normal row whose bounds
+// straddle 0): each pass a boxed LCP on the bounds of the previous answer, its active set re-solved
+// with the true coupled bounds; a guess only seeds those bounds. Details: docs/methods/pivoting.md,
+// the "Lemke: ..." sections (the standard form, the choice by size, the friction passes, friction
+// as one LCP).
 #pragma once
 
 #include <iosfwd>
