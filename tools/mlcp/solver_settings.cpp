@@ -131,6 +131,8 @@ std::vector<SolverParam> dantzigAndLemkeParams() {
                                              "pivots between refactorizations of the basis"),
       param<L, &LemkeSolver::maxRows>("lemke", "max_rows", kCountFrom1,
                                       "largest problem accepted, rows"),
+      param<L, &LemkeSolver::frictionLcp>("lemke", "friction_lcp", kFlag,
+                                          "findex friction as one LCP (0: the fixed point)"),
   };
 }
 

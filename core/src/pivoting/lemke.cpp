@@ -8,6 +8,7 @@
 
 #include "linalg/sparse_lu.hpp"
 #include "mlcp/residual.hpp"
+#include "pivoting/box_friction_lcp.hpp"
 #include "pivoting/lemke_revised.hpp"
 #include "pivoting/lemke_tableau.hpp"
 
@@ -59,6 +60,19 @@ struct StandardForm {
 };
 
 bool isFree(double lo, double hi) { return lo == -kInf && hi == kInf; }
+
+// A friction LCP that ends short on the factored basis runs once more on the dense tableau up to
+// this many rows (its n + 2T): a tableau pivot is O(m^2), 16 times cheaper here than at
+// kLemkeFreeRowsTableauRows.
+constexpr int kLemkeFrictionTableauRows = 500;
+
+// On the factored basis the friction LCP's pivots are tested at this multiple of
+// Options::pivotTolerance: its slack rows (q = 0) and a singular A leave round-off entries near
+// 1e-12 of their column in the entering columns, and a pivot on one of them led BasicDemo's
+// 1137-row pile to a false ray. The tableau keeps the option as it is: at 100x a plank bridge's
+// island (free rows) ran to its pivot limit (docs/benchmarks.md, "lemke: friction as one LCP
+// against the fixed point").
+constexpr double kFrictionLcpPivotScale = 100;
 
 // Relative width below which a box [lo, hi] is treated as the point lo (see toStandard).
 constexpr double kNarrowBox = 1e-13;
@@ -495,6 +509,30 @@ Vector passAnswer(const Problem& problem, const SparseMatrix& A, const StandardF
   return best;
 }
 
+// The friction LCP's answer u polished in the original problem: its active set (a tangent row
+// at a bound where its slack is positive, other rows at a bound where x sits on it) re-solved by
+// resolveActiveSet with the true coupled bounds; kept only when no less accurate.
+Vector polishFrictionLcp(const Problem& problem, const SparseMatrix& A,
+                         const detail::BoxFrictionLcp& lcp, const Vector& u, bool sparse) {
+  Vector x = lcp.toFindex(u);
+  const int n = problem.size();
+  std::vector<RowState> states(n, RowState::Inside);
+  for (int i = 0; i < n; ++i) {
+    const double lo = problem.effectiveLo(i, x), hi = problem.effectiveHi(i, x);
+    const double near = 1e-12 * (1 + std::max(std::abs(lo), std::abs(hi)));
+    if (x[i] <= lo + near) states[i] = RowState::AtLo;
+    if (x[i] >= hi - near) states[i] = RowState::AtHi;
+  }
+  for (int k = 0; k < lcp.tangentRows(); ++k) {
+    const int t = lcp.tangentRow(k);
+    states[t] =
+        !(lcp.slack(u, k) > 0) ? RowState::Inside : (x[t] >= 0 ? RowState::AtHi : RowState::AtLo);
+  }
+  if (std::optional<Vector> refined = resolveActiveSet(problem, A, states, x, sparse))
+    if (!(residual(problem, *refined) > residual(problem, x))) return std::move(*refined);
+  return x;
+}
+
 }  // namespace
 
 void LemkeSolver::run(const Problem& problem, Vector& x, Result& result) {
@@ -546,16 +584,83 @@ void LemkeSolver::run(const Problem& problem, Vector& x, Result& result) {
 }
 
 void LemkeSolver::pivot(const Problem& problem, const SparseMatrix& A, Vector& x, Result& result) {
+  if (!frictionLcp || !problem.hasFindex()) return pivotPasses(problem, A, x, result, denseRows);
+  detail::BoxFrictionLcp lcp;
+  if (const std::string refused = lcp.build(problem, A); !refused.empty()) {
+    pivotPasses(problem, A, x, result, denseRows);
+    result.message += " (friction by the fixed point: " + refused + ")";
+    return;
+  }
+  const Problem& p = lcp.problem();
+  const int m = p.size();
+  Vector u = Vector::Zero(m);
+  const bool factored =
+      m > denseRows && (!hasFreeRows(p.lo, p.hi) || m > kLemkeFreeRowsTableauRows);
+  pivotPasses(p, p.sparseA(), u, result, denseRows, factored ? kFrictionLcpPivotScale : 1);
+  std::ostringstream os;
+  os << "friction as one LCP (" << lcp.tangentRows() << " tangent rows as l+ - l-, " << m
+     << " rows): ";
+  const double tolerance = options().tolerance;
+  bool solved = result.status == Status::Converged;
+  // A ray, or z0 out of the basis at values that are not the answer; the pivot limit and the
+  // time budget end the solve.
+  auto endedShort = [&](bool solvedNow, const Vector& answer) {
+    return result.status != Status::MaxIterations && result.status != Status::TimeLimit &&
+           (!solvedNow || !(residual(problem, answer) <= tolerance));
+  };
+  if (factored && m <= kLemkeFrictionTableauRows && endedShort(solved, lcp.toFindex(u))) {
+    // The factored basis's ratio tests on a singular A can follow round-off into a basis whose
+    // values are not the answer (docs/decisions.md): once more on the dense tableau, within the
+    // same pivot limit.
+    Vector again = Vector::Zero(m);
+    Result dense = result;
+    pivotPasses(p, p.sparseA(), again, dense, m);
+    if (dense.status == Status::Converged &&
+        (!solved || residual(problem, lcp.toFindex(again)) < residual(problem, lcp.toFindex(u)))) {
+      os << "the factored basis ended with " << result.message << "; on the dense tableau: ";
+      u = std::move(again);
+      result = std::move(dense);
+      solved = true;
+    }
+    result.iterations = dense.iterations;
+  }
+  result.message = os.str() + result.message;
+  // Unsolved (a ray, the pivot limit, the time budget): the start stands.
+  const Vector start = x;
+  if (solved) x = polishFrictionLcp(problem, A, lcp, u, problem.size() > denseRows);
+  if (!endedShort(solved, x)) return;
+  // Ended short (a ray, the pivot limit, an inaccurate basis): the fixed point from the same
+  // start, within what is left of the pivot limit; the more accurate answer stands.
+  Vector passes = start;
+  Result second = result;
+  pivotPasses(problem, A, passes, second, denseRows);
+  const double before = solved ? residual(problem, x) : residual(problem, start);
+  if (second.status == Status::Converged || residual(problem, passes) < before) {
+    second.message = result.message + "; then the fixed point: " + second.message;
+    result = std::move(second);
+    x = std::move(passes);
+  } else {
+    result.message += "; the fixed point after it did no better (" + second.message + ")";
+    result.iterations = second.iterations;
+    // Its pivot limit or the time budget ends the whole solve; otherwise the solve failed on A
+    // and runs once more on A + delta I (run()).
+    const bool spent = second.status == Status::MaxIterations || second.status == Status::TimeLimit;
+    result.status = spent ? second.status : Status::Failed;
+  }
+}
+
+void LemkeSolver::pivotPasses(const Problem& problem, const SparseMatrix& A, Vector& x,
+                              Result& result, int tableauRows, double pivotScale) {
   const Options& opt = options();
   const int n = problem.size();
   const bool friction = problem.hasFindex();
   // Free rows keep the tableau (its Schur elimination, see lemke.hpp) up to
   // kLemkeFreeRowsTableauRows.
   const bool revised =
-      n > denseRows && (!hasFreeRows(problem.lo, problem.hi) || n > kLemkeFreeRowsTableauRows);
+      n > tableauRows && (!hasFreeRows(problem.lo, problem.hi) || n > kLemkeFreeRowsTableauRows);
   const int outerLimit = friction ? std::max(1, opt.maxIterations) : 1;
   ToleranceRules rules;
-  rules.pivotTolerance = opt.pivotTolerance;
+  rules.pivotTolerance = opt.pivotTolerance * pivotScale;
   // A tableau pivot costs O(m^2) with m >= n, a factored one at least O(m): the clock is read
   // once per ~4096 / n^2 (tableau) or 4096 / n (factored) pivots, at most ~2% of their cost.
   const int clockEvery = std::max(1, 4096 / std::max(1, revised ? n : n * n));

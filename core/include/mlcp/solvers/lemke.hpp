@@ -28,15 +28,23 @@
 // passes together (MaxIterations); Options::timeBudget stops it between pivots (TimeLimit); the
 // start or the last pass's answer is then returned, never a half-pivoted tableau.
 //
-// Singular A (redundant joints) ends on a ray in floating point: the solve runs once more from
-// the same start on A + delta I, delta = kLemkeRayShift max(1, max |A_ii|), and the answer with
-// the lower residual on A stands ("regularised"). Friction (findex): an outer fixed point, each
-// pass a boxed LCP on the bounds of the previous answer, its active set re-solved with the true
-// coupled bounds; a guess only seeds those bounds. Details: docs/methods/pivoting.md, the
-// "Lemke: ..." sections (the standard form, the choice by size, the friction passes).
+// Singular A (redundant joints) ends on a ray in floating point: the solve runs once more from the
+// same start on A + delta I, delta = kLemkeRayShift max(1, max |A_ii|), and the answer with the
+// lower residual on A stands ("regularised"). Friction (findex): by default one LCP, each tangent
+// row written as l+ - l- with a slack (the Stewart-Trinkle / Anitescu-Potra box form,
+// core/src/pivoting/box_friction_lcp.hpp), which needs no fixed point (on the factored basis its
+// pivots are tested at 100x Options::pivotTolerance); its answer's active set is re-solved in the
+// original problem. When it ends short (a ray, or z0 out at values above the tolerance), it runs
+// once more on the dense tableau if it was factored (up to 500 rows), then the fixed point from the
+// start, within one pivot limit. The fixed point (frictionLcp = false, or a normal row whose bounds
+// straddle 0): each pass a boxed LCP on the bounds of the previous answer, its active set re-solved
+// with the true coupled bounds; a guess only seeds those bounds. Details: docs/methods/pivoting.md,
+// the "Lemke: ..." sections (the standard form, the choice by size, the friction passes, friction
+// as one LCP).
 #pragma once
 
 #include <iosfwd>
+#include <string>
 
 #include "mlcp/solver.hpp"
 #include "mlcp/thresholds.hpp"
@@ -57,13 +65,21 @@ class LemkeSolver : public Solver {
   // Largest problem accepted, in rows (Status::Unsupported above it, x untouched). Default
   // 5,000,000.
   int maxRows = 5000000;
+  // Friction (findex) as one LCP in l+, l- and a slack per tangent row (box_friction_lcp.hpp),
+  // the fixed point only after it ends short; false: the fixed point alone. Default true.
+  bool frictionLcp = true;
 
  protected:
   void run(const Problem& problem, Vector& x, Result& result) override;
 
  private:
-  // The pivoting (with the friction passes) on A, the problem's matrix or a regularised one.
+  // The pivoting on A, the problem's matrix or a regularised one: friction as one LCP when
+  // frictionLcp and the problem fits it, otherwise pivotPasses.
   void pivot(const Problem& problem, const SparseMatrix& A, Vector& x, Result& result);
+  // The standard form's pivoting, with the friction passes when the problem has findex; the
+  // dense tableau up to tableauRows rows; pivots tested at pivotScale x Options::pivotTolerance.
+  void pivotPasses(const Problem& problem, const SparseMatrix& A, Vector& x, Result& result,
+                   int tableauRows, double pivotScale = 1);
 };
 
 // Runs Lemke on a standard LCP (lo = 0, hi = +inf, no findex) and prints every tableau to out:
