@@ -48,6 +48,7 @@ class _LemkeParams(TypedDict, total=False):
     dense_rows: int  # 50, >= 0: most rows of the dense tableau (above: factored basis)
     refactor_period: int  # 50, >= 1: pivots between refactorizations of the basis
     max_rows: int  # 5000000, >= 1: largest problem accepted, rows
+    friction_lcp: bool  # True, a flag: findex friction as one LCP (False: the fixed point)
 
 class _ProximalParams(TypedDict, total=False):
     sigma: float  # 1, > 0: alpha = sigma r^nu mean(A_ii)

@@ -18,6 +18,7 @@
 #include "mlcp/registry.hpp"
 #include "mlcp/residual.hpp"
 #include "mlcp/solvers/ldlt.hpp"
+#include "mlcp/solvers/lemke.hpp"
 #include "mlcp/solvers/pgs.hpp"
 #include "pivoting/dantzig_small.hpp"  // the tiny dense path (internal)
 
@@ -493,6 +494,8 @@ TEST(Dantzig, SingularBridgeIslandsAreRetriedRegularised) {
     const Problem p = io::readProblemJson(std::string(MLCP_SOURCE_DIR) + "/tests/data/" + file);
     std::unique_ptr<Solver> s = makeSolver(name);
     ASSERT_TRUE(s);
+    // lemke's friction fixed point (its friction LCP solves this island on A: below).
+    if (auto* lemke = dynamic_cast<LemkeSolver*>(s.get())) lemke->frictionLcp = false;
     s->options().tolerance = 1e-6;
     Vector x;
     const Result r = s->solve(p, x);
@@ -500,6 +503,15 @@ TEST(Dantzig, SingularBridgeIslandsAreRetriedRegularised) {
     EXPECT_NE(r.message.find("regularised"), std::string::npos) << r.message;
     EXPECT_LE(accuracy(p, x).residual, 1e-6);
   }
+  // The same lemke island with findex friction as one LCP (the default): solved on A itself.
+  const Problem p = io::readProblemJson(std::string(MLCP_SOURCE_DIR) +
+                                        "/tests/data/plank_bridge_bullet_step21.json");
+  LemkeSolver lemke;
+  lemke.options().tolerance = 1e-6;
+  Vector x;
+  const Result r = lemke.solve(p, x);
+  EXPECT_TRUE(r.converged()) << toString(r.status) << " " << r.message;
+  EXPECT_LE(accuracy(p, x).residual, 1e-6);
 }
 
 // DantzigParams::breakdownShift sets the retry's delta (relative to max |A_ii|): the message
