@@ -14,11 +14,21 @@ namespace {
 // lexicographic filter (as the tableau does); more are decided pairwise, two rows at a time.
 constexpr size_t kStoredRows = 64;
 
+// Iterative refinement steps a refactorization spends on basic values whose backward error
+// exceeds kLemkeBackwardError, and wrong bases a run recovers from before it ends as it would.
+constexpr int kRefinementSteps = 2;
+constexpr int kMaxRecoveries = 3;
+
 // The basis matrix B = B0 E_1 ... E_k: a KLU factor of B0 and the eta file.
 class FactoredBasis {
  public:
-  FactoredBasis(const ColumnMatrix& M, const Vector& cover)
-      : M_(M), m_(static_cast<int>(M.cols())), cover_(cover) {}
+  FactoredBasis(const ColumnMatrix& M, const Vector& cover,
+                double pivotThreshold = kLemkeBasisPivotThreshold)
+      : M_(M), m_(static_cast<int>(M.cols())), cover_(cover) {
+    lu_.setPivotTolerance(pivotThreshold);
+  }
+
+  void setPivotThreshold(double t) { lu_.setPivotTolerance(t); }
 
   // out <- the column of variable v in [I, -M, -c].
   void column(int v, Vector& out) const {
@@ -92,9 +102,10 @@ class FactoredBasis {
 
   // The backward error of x as the basic values of `basis`: ||B x - q||_inf / (||q||_inf +
   // ||B||_inf ||x||_inf), O(nnz B). Scale-free and blind to B's conditioning: what an accurate
-  // solve leaves is a few units of round-off whatever the basis.
-  double backwardError(const std::vector<int>& basis, const Vector& x, const Vector& q) const {
-    Vector r = -q;
+  // solve leaves is a few units of round-off whatever the basis. r <- q - B x.
+  double backwardError(const std::vector<int>& basis, const Vector& x, const Vector& q,
+                       Vector& r) const {
+    r = -q;
     Vector rowSum = Vector::Zero(m_);
     for (int k = 0; k < m_; ++k) {
       const int v = basis[k];
@@ -113,6 +124,7 @@ class FactoredBasis {
     }
     const double scale =
         q.lpNorm<Eigen::Infinity>() + rowSum.maxCoeff() * x.lpNorm<Eigen::Infinity>();
+    r = -r;
     return scale > 0 ? r.lpNorm<Eigen::Infinity>() / scale : 0.0;
   }
 
@@ -140,13 +152,17 @@ class RevisedRun {
  public:
   RevisedRun(const ColumnMatrix& M, const Vector& q, const RevisedLemkeSettings& s,
              const Vector& cover)
-      : m_(static_cast<int>(M.cols())), q_(q), s_(s), basis_(M, cover), period_(s.refactorPeriod) {}
+      : m_(static_cast<int>(M.cols())),
+        q_(q),
+        s_(s),
+        basis_(M, cover, s.basisPivotThreshold),
+        period_(s.refactorPeriod) {}
 
   // Runs from `basis` (the slack basis, or a warm one whose covering vector is `cover`).
   LemkeOutcome run(std::vector<int> basis, int maxPivots, RevisedLemkeResult& res) {
     LemkeOutcome out;
     order_ = std::move(basis);
-    if (!refactor(res, /*checkUpdates=*/false)) return singular(out, res);
+    if (refactor(res, /*checkUpdates=*/false) == Check::Singular) return singular(out, res);
     bool feasible = true;
     for (int i = 0; i < m_; ++i) feasible = feasible && !(x_[i] < 0);
     if (feasible) return out;
@@ -155,6 +171,7 @@ class RevisedRun {
     int row = 0;
     for (int i = 1; i < m_; ++i)
       if (rules.compare(x_[i], x_[row]) <= 0) row = i;
+    saved_ = {order_, entering, row};
     Vector d;
     if (!enteringColumn(entering, d)) return singular(out, res);
     for (;;) {
@@ -173,7 +190,36 @@ class RevisedRun {
       order_[row] = entering;
       basis_.update(row, d);
       ++out.pivots;
-      if (basis_.etas() >= period_ && !refactor(res, true)) return singular(out, res);
+      // The end is checked too: a wrong basis is seen before it is returned.
+      if (basis_.etas() >= period_ || leaving == 2 * m_) {
+        const Check c = refactor(res, true);
+        if (c == Check::Singular) return singular(out, res);
+        if (c == Check::Wrong && res.recoveries < kMaxRecoveries) {
+          // Back to the last basis checked right, with strict pivoting and a shorter period.
+          ++res.recoveries;
+          basis_.setPivotThreshold(1.0);
+          period_ = std::max(4, period_ / 2);
+          order_ = saved_.order;
+          if (refactor(res, false) == Check::Singular) return singular(out, res);
+          entering = saved_.entering;
+          row = saved_.row;
+          if (!enteringColumn(entering, d)) return singular(out, res);
+          continue;
+        }
+        if (c == Check::Right && leaving != 2 * m_) {
+          const int next = leaving < m_ ? leaving + m_ : leaving - m_;
+          if (!enteringColumn(next, d)) return singular(out, res);
+          saved_ = {order_, next, leavingRow(d)};
+          if (saved_.row < 0) {
+            out.end = LemkeEnd::Ray;
+            out.entering = next;
+            return out;
+          }
+          entering = next;
+          row = saved_.row;
+          continue;
+        }
+      }
       if (leaving == 2 * m_) return out;
       entering = leaving < m_ ? leaving + m_ : leaving - m_;
       if (!enteringColumn(entering, d)) return singular(out, res);
@@ -201,22 +247,37 @@ class RevisedRun {
     return basis_.ftran(d);
   }
 
-  // Factors B again and recomputes x_B = B^-1 q; halves the period when the eta-updated values
-  // it replaces had a backward error above kLemkeBackwardError (thresholds.hpp). Why not their
-  // forward drift from the fresh values: that measures B's conditioning, which a factorization
-  // cannot change (the cone LCP of a 55-box pyramid drifts 1e-8 at backward errors of 1e-13, and
-  // a drift rule refactored it every 4 pivots).
-  bool refactor(RevisedLemkeResult& res, bool checkUpdates) {
-    ++res.refactorizations;
+  // What a refactorization found: the basic values B^-1 q accurate and feasible (Right), not
+  // (Wrong: the basis or its factor went wrong somewhere), or B singular.
+  enum class Check { Right, Wrong, Singular };
 
-    Vector fresh = q_;
-    if (!basis_.factor(order_) || !basis_.ftran(fresh)) return false;
-    if (checkUpdates) {
-      if (basis_.backwardError(order_, x_, q_) > kLemkeBackwardError)
-        period_ = std::max(4, period_ / 2);
+  // Factors B again and recomputes x_B = B^-1 q, refined while its backward error exceeds
+  // kLemkeBackwardError (thresholds.hpp); halves the period when the eta-updated values it
+  // replaces had a backward error above it. Why not their forward drift from the fresh values:
+  // that measures B's conditioning, which a factorization cannot change (the cone LCP of a
+  // 55-box pyramid drifts 1e-8 at backward errors of 1e-13, and a drift rule refactored it
+  // every 4 pivots). Wrong: the fresh values stay inaccurate, or one is below
+  // -kLemkeInfeasibility (1 + max |x_B|), which a right path never leaves (its values are >= 0
+  // up to round-off).
+  Check refactor(RevisedLemkeResult& res, bool checkUpdates) {
+    ++res.refactorizations;
+    Vector fresh = q_, r;
+    if (!basis_.factor(order_) || !basis_.ftran(fresh)) return Check::Singular;
+    double error = basis_.backwardError(order_, fresh, q_, r);
+    for (int k = 0; k < kRefinementSteps && error > kLemkeBackwardError; ++k) {
+      if (!basis_.ftran(r)) return Check::Singular;
+      Vector refined = fresh + r, rr;
+      const double e = basis_.backwardError(order_, refined, q_, rr);
+      if (!(e < error)) break;
+      fresh.swap(refined);
+      r.swap(rr);
+      error = e;
     }
+    if (checkUpdates && basis_.backwardError(order_, x_, q_, r) > kLemkeBackwardError)
+      period_ = std::max(4, period_ / 2);
     x_ = std::move(fresh);
-    return true;
+    const double floor = -kLemkeInfeasibility * (1 + x_.lpNorm<Eigen::Infinity>());
+    return error <= kLemkeBackwardError && x_.minCoeff() >= floor ? Check::Right : Check::Wrong;
   }
 
   // Row e_i' B^-1.
@@ -294,6 +355,13 @@ class RevisedRun {
     return {best};
   }
 
+  // The last basis checked right, the variable entering it and its row.
+  struct Saved {
+    std::vector<int> order;
+    int entering = 0;
+    int row = 0;
+  };
+
   int m_;
   const Vector& q_;
   const RevisedLemkeSettings& s_;
@@ -301,6 +369,7 @@ class RevisedRun {
   int period_;
   std::vector<int> order_;
   Vector x_;
+  Saved saved_;
 };
 
 bool complementary(const std::vector<int>& basis, int m) {
@@ -349,9 +418,11 @@ RevisedLemkeResult revisedLemke(const ColumnMatrix& M, const Vector& q,
     RevisedLemkeResult attempt;
     attempt.outcome = warm.run(settings.warmBasis, std::max(1, maxPivots / 2), attempt);
     res.refactorizations += attempt.refactorizations;
+    res.recoveries += attempt.recoveries;
     if (attempt.outcome.end == LemkeEnd::Solved || attempt.outcome.end == LemkeEnd::Stopped) {
       res.outcome = attempt.outcome;
       res.refactorizations = attempt.refactorizations;
+      res.recoveries = attempt.recoveries;
       finish(warm, m, res);
       return res;
     }
