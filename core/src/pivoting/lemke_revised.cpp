@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "linalg/sparse_lu.hpp"
 #include "mlcp/thresholds.hpp"
@@ -61,6 +62,9 @@ class FactoredBasis {
       colStart_.push_back(static_cast<int>(rows_.size()));
     }
     etas_.clear();
+    etaIndex_.clear();
+    etaValue_.clear();
+    denseValue_.clear();
     return lu_.analyze(m_, colStart_, rows_) && lu_.factor(values_);
   }
 
@@ -69,7 +73,11 @@ class FactoredBasis {
     if (!lu_.solveTransposed(y)) return false;
     for (const Eta& e : etas_) {
       const double yr = y[e.row] / e.pivot;
-      for (size_t k = 0; k < e.index.size(); ++k) y[e.index[k]] -= e.value[k] * yr;
+      if (e.dense) {
+        y -= Eigen::Map<const Vector>(&denseValue_[e.begin], m_) * yr;
+      } else {
+        for (size_t k = e.begin; k < e.end; ++k) y[etaIndex_[k]] -= etaValue_[k] * yr;
+      }
       y[e.row] = yr;
     }
     return y.allFinite();
@@ -79,23 +87,39 @@ class FactoredBasis {
   bool btran(Vector& y) {
     for (auto e = etas_.rbegin(); e != etas_.rend(); ++e) {
       double s = y[e->row];
-      for (size_t k = 0; k < e->index.size(); ++k) s -= e->value[k] * y[e->index[k]];
+      if (e->dense) {
+        s -= Eigen::Map<const Vector>(&denseValue_[e->begin], m_).dot(y);
+      } else {
+        for (size_t k = e->begin; k < e->end; ++k) s -= etaValue_[k] * y[etaIndex_[k]];
+      }
       y[e->row] = s / e->pivot;
     }
     return lu_.solve(y);
   }
 
-  // Records the pivot on row r with the tableau column d = B^-1 a.
+  // Records the pivot on row r with the tableau column d = B^-1 a: its nonzeros with their rows,
+  // or, when they are over a third of the column, all m entries (d_r stored as 0), which the
+  // solves apply as one vector operation.
   void update(int r, const Vector& d) {
     Eta e;
     e.row = r;
     e.pivot = d[r];
-    for (int i = 0; i < m_; ++i)
-      if (i != r && d[i] != 0) {
-        e.index.push_back(i);
-        e.value.push_back(d[i]);
-      }
-    etas_.push_back(std::move(e));
+    const Eigen::Index nonzeros = (d.array() != 0).count() - (d[r] != 0);
+    e.dense = 3 * nonzeros > m_;
+    if (e.dense) {
+      e.begin = denseValue_.size();
+      denseValue_.insert(denseValue_.end(), d.data(), d.data() + m_);
+      denseValue_[e.begin + r] = 0;
+    } else {
+      e.begin = etaIndex_.size();
+      for (int i = 0; i < m_; ++i)
+        if (i != r && d[i] != 0) {
+          etaIndex_.push_back(i);
+          etaValue_.push_back(d[i]);
+        }
+    }
+    e.end = e.dense ? e.begin + m_ : etaIndex_.size();
+    etas_.push_back(e);
   }
 
   int etas() const { return static_cast<int>(etas_.size()); }
@@ -136,14 +160,16 @@ class FactoredBasis {
   struct Eta {
     int row = 0;
     double pivot = 1;
-    std::vector<int> index;
-    std::vector<double> value;
+    bool dense = false;
+    size_t begin = 0, end = 0;  // into etaIndex_ and etaValue_, or denseValue_
   };
   const ColumnMatrix& M_;
   int m_;
   Vector cover_;
   linalg::SparseLu lu_;
   std::vector<Eta> etas_;
+  std::vector<int> etaIndex_;
+  std::vector<double> etaValue_, denseValue_;
   std::vector<int> colStart_, rows_;
   std::vector<double> values_;
 };
@@ -293,17 +319,19 @@ class RevisedRun {
   int leavingRow(const Vector& d) {
     const ToleranceRules& rules = s_.rules;
     const double colMax = d.lpNorm<Eigen::Infinity>();
+    // Two passes over the column: the ratios (+inf where the entry is not a pivot) and their
+    // minimum, then the rows tied with it.
+    constexpr double kNone = std::numeric_limits<double>::infinity();
+    ratio_.resize(m_);
+    double best = kNone;
+    for (int i = 0; i < m_; ++i) {
+      ratio_[i] = rules.positive(d[i], colMax) ? rules.clampRhs(x_[i]) / d[i] : kNone;
+      best = std::min(best, ratio_[i]);
+    }
+    if (best == kNone) return -1;
     std::vector<int> ties;
     for (int i = 0; i < m_; ++i)
-      if (rules.positive(d[i], colMax)) ties.push_back(i);
-    if (ties.empty()) return -1;
-    auto ratio = [&](int i) { return rules.clampRhs(x_[i]) / d[i]; };
-    double best = ratio(ties[0]);
-    for (int i : ties) best = std::min(best, ratio(i));
-    std::vector<int> kept;
-    for (int i : ties)
-      if (rules.compare(ratio(i), best) == 0) kept.push_back(i);
-    ties.swap(kept);
+      if (ratio_[i] != kNone && rules.compare(ratio_[i], best) == 0) ties.push_back(i);
     for (int i : ties)
       if (order_[i] == 2 * m_) return i;
     if (ties.size() > 1)
@@ -369,6 +397,7 @@ class RevisedRun {
   int period_;
   std::vector<int> order_;
   Vector x_;
+  Vector ratio_;  // leavingRow's ratios (scratch)
   Saved saved_;
 };
 
