@@ -17,6 +17,10 @@
 //   blockSparseLcp     blocks of 3 rows (a contact's normal and two tangents): dense diagonal
 //                      blocks and `coupling` random off-diagonal blocks a block row, within
 //                      `blockBand` blocks; symmetric or not; diagonal as above.
+//   contactLcp         a findex contact problem on blockSparseLcp's SPD matrix: each block a
+//                      contact, its normal row [0, inf) approaching (b in [-1, -0.2]), its two
+//                      tangent rows boxed by +-mu x_normal (b in [-1, 1]). No constructed
+//                      solution (`solution` is empty): answers are checked by their residual.
 // Memory: nnz(A) = n (1 + 2 offsets) or n (3 + 6 coupling); fill of the KLU factor grows with the
 // bandwidth.
 #pragma once
@@ -158,6 +162,26 @@ inline BandedLcp blockSparseLcp(int n, int blockBand, int coupling, bool symmetr
   return detail_banded::finish(
       n, std::move(t), margin, 0.1, rng,
       std::string(symmetric ? "block SPD" : "block P") + " bw " + std::to_string(blockBand));
+}
+
+inline BandedLcp contactLcp(int n, int blockBand, double mu, unsigned seed) {
+  BandedLcp lcp = blockSparseLcp(n - n % 3, blockBand, 2, true, seed);
+  Problem& p = lcp.problem;
+  std::mt19937 rng(seed + 1);
+  std::uniform_real_distribution<double> u(-1, 1), approach(0.2, 1);
+  p.findex.assign(p.size(), -1);
+  for (int k = 0; k < p.size(); k += 3) {
+    p.b[k] = -approach(rng);
+    for (int t = 1; t <= 2; ++t) {
+      p.b[k + t] = u(rng);
+      p.lo[k + t] = -mu;
+      p.hi[k + t] = mu;
+      p.findex[k + t] = k;
+    }
+  }
+  lcp.solution = Vector();
+  lcp.name = "contacts bw " + std::to_string(blockBand);
+  return lcp;
 }
 
 }  // namespace mlcp::test
