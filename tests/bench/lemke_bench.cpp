@@ -10,9 +10,10 @@
 // The stress family (banded_lcp.hpp: the 1/7/131 stencil, random sparse bands of bandwidth 300
 // symmetric and not, 3-row blocks coupled within 100 blocks symmetric and not; --seeds seeds
 // each) at the --stress sizes, factored basis only, prints a second table: the answer checked
-// against the constructed x*, the time per pivot, and one KLU analysis, factorization and solve
-// of the final basis (the work of a refactorization) over the refactorization period: the
-// per-pivot share of refactoring, which the time per pivot is compared with. Last, findex
+// against the constructed x*, the time per pivot, and what KLU takes on the final basis: an
+// analysis and factorization (F, a refactorization's work) and a solve (S, the least a pivot
+// does). Two ratios: the time per pivot over F / P + S (P the refactorization period: a pivot's
+// own solve and its share of refactoring) and over (F + S) / P. Last, findex
 // contact problems on the block SPD matrices (contactLcp), checked by their residual; their KLU
 // column factors the basis of the answer's x > 0 in A's columns, a proxy for the bases of their
 // standard form (tangent rows split in two).
@@ -99,9 +100,13 @@ void compare(const std::string& name, const Problem& p, const Vector* solution, 
   }
 }
 
-// Seconds of one refactorization's work on the basis of the answer x (y_j basic where x_j > 0,
-// w_i otherwise): KLU analysis, factorization and one solve, the best of 3.
-double refactorSeconds(const Problem& p, const Vector& x) {
+struct KluSeconds {
+  double factor = -1, solve = -1;
+};
+
+// KLU on the basis of the answer x (y_j basic where x_j > 0, w_i otherwise): seconds of an
+// analysis and factorization and of one solve, each the best of 3.
+KluSeconds kluSeconds(const Problem& p, const Vector& x) {
   const int n = p.size();
   const SparseMatrix& A = p.sparseA();  // row-major: row j of A is column j of A'
   SparseMatrix At = A.transpose();      // rows of At: columns of A
@@ -120,15 +125,18 @@ double refactorSeconds(const Problem& p, const Vector& x) {
     }
     start.push_back(static_cast<int>(rows.size()));
   }
-  double best = 1e300;
+  KluSeconds best{1e300, 1e300};
   for (int k = 0; k < 3; ++k) {
     linalg::SparseLu lu;
     lu.setPivotTolerance(kLemkeBasisPivotThreshold);
     Vector y = p.b;
     const double t0 = nowSeconds();
-    const bool ok = lu.analyze(n, start, rows) && lu.factor(values) && lu.solveTransposed(y);
-    best = std::min(best, nowSeconds() - t0);
-    if (!ok) return -1;
+    if (!lu.analyze(n, start, rows) || !lu.factor(values)) return {};
+    const double t1 = nowSeconds();
+    if (!lu.solveTransposed(y)) return {};
+    const double t2 = nowSeconds();
+    best.factor = std::min(best.factor, t1 - t0);
+    best.solve = std::min(best.solve, t2 - t1);
   }
   return best;
 }
@@ -137,7 +145,7 @@ void stress(const test::BandedLcp& lcp, int period, const Options& opt, const st
   if (lcp.name.find(only) == std::string::npos) return;
   const Problem& p = lcp.problem;
   const Timing t = timeSolve(p, false, 1, period, opt);
-  const double klu = refactorSeconds(p, t.x);
+  const KluSeconds klu = kluSeconds(p, t.x);
   const double perPivot = t.seconds / std::max(1, t.result.iterations);
   // Checked here, not by the solver: the natural map from A, b and the bounds (a friction
   // row's at mu |x_normal|), and the distance to x* where it is known.
@@ -154,10 +162,12 @@ void stress(const test::BandedLcp& lcp, int period, const Options& opt, const st
   if (lcp.solution.size() == p.size())
     std::snprintf(distance, sizeof distance, "%.1e",
                   (t.x - lcp.solution).lpNorm<Eigen::Infinity>());
-  std::printf("| %s | %d | %lld | %.4g | %d | %s | %.1e | %s | %.3g | %.3g | %.2f |\n",
-              lcp.name.c_str(), p.size(), static_cast<long long>(p.sparseA().nonZeros()), t.seconds,
-              t.result.iterations, toString(t.result.status), natural, distance, perPivot * 1e3,
-              klu / period * 1e3, perPivot / (klu / period));
+  std::printf(
+      "| %s | %d | %lld | %.4g | %d | %s | %.1e | %s | %.3g | %.3g | %.3g | %.2f | %.2f |\n",
+      lcp.name.c_str(), p.size(), static_cast<long long>(p.sparseA().nonZeros()), t.seconds,
+      t.result.iterations, toString(t.result.status), natural, distance, perPivot * 1e3,
+      klu.factor * 1e3, klu.solve * 1e3, perPivot / (klu.factor / period + klu.solve),
+      perPivot / ((klu.factor + klu.solve) / period));
   std::fflush(stdout);
 }
 
@@ -204,7 +214,8 @@ int main(int argc, char** argv) {
   if (stressSizes.empty()) return 0;
   std::printf(
       "\n| family | rows | nnz(A) | seconds | pivots | status | residual | max abs(x - x*) | "
-      "ms / pivot | KLU ms / period | ratio |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
+      "ms / pivot | KLU F ms | KLU S ms | / (F/P + S) | / ((F + S)/P) |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (int n : stressSizes)
     for (int seed = 1; seed <= seeds; ++seed) {
       const unsigned s = 100u * seed + n;
