@@ -182,7 +182,8 @@ class RevisedRun {
         q_(q),
         s_(s),
         basis_(M, cover, s.basisPivotThreshold),
-        period_(s.refactorPeriod) {}
+        period_(s.refactorPeriod),
+        strict_(s.basisPivotThreshold >= 1.0) {}
 
   // Runs from `basis` (the slack basis, or a warm one whose covering vector is `cover`).
   LemkeOutcome run(std::vector<int> basis, int maxPivots, RevisedLemkeResult& res) {
@@ -223,7 +224,7 @@ class RevisedRun {
         if (c == Check::Wrong && res.recoveries < kMaxRecoveries) {
           // Back to the last basis checked right, with strict pivoting and a shorter period.
           ++res.recoveries;
-          basis_.setPivotThreshold(1.0);
+          strictPivoting();
           period_ = std::max(4, period_ / 2);
           order_ = saved_.order;
           if (refactor(res, false) == Check::Singular) return singular(out, res);
@@ -290,6 +291,15 @@ class RevisedRun {
     Vector fresh = q_, r;
     if (!basis_.factor(order_) || !basis_.ftran(fresh)) return Check::Singular;
     double error = basis_.backwardError(order_, fresh, q_, r);
+    if (error > kLemkeBackwardError && !strict_) {
+      // The factor itself is inaccurate: replaced by plain partial pivoting's before any entering
+      // column is solved with it.
+      ++res.recoveries;
+      strictPivoting();
+      fresh = q_;
+      if (!basis_.factor(order_) || !basis_.ftran(fresh)) return Check::Singular;
+      error = basis_.backwardError(order_, fresh, q_, r);
+    }
     for (int k = 0; k < kRefinementSteps && error > kLemkeBackwardError; ++k) {
       if (!basis_.ftran(r)) return Check::Singular;
       Vector refined = fresh + r, rr;
@@ -304,6 +314,11 @@ class RevisedRun {
     x_ = std::move(fresh);
     const double floor = -kLemkeInfeasibility * (1 + x_.lpNorm<Eigen::Infinity>());
     return error <= kLemkeBackwardError && x_.minCoeff() >= floor ? Check::Right : Check::Wrong;
+  }
+
+  void strictPivoting() {
+    strict_ = true;
+    basis_.setPivotThreshold(1.0);
   }
 
   // Row e_i' B^-1.
@@ -395,6 +410,7 @@ class RevisedRun {
   const RevisedLemkeSettings& s_;
   FactoredBasis basis_;
   int period_;
+  bool strict_;  // B is factored with plain partial pivoting
   std::vector<int> order_;
   Vector x_;
   Vector ratio_;  // leavingRow's ratios (scratch)

@@ -24,8 +24,10 @@
 // returned basic values with a backward error of 0.4 and -1.2 among them, and the method
 // pivoted on and ended, z0 leaving, on a wrong basis.
 //
-// The check: each refactorization (and the end, when z0 leaves) computes x_B fresh, refines it
-// while its backward error exceeds kLemkeBackwardError (two steps at most), and calls the basis
+// The check: each refactorization (and the end, when z0 leaves) computes x_B fresh. A backward
+// error above kLemkeBackwardError there means the factor itself is inaccurate: under a pivot
+// threshold below 1, B is factored again with plain partial pivoting at once. x_B is then
+// refined while its backward error exceeds the limit (two steps at most), and the basis is
 // wrong when it stays inaccurate or has a value below -kLemkeInfeasibility (1 + ||x_B||): the
 // invariant x_B >= 0 held on the right path. A wrong basis is recovered from: the run returns to
 // the last basis checked right (its entering variable and row kept with it), factors it with
@@ -52,7 +54,7 @@ struct RevisedLemkeResult {
   std::vector<int> basis;    // the final basis (variables w_i = i, y_j = m + j, z0 = 2 m)
   bool singular = false;     // a factorization of the basis failed (outcome.end is Ray then)
   int refactorizations = 0;
-  int recoveries = 0;  // returns to the last basis checked right after a wrong one
+  int recoveries = 0;  // strict refactorizations and returns to the last basis checked right
 };
 
 struct RevisedLemkeSettings {
