@@ -51,7 +51,7 @@ def command(out, name):
     cmd = cmd.replace(REPO + "/", "")
     cmd = re.sub(r"^env ", "", cmd)
     # The Siconos files as the glob that named them.
-    cmd = re.sub(r"(\S+/lcp/\S+\.dat ?)+", "../shared/data/siconos/lcp/*.dat ", cmd)
+    cmd = re.sub(r"(\S+/lcp/\S+\.dat ?)+", "tests/data/siconos/lcp/*.dat ", cmd)
     return cmd.strip()
 
 

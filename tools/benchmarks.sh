@@ -4,8 +4,7 @@
 # --full adds the long Bullet runs (a demo's first 300 steps, its steady state, 210 boxes:
 # about 10 more minutes, mostly the stock btMLCPSolver's Dantzig). Each table in the file is
 # replaced only when its benchmark ran, and carries the commit and date of its own run. The raw
-# outputs stay in BUILD_DIR/benchmarks/. The Siconos table needs the corpus (MLCP_SICONOS_DIR,
-# default ../shared/data/siconos beside the repository); without it that table is left as is.
+# outputs stay in BUILD_DIR/benchmarks/. The Siconos table reads the corpus in tests/data/siconos.
 set -euo pipefail
 repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 full=0
@@ -25,7 +24,7 @@ rm -f "$out"/*.txt "$out"/*.cmd
     ':!tools/benchmarks.sh' ':!tools/benchmarks.py' | grep -q . && echo "+ uncommitted changes"
   date -u '+%Y-%m-%d %H:%M UTC'
 } > "$out/run" || true
-siconos=${MLCP_SICONOS_DIR:-$repo/../shared/data/siconos}
+siconos=$repo/tests/data/siconos
 
 cmake --build "$build" --target mlcp core_bench bullet_bench ode_bench ode_pgs_bench > /dev/null
 
@@ -60,9 +59,7 @@ run pgs-vs-si-baseline env MLCP_CPU_PATH=baseline "$bin/bullet_bench" --pgs-vs-s
   --sweeps 10
 run ode-dantzig "$bench/ode_bench" 10 5
 run ode-pgs "$bench/ode_pgs_bench" 100 40 20
-if [[ -d $siconos/lcp ]]; then
-  run siconos "$bin/mlcp" table --markdown "$siconos"/lcp/*.dat --solvers pgs,lemke,dantzig,auto
-fi
+run siconos "$bin/mlcp" table --markdown "$siconos"/lcp/*.dat --solvers pgs,lemke,dantzig,auto
 
 cut -d' ' -f1 /proc/loadavg > "$out/load"
 python3 "$repo/tools/benchmarks.py" "$out" "$repo/docs/benchmarks.md"

@@ -25,7 +25,7 @@ cmake --build "$build" -j "$jobs" --target "${targets[@]}"
 seed() {  # seed TARGET: the files its corpus starts from
   case $1 in
     problem_reader_fuzz) ls "$repo"/tests/data/*.json "$repo"/tests/data/bad/* "$repo"/tests/data/fuzz/problem_* \
-      "${MLCP_SICONOS_DIR:-$repo/../shared/data/siconos}"/lcp/*.dat 2>/dev/null || true ;;
+      "$repo"/tests/data/siconos/lcp/*.dat 2>/dev/null || true ;;
     scene_parser_fuzz) ls "$repo"/scenes/*.json "$repo"/tests/data/fuzz/scene_* 2>/dev/null || true ;;
     solver_fuzz) ls "$repo"/tests/data/*.json "$repo"/tests/data/fuzz/solver_* 2>/dev/null || true ;;
   esac

@@ -6,14 +6,13 @@
 # index.html. Needs a built mlcp and the chart venv; prints where the report is.
 #
 # Environment: MLCP (the mlcp program, default build/bin/mlcp), MLCP_PYTHON (default
-# .venv/bin/python), MLCP_SICONOS_DIR (default ../shared/data/siconos; the table is left out
-# when it is missing), MLCP_REPORT_QUICK=1 (a smoke run: 2 scenes, 5 steps; for the tests).
+# .venv/bin/python), MLCP_REPORT_QUICK=1 (a smoke run: 2 scenes, 5 steps; for the tests).
 set -euo pipefail
 repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 out=${1:-$repo/build/report}
 mlcp=${MLCP:-$repo/build/bin/mlcp}
 py=${MLCP_PYTHON:-$repo/.venv/bin/python}
-siconos=${MLCP_SICONOS_DIR:-$repo/../shared/data/siconos}
+siconos=$repo/tests/data/siconos
 export MLCP_PYTHON=$py  # `mlcp chart` uses the same interpreter
 
 [ -x "$mlcp" ] || { echo "report: $mlcp is missing; build first (tools/build.sh)" >&2; exit 2; }
@@ -90,21 +89,16 @@ else
   notes+=("No stability map: this mlcp has no 'stability' command.")
 fi
 
-if [ -d "$siconos/lcp" ]; then
-  printf 'report: seed and Siconos solver table ... '
-  t0=$SECONDS
-  "$mlcp" table --markdown "$repo/tests/data/seed_lemke.json" "$repo/tests/data/spd.json" \
-    "$repo/tests/data/boxed.json" "$repo/tests/data/findex.json" "$siconos"/lcp/*.dat \
-    --solvers pgs,lemke,dantzig,auto > "$out/table.md"
-  if [ -d "$siconos/mlcp" ]; then
-    printf '\nSiconos MLCP files (free rows for the equalities), tolerance 1e-9:\n\n' >> "$out/table.md"
-    "$mlcp" table --markdown "$siconos"/mlcp/*.dat --solvers pgs,lemke,dantzig,auto --tol 1e-9 \
-      >> "$out/table.md"
-  fi
-  echo "$((SECONDS - t0)) s"
-else
-  notes+=("No Siconos table: $siconos/lcp is missing (set MLCP_SICONOS_DIR).")
-fi
+# The Siconos corpus is test data in the repository (tests/data/siconos).
+printf 'report: seed and Siconos solver table ... '
+t0=$SECONDS
+"$mlcp" table --markdown "$repo/tests/data/seed_lemke.json" "$repo/tests/data/spd.json" \
+  "$repo/tests/data/boxed.json" "$repo/tests/data/findex.json" "$siconos"/lcp/*.dat \
+  --solvers pgs,lemke,dantzig,auto > "$out/table.md"
+printf '\nSiconos MLCP files (free rows for the equalities), tolerance 1e-9:\n\n' >> "$out/table.md"
+"$mlcp" table --markdown "$siconos"/mlcp/*.dat --solvers pgs,lemke,dantzig,auto --tol 1e-9 \
+  >> "$out/table.md"
+echo "$((SECONDS - t0)) s"
 
 elapsed=$((SECONDS - start))
 notes+=("Made by tools/report.sh in ${elapsed} s on $(nproc) cores, $(date -u '+%Y-%m-%d %H:%M UTC'), commit $(git -C "$repo" rev-parse --short HEAD 2> /dev/null || echo unknown).")

@@ -7,6 +7,7 @@ The columns each chart reads, and what its points, lines and colours mean: tools
 """
 
 import csv
+import importlib
 import math
 import os
 import re
@@ -19,9 +20,21 @@ from collections import OrderedDict, defaultdict
 plt = ListedColormap = Line2D = Patch = FuncFormatter = LogLocator = NullFormatter = None
 
 
+def require(module, extra):
+    """Imports an optional dependency of the package, or raises an ImportError that names the
+    extra installing it (`pip install "mlcp[chart]"`; from a clone, `pip install ".[chart]"`)."""
+    try:
+        return importlib.import_module(module)
+    except ImportError as e:
+        raise ImportError(
+            f"{module} is not installed; mlcp's '{extra}' extra installs it: "
+            f"pip install \"mlcp[{extra}]\" (from a clone: pip install \".[{extra}]\")",
+            name=module) from e
+
+
 def load_pyplot():
     global plt, ListedColormap, Line2D, Patch, FuncFormatter, LogLocator, NullFormatter
-    import matplotlib
+    matplotlib = require("matplotlib", "chart")
 
     matplotlib.use("Agg")  # headless: CI has no display
     import matplotlib.pyplot as plt

@@ -18,6 +18,7 @@ from typing import Any, Callable, Dict, Iterable, List, Optional, Sequence, Tupl
 import numpy as np
 
 from . import _mlcp
+from .chart import require
 
 _STEP_COLUMNS = ("solver_ms", "step_ms", "residual", "iterations", "status", "fallbacks",
                  "choice", "contacts", "max_penetration", "joint_error", "energy", "momentum",
@@ -64,7 +65,7 @@ def sweep(scenes: "Iterable[str | os.PathLike[str]]", engines: Optional[Sequence
     engines' worlds are not stepped from two threads at once). Bad input raises ValueError with the CLI's
     message.
     """
-    import pandas as pd
+    pd = require("pandas", "sweep")
 
     if not 1 <= int(repeat) <= 100:
         raise ValueError(f"repeat must be 1 to 100, not {repeat}")
@@ -121,7 +122,7 @@ def stability(engines: Optional[Sequence[str]] = None, solvers: Optional[Sequenc
     CLI's default (`mlcp stability --help`), and a pandas DataFrame with the columns of its
     CSV, one row per cell in the CLI's order. quick: a 2 x 2 grid of each kind and 1 s per cell.
     executor as in sweep(). Bad arguments raise ValueError with the CLI's message."""
-    import pandas as pd
+    pd = require("pandas", "sweep")
 
     given = dict(engines=engines, solvers=solvers, grids=grids, ratios=ratios, heights=heights,
                  time_steps=time_steps, iteration_counts=iteration_counts,

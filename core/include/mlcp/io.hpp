@@ -11,7 +11,7 @@
 //    "findex": [-1, -1, 0]}    optional, default all -1
 //
 // Siconos LCP .dat files (find z >= 0, w = M z + q >= 0, z'w = 0; their convention is ours):
-// dense (storage 0) and sparse-block (storage 1) matrices, see ../shared/data/siconos/README.md.
+// dense (storage 0) and sparse-block (storage 1) matrices, see tests/data/siconos/README.md.
 // Both store their values column by column (the dense form prints one column per line).
 //
 // Siconos MLCP .dat files (`*mlcp.dat`; Siconos' mixedLinearComplementarity_newFromFile):

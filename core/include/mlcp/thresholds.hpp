@@ -50,6 +50,13 @@ inline constexpr double kLemkeRayShift = 1e-12;
 // values' backward error ||B x - q|| / (||q|| + ||B|| ||x||) exceeds this: ~1e6 units of
 // round-off, far below what changes a ratio test's choice; a fresh factorization leaves ~1e-16.
 inline constexpr double kLemkeBackwardError = 1e-10;
+// lemke's factored basis factors B with this KLU pivot threshold, plain partial pivoting: at
+// KLU's default 0.001 (the diagonal kept down to 1e-3 of its column) a 5,000-row banded
+// P-matrix basis was factored with a backward error of 0.4 and lemke ended on a wrong basis.
+inline constexpr double kLemkeBasisPivotThreshold = 1.0;
+// lemke's factored basis is wrong when a basic value computed fresh at a refactorization is
+// below -this * (1 + max |x_B|): a right path keeps x_B >= 0 up to round-off (~1e-16 relative).
+inline constexpr double kLemkeInfeasibility = 1e-9;
 // The minimum-norm least-squares rank decision, times max(1, max |A_ii|): directions 1e-6
 // below the stiffest are where an exact answer would throw bodies (linalg/min_norm.hpp).
 inline constexpr double kMinNormShift = 1e-6;

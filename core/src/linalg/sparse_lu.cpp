@@ -41,6 +41,8 @@ bool SparseLu::analyze(int n, const std::vector<int>& rowStart, const std::vecto
   return true;
 }
 
+void SparseLu::setPivotTolerance(double tol) { s_->common.tol = tol; }
+
 bool SparseLu::factor(const std::vector<double>& values) {
   State& s = *s_;
   s.clearNumeric();

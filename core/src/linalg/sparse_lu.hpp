@@ -39,6 +39,9 @@ class SparseLu {
   // y <- J^-T y with the last factor (the same factor, no second factorization). False like
   // solve().
   bool solveTransposed(Vector& y);
+  // KLU's threshold partial pivoting: a pivot is taken on the diagonal when its magnitude is at
+  // least this fraction of its column's largest (1: plain partial pivoting). Default KLU's 0.001.
+  void setPivotTolerance(double tol);
   // Symbolic analyses done by this object (for tests of the reuse).
   int analyses() const { return analyses_; }
 
