@@ -190,6 +190,10 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--seeds")) seeds = std::atoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--family")) family = argv[i + 1];
   }
+  // A size of 0 leaves a list out (--sizes 0 --dense 0 --findex 0: the stress table alone).
+  for (std::vector<int>* list : {&sizes, &denseSizes, &findex, &stressSizes})
+    list->erase(std::remove_if(list->begin(), list->end(), [](int n) { return n <= 0; }),
+                list->end());
   std::printf(
       "| problem | rows | path | seconds | pivots | status | residual | max abs(x - x*) | "
       "tableau / factored |\n|---|---|---|---|---|---|---|---|---|\n");
