@@ -573,15 +573,16 @@ TEST(RowSolver, BasicDemoPileMissedByNewtonRunsUnderTheEngineCostCap) {
 }
 
 // A pile without cfm (36 boxes, A singular, the contacts' depths inconsistent where all hold):
-// newton's answer ends short of the tolerance, proximal goes on from it and ends exact, and the
-// island's next solve runs proximal first.
+// with the singular-island continuation on, newton's answer ends short of the tolerance, proximal
+// goes on from it and ends exact, and the island's next solve runs proximal first.
 TEST(RowSolver, SingularIslandMissedByNewtonIsFinishedByProximal) {
   test::PyramidSpec spec;
   spec.levels = 8;
   spec.cfm = 0;
   const RowSystem rows = test::BoxPyramid(spec).rows();
   RowSolverSettings settings;
-  settings.timeBudget = 0;  // the same path on any machine
+  settings.timeBudget = 0;                                       // the same path on any machine
+  settings.policy.singularIslandSolver = kSingularIslandSolver;  // off by default in engines
   RowSolver solver(settings);
   Vector x;
   const IslandSolve first = solver.solve(rows, Vector::Zero(rows.size()), x, 7);

@@ -19,7 +19,8 @@
 //     pivoting's with the rows);
 //   a contact island whose dantzig or newton answer ended short of the tolerance (a singular A:
 //     a pile without cfm) -> singularIslandSolver ("proximal") from that answer, and first for
-//     that island's next singularIslandSolves solves (RowSolver's per-island memory).
+//     that island's next singularIslandSolves solves (RowSolver's per-island memory; engine
+//     islands leave it off by default: row_solver.hpp, engineIslandPolicy()).
 //
 // The fallback rule (a registry chain "a>b>c" and RowSolver's primary and fallback alike):
 //  1. an answer is acceptable when its status is not a breakdown and its residual, recomputed

@@ -72,6 +72,17 @@ inline constexpr double kDefaultEngineCostFactor = 3;
 // QuickStep's default sweep counts, is what a rejected answer may cost at most by default.
 inline constexpr int kDefaultFallbackSweeps = 100;
 
+// Policy's defaults without the singular-island continuation (singularIslandSolver ""): under the
+// engine-relative cap proximal rarely finishes a pile and its attempt costs more than the engine
+// (Bullet's examples: 1.2-1.7x auto's step and more islands left to pgs). Set
+// policy.singularIslandSolver = kSingularIslandSolver, with engineCostFactor 0 for no cap, where
+// the exact answer on piles is worth its cost.
+inline Policy engineIslandPolicy() {
+  Policy p;
+  p.singularIslandSolver = "";
+  return p;
+}
+
 // Options with the islands' default tolerance (kDefaultIslandTolerance), core defaults otherwise.
 inline Options islandOptions() {
   Options o;
@@ -92,8 +103,8 @@ struct RowSolverSettings {
   // A registry name (mlcp::solverNames(), "a>b" chains included), "auto" (policy below, per
   // island) or "pgs" (RowPgs on the rows). Default "auto".
   std::string solver = "auto";
-  // The rules of "auto" (policy.hpp). Default: Policy's defaults.
-  Policy policy;
+  // The rules of "auto" (policy.hpp). Default: engineIslandPolicy().
+  Policy policy = engineIslandPolicy();
   // Options of the primary (tolerance, iteration and pivot limits, ...). warmStart is ignored:
   // every solve starts from the caller's start. Default islandOptions(): tolerance 1e-6
   // (kDefaultIslandTolerance), core defaults otherwise.
