@@ -166,6 +166,22 @@ TEST(Proximal, TimeBudgetIsHonoured) {
   EXPECT_LE(r.residual, accuracy(p, Vector::Zero(p.size())).residual);
 }
 
+// A sparse A without a stored diagonal entry (the worked Lemke example's A_33 = 0): alpha is
+// written into an explicit diagonal entry.
+TEST(Proximal, SparseMatrixWithoutADiagonalEntryIsShifted) {
+  Eigen::MatrixXd a(3, 3);
+  a << 2, -1, 3, -1, 10, 2, -3, -2, 0;
+  SparseMatrix sparse = a.sparseView();
+  ASSERT_EQ(sparse.nonZeros(), 8);
+  Problem p(sparse, Vector((Vector(3) << -1, -10, 6).finished()));
+  ProximalSolver s;
+  s.options().tolerance = 1e-9;
+  Vector x;
+  const Result r = s.solve(p, x);
+  EXPECT_EQ(r.status, Status::Converged) << r.message;
+  EXPECT_LE(accuracy(p, x).residual, 1e-9);
+}
+
 TEST(Proximal, RegisteredByName) {
   auto s = makeSolver("proximal");
   ASSERT_NE(s, nullptr);
