@@ -42,6 +42,16 @@ struct BandedLcp {
 
 namespace detail_banded {
 
+// The problem with A and b = w* - A x* for a random half-active solution x*, w*.
+inline BandedLcp withAnswer(SparseMatrix A, std::mt19937& rng, std::string name) {
+  const int n = static_cast<int>(A.rows());
+  std::uniform_real_distribution<double> u(-1, 1), pos(0.1, 1);
+  Vector x = Vector::Zero(n), w = Vector::Zero(n);
+  for (int i = 0; i < n; ++i) (u(rng) < 0 ? x[i] : w[i]) = pos(rng);
+  Vector b = w - A * x;
+  return {Problem(std::move(A), std::move(b)), std::move(x), std::move(name)};
+}
+
 // b = w* - A x* for a random half-active solution; A from triplets without the diagonal, which
 // becomes (1 + margin) * (row's off-diagonal absolute sum) + floor.
 inline BandedLcp finish(int n, std::vector<Eigen::Triplet<double>> t, double margin, double floor,
@@ -51,18 +61,14 @@ inline BandedLcp finish(int n, std::vector<Eigen::Triplet<double>> t, double mar
   for (int i = 0; i < n; ++i) t.emplace_back(i, i, (1 + margin) * rowSum[i] + floor);
   SparseMatrix A(n, n);
   A.setFromTriplets(t.begin(), t.end());
-  std::uniform_real_distribution<double> u(-1, 1), pos(0.1, 1);
-  Vector x = Vector::Zero(n), w = Vector::Zero(n);
-  for (int i = 0; i < n; ++i) (u(rng) < 0 ? x[i] : w[i]) = pos(rng);
-  Vector b = w - A * x;
-  return {Problem(std::move(A), std::move(b)), std::move(x), std::move(name)};
+  return withAnswer(std::move(A), rng, std::move(name));
 }
 
 }  // namespace detail_banded
 
 inline BandedLcp bandedSpdLcp(int n, int band, unsigned seed) {
   std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-1, 1), pos(0.1, 1);
+  std::uniform_real_distribution<double> u(-1, 1);
   std::vector<Eigen::Triplet<double>> t;
   Vector diag = Vector::Ones(n);
   for (int i = 0; i < n; ++i)
@@ -76,10 +82,7 @@ inline BandedLcp bandedSpdLcp(int n, int band, unsigned seed) {
   for (int i = 0; i < n; ++i) t.emplace_back(i, i, diag[i]);
   SparseMatrix A(n, n);
   A.setFromTriplets(t.begin(), t.end());
-  Vector x = Vector::Zero(n), w = Vector::Zero(n);
-  for (int i = 0; i < n; ++i) (u(rng) < 0 ? x[i] : w[i]) = pos(rng);
-  Vector b = w - A * x;
-  return {Problem(std::move(A), std::move(b)), std::move(x), "banded SPD"};
+  return detail_banded::withAnswer(std::move(A), rng, "banded SPD");
 }
 
 inline BandedLcp stencilLcp(int n, double diagonal, const std::vector<int>& offsets,
@@ -94,11 +97,7 @@ inline BandedLcp stencilLcp(int n, double diagonal, const std::vector<int>& offs
   for (int i = 0; i < n; ++i) t.emplace_back(i, i, diagonal);
   SparseMatrix A(n, n);
   A.setFromTriplets(t.begin(), t.end());
-  std::uniform_real_distribution<double> u(-1, 1), pos(0.1, 1);
-  Vector x = Vector::Zero(n), w = Vector::Zero(n);
-  for (int i = 0; i < n; ++i) (u(rng) < 0 ? x[i] : w[i]) = pos(rng);
-  Vector b = w - A * x;
-  return {Problem(std::move(A), std::move(b)), std::move(x), "stencil"};
+  return detail_banded::withAnswer(std::move(A), rng, "stencil");
 }
 
 // The stencil of the 20,000-row problem that once ended lemke on a wrong basis.
