@@ -178,6 +178,19 @@ TEST(Proximal, SparseMatrixWithoutADiagonalEntryIsShifted) {
   expectExact(s, p, 1e-9);
 }
 
+// Two resting boxes' islands captured from Bullet's BasicDemo (scenes/basic_demo.json, step 150,
+// cfm 0): newton ends island 26 at 1.7e-7; proximal ends both within 1e-9.
+TEST(Proximal, CapturedBasicDemoIslandsAreExact) {
+  for (const char* island : {"island12", "island26"}) {
+    SCOPED_TRACE(island);
+    const Problem p =
+        io::readProblemJson(std::string(MLCP_SOURCE_DIR) +
+                            "/tests/data/islands/basic_demo-bullet-step150-" + island + ".json");
+    ProximalSolver s;
+    expectExact(s, p, 1e-9);
+  }
+}
+
 TEST(Proximal, RegisteredByName) {
   auto s = makeSolver("proximal");
   ASSERT_NE(s, nullptr);
