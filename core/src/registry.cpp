@@ -54,6 +54,12 @@ bool registerSolver(const SolverInfo& info) {
   return true;
 }
 
+bool isRegistered(const std::string& name) {
+  for (const SolverInfo& info : solvers())
+    if (name == info.name) return true;
+  return false;
+}
+
 std::string solverNames() {
   std::string s;
   for (const SolverInfo& info : solvers()) {

@@ -69,12 +69,6 @@ Solver* cachedChain(std::vector<std::pair<std::string, std::unique_ptr<Solver>>>
   return cache.back().second.get();
 }
 
-bool registered(const std::string& name) {
-  for (const SolverInfo& info : solvers())
-    if (name == info.name) return true;
-  return false;
-}
-
 bool positiveDiagonal(const Problem& p) {
   for (int i = 0; i < p.size(); ++i)
     if (!(p.diagonal(i) > 0)) return false;
@@ -95,7 +89,7 @@ void AutoSolver::run(const Problem& problem, Vector& x, Result& result) {
                     hasFreeRows(problem.lo, problem.hi));
   std::string chain;
   for (const char* name : {choice.solver, choice.fallback})
-    if (registered(name)) chain += (chain.empty() ? "" : ">") + std::string(name);
+    if (isRegistered(name)) chain += (chain.empty() ? "" : ">") + std::string(name);
   Solver* solver = chain.empty() ? nullptr : cachedChain(cache_, chain, configure);
   const std::string why = std::string(choice.why) + ", " + toString(c) + ", " +
                           std::to_string(problem.size()) + " rows";
@@ -120,11 +114,7 @@ void AutoSolver::run(const Problem& problem, Vector& x, Result& result) {
 void AutoSolver::continueSingular(const Problem& problem, ProblemClass c, const Choice& choice,
                                   Vector& x, Result& result) {
   const std::string& singular = policy.singularIslandSolver;
-  const bool contacts =
-      c == ProblemClass::Findex || c == ProblemClass::Boxed || c == ProblemClass::StandardLcp;
-  const bool exact = std::string(choice.solver) == "dantzig" ||
-                     std::string(choice.solver) == policy.largeIslandSolver;
-  if (!contacts || !exact || singular.empty() || !registered(singular.c_str()) ||
+  if (!policy.continuesShort(c, choice.solver) || !isRegistered(singular) ||
       result.status == Status::Converged || x.size() != problem.size() || !x.allFinite() ||
       outOfTime())
     return;

@@ -21,6 +21,13 @@ Choice Policy::choose(ProblemClass c, int rows, double tolerance, bool positiveD
   return {largeIslandSolver.c_str(), "pgs", "large contact island"};
 }
 
+bool Policy::continuesShort(ProblemClass c, const std::string& primary) const {
+  const bool contacts =
+      c == ProblemClass::Findex || c == ProblemClass::Boxed || c == ProblemClass::StandardLcp;
+  return contacts && !singularIslandSolver.empty() &&
+         (primary == "dantzig" || primary == largeIslandSolver);
+}
+
 bool Policy::demotes(const Result& rejected, double acceptResidual, int cutsInRow) const {
   if (rejected.status == Status::Failed || rejected.status == Status::NumericalIssue) return true;
   if (!std::isfinite(rejected.residual)) return true;

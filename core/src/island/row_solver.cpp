@@ -477,15 +477,12 @@ void RowSolver::Impl::continueWith(const std::string& name, const RowSystem& row
 void RowSolver::Impl::continueShort(const RowSystem& rows, Vector& x, Slot& island,
                                     IslandSolve& out, Result& r, const Plan& plan, double t0) {
   const Policy& policy = settings_.policy;
-  const bool contacts = out.problemClass == ProblemClass::Findex ||
-                        out.problemClass == ProblemClass::Boxed ||
-                        out.problemClass == ProblemClass::StandardLcp;
-  if (plan.fromStart || !contacts) return;
+  if (plan.fromStart) return;
   if (out.problemClass == ProblemClass::Findex && equals(out.requested, "dantzig") &&
       !acceptable(r, settings_.acceptResidual))
     continueWith("newton", rows, x, island, out, r, leftOfShare(plan.share, t0));
-  const bool exact = equals(out.requested, "dantzig") || out.requested == policy.largeIslandSolver;
-  if (!exact || policy.singularIslandSolver.empty() || r.status == Status::Converged) return;
+  if (r.status == Status::Converged || !policy.continuesShort(out.problemClass, out.requested))
+    return;
   Options o = leftOfShare(plan.share, t0);
   if (const double cap = engineShare(rows, x); cap > 0 && !(o.timeBudget > 0 && o.timeBudget < cap))
     o = withBudget(settings_.options, cap, nowSeconds());
@@ -624,8 +621,7 @@ void RowSolver::Impl::chooseForAuto(const RowSystem& rows, const Vector& start, 
   // The singular-island solver answers under the cap whenever the engine's cost is known: it
   // runs on islands no exact method finishes, every step.
   const bool singular =
-      island.singularFirst > 0 && !policy.singularIslandSolver.empty() &&
-      (equals(out.requested, "dantzig") || out.requested == policy.largeIslandSolver);
+      island.singularFirst > 0 && policy.continuesShort(out.problemClass, out.requested);
   if (singular) {
     --island.singularFirst;
     out.requested = policy.singularIslandSolver;
@@ -634,7 +630,7 @@ void RowSolver::Impl::chooseForAuto(const RowSystem& rows, const Vector& start, 
     const double cap = engineShare(rows, start);
     plan.capped = cap > 0;
     if (plan.capped && !singular) --island.cappedSolves;
-    if (plan.capped && (cap < plan.share || !(plan.share > 0))) plan.share = cap;
+    if (plan.capped && cap < plan.share) plan.share = cap;
   }
 }
 

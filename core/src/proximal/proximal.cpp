@@ -42,8 +42,8 @@ constexpr double kMaxAlphaDrop = 10;
 std::string innerError(const std::string& name) {
   if (name == "proximal" || name == "auto" || name.find('>') != std::string::npos)
     return "proximal: inner solver '" + name + "' must be a single method other than auto";
-  std::string error;
-  if (!makeSolver(name, &error)) return "proximal: inner solver: " + error;
+  if (!isRegistered(name))
+    return "proximal: inner solver: unknown solver '" + name + "' (known: " + solverNames() + ")";
   return "";
 }
 
@@ -57,17 +57,13 @@ SparseMatrix withDiagonal(const SparseMatrix& a) {
   s.makeCompressed();
   return s;
 }
-}  // namespace
-
-namespace {
-// The solver of this name kept in `slot` (made anew when the name changed), or null.
+// The solver of this name kept in `slot` (made, after innerError's check, when the name
+// changed), or null.
 Solver* keptSolver(std::unique_ptr<Solver>& slot, std::string& slotName, const std::string& name) {
-  if (name.empty() || !innerError(name).empty()) return nullptr;
-  if (!slot || slotName != name) {
-    slot = makeSolver(name);
-    slotName = name;
-    if (slot) slot->setTimed(false);
-  }
+  if (slot && slotName == name) return slot.get();
+  slot = name.empty() || !innerError(name).empty() ? nullptr : makeSolver(name);
+  slotName = name;
+  if (slot) slot->setTimed(false);
   return slot.get();
 }
 }  // namespace
@@ -191,10 +187,7 @@ void ProximalSolver::run(const Problem& problem, Vector& x, Result& result) {
     }
   }
   const int n = problem.size();
-  double scale = 0;
-  for (int i = 0; i < n; ++i) scale += std::abs(problem.diagonal(i));
-  scale = n > 0 && scale > 0 ? scale / n : 1;
-
+  double scale = 1;  // mean |A_ii|, the unit of alpha (set with the shifted problem)
   const auto residualOf = [&](const Vector& v) {
     if (v.size() != n) return kInf;
     const Accuracy a = accuracy(problem, v);
@@ -215,8 +208,12 @@ void ProximalSolver::run(const Problem& problem, Vector& x, Result& result) {
       stop = Status::TimeLimit;
       break;
     }
-    if (!prepared) prepare(problem);
-    prepared = true;
+    if (!prepared) {
+      prepare(problem);
+      const double mean = wk.baseDiagonal.cwiseAbs().mean();
+      if (mean > 0) scale = mean;
+      prepared = true;
+    }
     rel = nextAlpha(rel, r, failedLast, floor);
     lastAlpha_ = scale * rel;
     const bool solved = outerStep(problem, lastAlpha_, r, fallbacks);

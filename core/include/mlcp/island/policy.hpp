@@ -78,6 +78,10 @@ struct Policy {
   // kSingularIslandSolver ("proximal").
   std::string singularIslandSolver = kSingularIslandSolver;
   int singularIslandSolves = 30;
+  // Whether singularIslandSolver continues a short answer of `primary` on a problem of class c:
+  // it is set, the rows are contacts (Findex, Boxed, StandardLcp) and primary is an exact method
+  // this policy chooses for them (dantzig or largeIslandSolver).
+  bool continuesShort(ProblemClass c, const std::string& primary) const;
   // Requested tolerance (scaled residual) at or above which large contact islands go to pgs.
   // Default 1e-4.
   double looseTolerance = 1e-4;
