@@ -25,7 +25,7 @@
 #include <random>
 #include <vector>
 
-#include "mlcp/island/rows.hpp"
+#include "mlcp/rows.hpp"
 
 namespace mlcp::test {
 

@@ -5,7 +5,7 @@
 
 #include <vector>
 
-#include "mlcp/island/rows.hpp"
+#include "mlcp/rows.hpp"
 
 namespace mlcp::test {
 

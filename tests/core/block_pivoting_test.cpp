@@ -11,8 +11,8 @@
 #include "common/expect_solved.hpp"
 #include "common/generators.hpp"
 #include "linalg/body_space.hpp"  // BodySpaceSystem (internal)
-#include "mlcp/island/rows.hpp"
 #include "mlcp/residual.hpp"
+#include "mlcp/rows.hpp"
 #include "mlcp/solvers/dantzig.hpp"
 #include "mlcp/solvers/pgs.hpp"
 #include "projection/pgs_sweep.hpp"  // pgsSweep (internal)

@@ -16,7 +16,7 @@
 #include "common/contact_scenes.hpp"
 #include "common/cpu_path_guard.hpp"
 #include "common/row_source.hpp"
-#include "mlcp/island/rows.hpp"
+#include "mlcp/rows.hpp"
 #include "mlcp/solvers/newton.hpp"
 #include "mlcp/solvers/row_pgs.hpp"
 #include "projection/cpu_dispatch.hpp"  // MLCP_CPU_DISPATCH (internal)

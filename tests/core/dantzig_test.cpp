@@ -14,9 +14,9 @@
 #include "common/generators.hpp"
 #include "linalg/body_space.hpp"  // BodySpaceSystem (internal)
 #include "mlcp/io.hpp"
-#include "mlcp/island/rows.hpp"
 #include "mlcp/registry.hpp"
 #include "mlcp/residual.hpp"
+#include "mlcp/rows.hpp"
 #include "mlcp/solvers/ldlt.hpp"
 #include "mlcp/solvers/lemke.hpp"
 #include "mlcp/solvers/pgs.hpp"

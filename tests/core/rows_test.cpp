@@ -1,6 +1,6 @@
 // The factored row form: assembly matches J M^-1 J^T + diag(cfm) built densely by hand, and
 // row PGS reaches the same answer as pgs on the assembled problem.
-#include "mlcp/island/rows.hpp"
+#include "mlcp/rows.hpp"
 
 #include <gtest/gtest.h>
 

@@ -20,7 +20,7 @@
 
 #include <Eigen/Dense>
 
-#include "mlcp/island/rows.hpp"
+#include "mlcp/rows.hpp"
 
 namespace mlcp::ode::test {
 

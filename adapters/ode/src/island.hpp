@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "mlcp/island/row_solver.hpp"
-#include "mlcp/island/rows.hpp"
 #include "mlcp/ode/stepper.hpp"
+#include "mlcp/rows.hpp"
 #include "mlcp/solver.hpp"
 #include "ode_internal.hpp"
 

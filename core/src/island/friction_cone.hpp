@@ -48,8 +48,8 @@
 #include <vector>
 
 #include "mlcp/island/friction_model.hpp"
-#include "mlcp/island/rows.hpp"
 #include "mlcp/problem.hpp"
+#include "mlcp/rows.hpp"
 
 namespace mlcp {
 

@@ -35,8 +35,8 @@
 #include <vector>
 
 #include "block_update.hpp"
-#include "mlcp/island/rows.hpp"
 #include "mlcp/problem.hpp"
+#include "mlcp/rows.hpp"
 
 namespace mlcp::detail {
 

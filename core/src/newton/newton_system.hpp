@@ -9,8 +9,8 @@
 
 #include "linalg/sparse_lu.hpp"
 #include "linalg/symmetry.hpp"
-#include "mlcp/island/rows.hpp"
 #include "mlcp/problem.hpp"
+#include "mlcp/rows.hpp"
 
 namespace mlcp::detail {
 

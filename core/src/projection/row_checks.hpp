@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "mlcp/island/rows.hpp"
+#include "mlcp/rows.hpp"
 #include "mlcp/solvers/row_pgs.hpp"
 
 namespace mlcp {

@@ -13,7 +13,7 @@
 #include <limits>
 #include <vector>
 
-#include "mlcp/island/rows.hpp"
+#include "mlcp/rows.hpp"
 #include "mlcp/solver.hpp"
 #include "mlcp/solvers/row_pgs.hpp"
 #include "projection/cpu_dispatch.hpp"

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <cstdio>
 
-#include "mlcp/island/rows.hpp"
 #include "mlcp/registry.hpp"
 #include "mlcp/residual.hpp"
+#include "mlcp/rows.hpp"
 
 namespace mlcp {
 

@@ -41,7 +41,7 @@
 #include <string>
 #include <vector>
 
-#include "mlcp/island/rows.hpp"
+#include "mlcp/rows.hpp"
 #include "mlcp/thresholds.hpp"
 
 namespace mlcp {

@@ -6,7 +6,7 @@
 //     s.choice;    // "ldlt", "dantzig", "newton", "start", ...: whose answer x is
 //     s.accepted;  // the returned answer is acceptable (policy.hpp, rule 1)
 //
-// The problem: an island's rows (rows.hpp), w = A x + b with A = J M^-1 J^T + diag(cfm),
+// The problem: an island's rows (mlcp/rows.hpp), w = A x + b with A = J M^-1 J^T + diag(cfm),
 // lo <= x <= hi, friction bounds through findex (problem.hpp's canonical form). Each solve runs
 // five stages: 0. screen degenerate rows (row_screen.hpp), and drop a start that would change
 // a body's velocity by more than 1000 ||b||_inf (not a warm start: solved cold); 1. classify the
@@ -42,9 +42,9 @@
 #include "mlcp/island/friction_model.hpp"
 #include "mlcp/island/policy.hpp"
 #include "mlcp/island/row_screen.hpp"
-#include "mlcp/island/rows.hpp"
 #include "mlcp/problem.hpp"
 #include "mlcp/result.hpp"
+#include "mlcp/rows.hpp"
 #include "mlcp/solver.hpp"
 #include "mlcp/solvers/newton.hpp"
 #include "mlcp/thresholds.hpp"

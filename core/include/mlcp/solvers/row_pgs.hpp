@@ -4,8 +4,8 @@
 #include <memory>
 #include <vector>
 
-#include "mlcp/island/rows.hpp"
 #include "mlcp/result.hpp"
+#include "mlcp/rows.hpp"
 
 namespace mlcp {
 

@@ -50,8 +50,8 @@
 
 #include "mlcp/bullet/islands.hpp"
 #include "mlcp/island/row_solver.hpp"
-#include "mlcp/island/rows.hpp"
 #include "mlcp/result.hpp"
+#include "mlcp/rows.hpp"
 #include "mlcp/solver.hpp"
 #include "mlcp/solvers/row_pgs.hpp"
 

@@ -2,7 +2,7 @@
 //
 // Input: the pools btSequentialImpulseConstraintSolver's setup fills (solver bodies; joint,
 // contact, friction and rolling-friction rows). Output: one Island per connected component of
-// the dynamic-body graph, each holding an mlcp::RowSystem (mlcp/island/rows.hpp; rows in
+// the dynamic-body graph, each holding an mlcp::RowSystem (mlcp/rows.hpp; rows in
 // Bullet's order: joints, contacts, friction, rolling friction, the stock btMLCPSolver's order)
 // and pointers back to Bullet's rows for the write-back. The conversion rules are stage 3 of
 // docs/methods/adapters.md, "Bullet: the drop-in's stages".
@@ -28,7 +28,7 @@
 #include <utility>
 #include <vector>
 
-#include "mlcp/island/rows.hpp"
+#include "mlcp/rows.hpp"
 #include "mlcp/solvers/row_pgs.hpp"
 
 namespace mlcp::bullet {

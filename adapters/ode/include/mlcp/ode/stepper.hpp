@@ -18,7 +18,7 @@
 // the island stepper's stages"):
 //   1. prepare bodies: forces, world-frame inverse inertia, gyroscopic torque, as dxStepIsland;
 //   2. prepare rows: getInfo1, joints ordered unbounded | mixed | LCP as ODE orders them,
-//      getInfo2 into factored rows (mlcp::RowSystem, mlcp/island/rows.hpp);
+//      getInfo2 into factored rows (mlcp::RowSystem, mlcp/rows.hpp);
 //   3. canonical form (core/include/mlcp/problem.hpp): ODE solves A lambda = rhs + w with
 //      A = J M^-1 J^T + diag(cfm / h), rhs = c / h - J (M^-1 f_ext + v / h); so b = -rhs;
 //   4. warm start: last step's lambda per joint, per contact the nearest last-step contact of
@@ -45,8 +45,8 @@
 #include <vector>
 
 #include "mlcp/island/row_solver.hpp"
-#include "mlcp/island/rows.hpp"
 #include "mlcp/result.hpp"
+#include "mlcp/rows.hpp"
 
 namespace mlcp::ode {
 

@@ -1,4 +1,4 @@
-// mlcp/island/rows.hpp: constraint rows in the factored form physics engines hand over.
+// mlcp/rows.hpp: constraint rows in the factored form physics engines hand over.
 //
 // Engines do not build A. They give, per constraint row i, two 6-wide Jacobian blocks
 // J_iA, J_iB (linear part first, then angular) on two bodies A and B, and per body its
@@ -62,7 +62,7 @@ class RowSystem {
   // compared), only the values are written, through each product's slot (found once per
   // pattern, at its second assembly: islands whose contacts change every step never pay for
   // it). Both sum in the dense path's order: the same bits in every storage.
-  // The buffers and the remembered pattern of the call above (core/src/island/assembly.hpp),
+  // The buffers and the remembered pattern of the call above (core/src/rows.cpp),
   // opaque here: one per island that is assembled every step.
   class AssembleScratch {
    public:

@@ -1,4 +1,4 @@
-#include "mlcp/island/rows.hpp"
+#include "mlcp/rows.hpp"
 
 #include <algorithm>
 #include <cassert>
