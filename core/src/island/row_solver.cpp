@@ -502,7 +502,7 @@ bool RowSolver::Impl::throwsBodies(const RowSystem& rows, const Vector& x, doubl
   const double limit = factor * rows.b.lpNorm<Eigen::Infinity>();
   for (const Vector6& v : rows.bodyVelocities(x))
     if (v.head<3>().squaredNorm() > limit * limit) return true;
-  return false;
+  return rows.articulatedSpeed(x) > limit;
 }
 
 // Stage 5 (safe application): x, r are the lowest-residual answer, and it is not acceptable, or
