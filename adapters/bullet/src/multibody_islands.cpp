@@ -8,6 +8,12 @@
 
 namespace mlcp::bullet::detail {
 
+namespace {
+// How far past its limit a one-sided multibody row aims with multiBodyPositionCorrection, in the
+// row's unit (rad for a revolute limit, m for a prismatic one).
+constexpr double kLimitSlop = 1e-3;
+}  // namespace
+
 int MultiBodyIslands::rigidNode(int solverBody) const {
   if (solverBody < 0 || solverBody >= nb_) return -1;
   const btRigidBody* rb = (*in_.bodies)[solverBody].m_originalBody;
@@ -201,6 +207,12 @@ void MultiBodyIslands::fill(MultiBodyIsland& isl, int r, int local, const btCont
     }
     const double penetration = settings.multiBodyPositionCorrection ? c.m_rhsPenetration : 0.0;
     values(c, c.m_rhs + penetration);
+    // A one-sided multibody row (a joint limit) made only past its limit: aimed kLimitSlop inside
+    // the violation, so that it stays there at rest instead of vanishing the step after an exact
+    // answer puts the joint on the limit (and the joint falling free for a step).
+    if (settings.multiBodyPositionCorrection && row.kind == Kind::Joint && s.lo[local] == 0 &&
+        s.hi[local] > 0)
+      s.b[local] += kLimitSlop * info.m_erp / info.m_timeStep;
   }
   const bool warm = info.m_warmstartingFactor > 0 && (info.m_solverMode & SOLVER_USE_WARMSTARTING);
   isl.start[local] = startOf(row, start, warm ? 1.0 / info.m_warmstartingFactor : 1.0);

@@ -25,9 +25,10 @@
 //     bodies' own update, as Bullet's resolveSingleConstraintRowGeneric applies a row; Bullet's
 //     finish writes joint feedback, contact impulses and velocities.
 // Split impulse: Bullet's own push iterations run on the rigid contacts (the only rows they
-// serve); a multibody row's positional error that split impulse sets apart is dropped, as in
-// Bullet, unless Settings::multiBodyPositionCorrection (settings.hpp). "si" runs Bullet's own
-// iterations, with the same statistics.
+// serve); a multibody row's positional error that split impulse sets apart, which Bullet drops,
+// is put back by Settings::multiBodyPositionCorrection (settings.hpp, default on; it also keeps
+// a joint limit's row alive at rest). "si" runs Bullet's own iterations, with the same
+// statistics.
 // Differences from Bullet's solver it replaces: friction is a box per direction (findex), not
 // the implicit cone resolveConeFrictionConstraintRows projects a lateral pair on; rows on
 // different islands never share a problem. Cost: Bullet's setup and finish, O(rows + nnz J) for
