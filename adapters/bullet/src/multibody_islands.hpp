@@ -62,8 +62,8 @@ struct MultiBodyIsland {
 class MultiBodyIslands {
  public:
   // Splits the pools' rows into islands; start as in island.hpp (CachedImpulse: last step's
-  // answers where Bullet keeps them: a contact point's impulses, a multibody constraint's
-  // applied impulse; the applied impulse elsewhere).
+  // answers where Bullet keeps them, a contact point's impulses; limits and motors start at the
+  // impulse Bullet's setup applied).
   void build(const MultiBodyPools& pools, const btContactSolverInfo& info, const Settings& settings,
              Start start);
   int count() const { return count_; }
