@@ -22,6 +22,7 @@ std::vector<std::string> engineList() {
   std::vector<std::string> list;
 #ifdef MLCP_HAVE_BULLET
   list.push_back("bullet");
+  list.push_back("bullet-multibody");
 #endif
 #ifdef MLCP_HAVE_ODE
   list.push_back("ode");
@@ -39,6 +40,7 @@ std::unique_ptr<scene::World> makeWorld(const std::string& engine, const scene::
                                         const scene::RunSettings& run) {
 #ifdef MLCP_HAVE_BULLET
   if (engine == "bullet") return bullet::loadWorld(s, run);
+  if (engine == "bullet-multibody") return bullet::loadWorld(s, run, bullet::Coordinates::Reduced);
 #endif
 #ifdef MLCP_HAVE_ODE
   if (engine == "ode") return ode::loadWorld(s, run);

@@ -13,7 +13,8 @@
 
 namespace mlcp::cli {
 
-// Engines this build can run ("bullet, ode"), for help texts and errors.
+// Engines this build can run ("bullet, bullet-multibody, ode"), for help texts and errors.
+// "bullet-multibody" is Bullet with its articulations as btMultiBodies (reduced coordinates).
 std::string engineNames();
 std::vector<std::string> engineList();
 
