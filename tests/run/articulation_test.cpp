@@ -74,6 +74,10 @@ TEST(Articulations, LoadWithTheSameMassesLinksAndJointsInEveryEngine) {
         EXPECT_DOUBLE_EQ(dm.mass, m);
         const auto& j = s.joints[art.links[k].joint];
         constraints += j.limits.enabled + j.motor.enabled;
+        // ODE: the joint to its parent and one to each child (no contacts before a step).
+        const auto children = std::count_if(art.links.begin(), art.links.end(),
+                                            [&](const auto& l) { return l.parent == int(k); });
+        EXPECT_EQ(dBodyGetNumJoints(ode->bodies()[art.links[k].body]), 1 + children);
       }
     }
     // Maximal: one constraint per joint; reduced: the joints are the tree, limits and motors rows.
@@ -250,7 +254,7 @@ TEST(Articulations, LimitChainViolationAfterSettling) {
   // Through the loaders (Bullet's default split impulse): ODE's own, the core solvers, Bullet's
   // multibody MLCP path.
   const std::pair<const char*, const char*> runs[] = {
-      {"ode", "ode-world"}, {"bullet", "auto"},   {"ode", "auto"},
+      {"ode", "ode-world"},  {"bullet", "auto"}, {"ode", "auto"},
       {"bullet", "dantzig"}, {"ode", "dantzig"}, {"bullet-multibody", "bullet-mlcp-dantzig"}};
   for (const auto& [engine, solver] : runs) {
     auto w = makeWorld(engine, s, solver);

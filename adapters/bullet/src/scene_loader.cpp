@@ -319,7 +319,10 @@ BulletScene::BulletScene(const scene::Scene& s, const scene::RunSettings& run,
   info.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS | SOLVER_ENABLE_FRICTION_DIRECTION_CACHING |
                        SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION;
   if (!run.warmStart) info.m_solverMode &= ~SOLVER_USE_WARMSTARTING;
+  addContent(s, coordinates);
+}
 
+void BulletScene::addContent(const scene::Scene& s, Coordinates coordinates) {
   // Reduced: the articulations' bodies and link joints are the btMultiBodies' (one owner each).
   std::vector<bool> inMultiBody(s.bodies.size(), false), jointInMultiBody(s.joints.size(), false);
   if (coordinates == Coordinates::Reduced)
@@ -407,8 +410,8 @@ void BulletScene::addBody(const scene::Scene& s, const scene::Body& b) {
 }
 
 void BulletScene::addJoint(const scene::Joint& j) {
-  btRigidBody& a = *bodies_[j.body0];
-  btRigidBody& b = j.body1 >= 0 ? *bodies_[j.body1] : btTypedConstraint::getFixedBody();
+  btRigidBody& a = *bodyPointers_[j.body0];
+  btRigidBody& b = j.body1 >= 0 ? *bodyPointers_[j.body1] : btTypedConstraint::getFixedBody();
   const btTransform ta = a.getCenterOfMassTransform().inverse();
   const btTransform tb = b.getCenterOfMassTransform().inverse();
   // Bullet's slider offset is B's relative to A (its hinge angle is A's relative to B, as the

@@ -92,6 +92,8 @@ class BulletScene {
   double timeStep() const { return timeStep_; }
 
  private:
+  // The bodies, joints and (Reduced) btMultiBodies of the scene.
+  void addContent(const scene::Scene& s, Coordinates coordinates);
   std::unique_ptr<btCollisionShape> makeShape(const scene::Body& b);
   void addBody(const scene::Scene& s, const scene::Body& b);
   // Reduced: the articulation as a btMultiBody with its colliders, limits and motors.
