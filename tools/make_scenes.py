@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""Writes the generated scene files scenes/ragdoll_pile.json, scenes/plank_bridge.json and
-scenes/wall_120.json.
+"""Writes the generated scene files scenes/ragdoll_pile.json, scenes/plank_bridge.json,
+scenes/wall_120.json and the articulated scenes of tools/articulated_scenes.py (arm_push,
+legged_base, spherical_chain, limit_chain).
 
 Their bodies and joints repeat with rotations the scene generators (stack, pyramid, grid) do
 not express; this script is their source. Run it from anywhere after changing it:
@@ -13,6 +14,8 @@ import json
 import math
 import os
 import sys
+
+from articulated_scenes import articulated_scenes
 
 SCENES = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scenes")
 
@@ -43,15 +46,25 @@ def r(v, digits=6):
 def text_of(scene):
     """One body or joint per line: long files stay readable and diff well."""
     lines = ["{"]
-    head = [k for k in scene if k not in ("bodies", "joints")]
+    lists = [k for k in ("bodies", "articulations", "joints") if k in scene]
+    head = [k for k in scene if k not in lists]
     for k in head:
         lines.append("  %s: %s," % (json.dumps(k), json.dumps(scene[k])))
-    for key in ("bodies", "joints"):
+    for n, key in enumerate(lists):
         items = scene[key]
         lines.append('  "%s": [' % key)
         for i, item in enumerate(items):
-            lines.append("    " + json.dumps(item) + ("," if i + 1 < len(items) else ""))
-        lines.append("  ]" + ("," if key == "bodies" else ""))
+            comma = "," if i + 1 < len(items) else ""
+            if key == "articulations":  # one link per line
+                top = {k: v for k, v in item.items() if k != "links"}
+                lines.append("    " + json.dumps(top)[:-1] + ', "links": [')
+                for j, link in enumerate(item["links"]):
+                    last = j + 1 == len(item["links"])
+                    lines.append("      " + json.dumps(link) + ("" if last else ","))
+                lines.append("    ]}" + comma)
+            else:
+                lines.append("    " + json.dumps(item) + comma)
+        lines.append("  ]" + ("," if n + 1 < len(lists) else ""))
     lines.append("}")
     return "\n".join(lines) + "\n"
 
@@ -201,7 +214,7 @@ if __name__ == "__main__":
     check = sys.argv[1:] == ["--check"]
     stale = []
     generated = (("ragdoll_pile", ragdoll_pile()), ("plank_bridge", plank_bridge()),
-                 ("wall_120", brick_wall()))
+                 ("wall_120", brick_wall())) + articulated_scenes()
     for name, scene in generated:
         path = os.path.join(SCENES, name + ".json")
         text = text_of(scene)

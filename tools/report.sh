@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # tools/report.sh [OUT]: the comparison report of the main job (tools/main.sh), into OUT
-# (default build/report): a sweep of a few small scenes in both engines with stock and our
-# solvers (sweep.csv), work-precision charts per scene (charts/), the stability map
-# (stability.csv, stability/), the worked-example + Siconos solver table (table.md), summary.md and
-# index.html. Needs a built mlcp and the chart venv; prints where the report is.
+# (default build/report): a sweep of a few small scenes in both engines (articulated ones also
+# in bullet-multibody) with stock and our solvers (sweep.csv), work-precision charts per scene
+# (charts/), the stability map (stability.csv, stability/), the worked-example + Siconos solver
+# table (table.md), summary.md and index.html. Needs a built mlcp and the chart venv; prints
+# where the report is.
 #
 # Environment: MLCP (the mlcp program, default build/bin/mlcp), MLCP_PYTHON (default
 # .venv/bin/python), MLCP_REPORT_QUICK=1 (a smoke run: 2 scenes, 5 steps; for the tests).
@@ -30,6 +31,10 @@ export MLCP_PYTHON=$py  # `mlcp chart` uses the same interpreter
 # step keeps its shortest time (`mlcp sweep --repeat`): single runs of a few ms moved by 30%
 # between runs on a shared 2-core machine, enough to flip the front between identical solvers.
 scenes=(stack_10 pyramid_15 pendulum_chain hinge_motor_limits mass_ratio_stack sphere_pit)
+# Articulated scenes run also in reduced coordinates (engine bullet-multibody, where the sweep
+# runs Bullet's own solvers and skips the core ones until mlcp::bullet::install serves
+# multibody worlds): the arm pushing boxes and the chain holding its joint limits.
+articulated=(arm_push limit_chain)
 iterative=pgs,bullet-si,ode-quick
 iterative_values=5,10,20,50,100
 pivoting=dantzig,auto,bullet-mlcp-dantzig,ode-world
@@ -39,6 +44,7 @@ repeat=3
 stability_args=()
 if [ "${MLCP_REPORT_QUICK:-0}" = 1 ]; then
   scenes=(stack_10 pendulum_chain)
+  articulated=(limit_chain)
   iterative=pgs,bullet-si,ode-quick
   iterative_values=5,20
   pivoting=dantzig,auto  # auto: the Pareto table has its row
@@ -48,6 +54,8 @@ if [ "${MLCP_REPORT_QUICK:-0}" = 1 ]; then
 fi
 scene_files=()
 for s in "${scenes[@]}"; do scene_files+=("$repo/scenes/$s.json"); done
+articulated_files=()
+for s in "${articulated[@]}"; do articulated_files+=("$repo/scenes/$s.json"); done
 
 mkdir -p "$out"
 rm -rf "$out/charts" "$out/stability"
@@ -71,14 +79,19 @@ step() {  # step TITLE command...: runs the command, its stderr into the log; ex
   fi
 }
 
-sweep() {  # sweep SOLVERS VALUES [--append]
-  step "sweep: $1 at iterations $2" "$mlcp" sweep "${scene_files[@]}" --solvers "$1" \
-    --setting iterations --values "$2" --steps "$steps" --repeat "$repeat" --fallback none \
-    --csv "$out/sweep.csv" "${@:3}"
+sweep() {  # sweep SOLVERS VALUES ENGINES SCENE_FILES... [--append]: into sweep.csv
+  local solvers=$1 values=$2 engines=$3
+  shift 3
+  step "sweep: $solvers at iterations $values in $engines" "$mlcp" sweep "$@" \
+    --engines "$engines" --solvers "$solvers" --setting iterations --values "$values" \
+    --steps "$steps" --repeat "$repeat" --fallback none --csv "$out/sweep.csv"
 }
-echo "report: ${#scenes[@]} scenes (${scenes[*]}), $steps steps per run, both engines"
-sweep "$iterative" "$iterative_values"
-sweep "$pivoting" "$pivoting_values" --append
+echo "report: ${#scenes[@]} scenes (${scenes[*]}) in bullet and ode, ${#articulated[@]}" \
+  "articulated (${articulated[*]}) also in bullet-multibody, $steps steps per run"
+sweep "$iterative" "$iterative_values" bullet,ode "${scene_files[@]}"
+sweep "$pivoting" "$pivoting_values" bullet,ode "${scene_files[@]}" --append
+sweep "$iterative" "$iterative_values" bullet,bullet-multibody,ode "${articulated_files[@]}" --append
+sweep "$pivoting" "$pivoting_values" bullet,bullet-multibody,ode "${articulated_files[@]}" --append
 step "work-precision charts" "$mlcp" chart work-precision "$out/sweep.csv" -o "$out/charts"
 # Stability map: `mlcp stability` (its grid and thresholds are its own defaults).
 commands=$("$mlcp" --help)  # (not piped into grep -q: with pipefail, an early exit fails)
@@ -102,7 +115,7 @@ echo "$((SECONDS - t0)) s"
 
 elapsed=$((SECONDS - start))
 notes+=("Made by tools/report.sh in ${elapsed} s on $(nproc) cores, $(date -u '+%Y-%m-%d %H:%M UTC'), commit $(git -C "$repo" rev-parse --short HEAD 2> /dev/null || echo unknown).")
-notes+=("Sweep: ${scenes[*]}; $steps steps of each scene's time step per run; iterations $iterative_values for $iterative, $pivoting_values for $pivoting; no fallback (--fallback none): each solver alone.")
+notes+=("Sweep: ${scenes[*]} in bullet and ode; ${articulated[*]} (articulated) in bullet, bullet-multibody (reduced coordinates: Bullet's own solvers only) and ode; $steps steps of each scene's time step per run; iterations $iterative_values for $iterative, $pivoting_values for $pivoting; no fallback (--fallback none): each solver alone.")
 note_args=()
 for n in "${notes[@]}"; do note_args+=(--note "$n"); done
 "$py" "$repo/tools/report.py" "$out" "${note_args[@]}" > /dev/null

@@ -320,7 +320,10 @@ def run(scene: "str | os.PathLike[str]", engine: str, solver: Optional[str] = No
         csv: "str | os.PathLike[str] | None" = None,
         trajectory: "str | os.PathLike[str] | None" = None, capture: Optional[int] = None,
         capture_dir: "str | os.PathLike[str]" = ".", states: bool = False) -> Run:
-    """Steps a scene file (mlcp-scene/1) in an engine ("bullet" or "ode", see engines()).
+    """Steps a scene file (mlcp-scene/1) in an engine ("bullet", "bullet-multibody" or "ode",
+    see engines()). "bullet-multibody" builds the scene's articulated bodies as Bullet
+    btMultiBodies (reduced coordinates) and runs Bullet's own solvers ("bullet-si",
+    "bullet-mlcp-dantzig", ...); "bullet" and "ode" build them as jointed rigid bodies.
 
     The settings of `mlcp run`, snake_case, with its defaults (`mlcp run --help`); None: the
     scene's own value (solver, steps, iterations, tol, friction, friction_directions) or the
@@ -358,6 +361,6 @@ def solvers() -> List[str]:
 
 
 def engines() -> List[str]:
-    """The engines this build can run scenes in ("bullet", "ode")."""
+    """The engines this build can run scenes in ("bullet", "bullet-multibody", "ode")."""
     return list(_mlcp.engine_names())
 

@@ -56,7 +56,7 @@ OUTCOMES = OrderedDict([  # outcome -> (colour, letter); colour-blind-safe-ish, 
     ("exploded", ("#c0392b", "E")),
     ("solver-failure", ("#5e3c99", "F")),
 ])
-ENGINE_STYLE = {"bullet": ("-", "o"), "ode": ("--", "s")}
+ENGINE_STYLE = {"bullet": ("-", "o"), "bullet-multibody": ("-.", "P"), "ode": ("--", "s")}
 OTHER_STYLES = [(":", "^"), ("-.", "D"), ((0, (5, 1)), "v")]
 LOG_FLOOR = 1e-17  # where zeros go on a log axis
 AXIS_NAMES = {  # setting name -> axis label with its unit (other names are shown as they are)

@@ -13,166 +13,12 @@
 #include "mlcp/input_limits.hpp"
 #include "mlcp/scene/convex_hull.hpp"
 #include "mlcp/scene/scene_limits.hpp"
+#include "scene_parse.hpp"
 
 namespace mlcp::scene {
 
-using nlohmann::json;
-
-namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-// A typo such as "count": 1e6 should fail fast rather than allocate for minutes.
-constexpr long long kMaxGeneratedBodies = limits::kMaxBodies;
-
-double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-double norm(const Vec3& a) { return std::sqrt(dot(a, a)); }
-
-std::string shortDump(const json& v) {
-  std::string s = v.dump();
-  if (s.size() > 60) s = s.substr(0, 57) + "...";
-  return s;
-}
-
-// Names and keys come from the file: quoted capped, so that a message stays one short line.
-std::string inQuotes(const std::string& s) { return "\"" + io::capped(s) + "\""; }
-
-std::string joinNames(std::initializer_list<const char*> names) {
-  std::string s;
-  for (const char* n : names) s += std::string(s.empty() ? "" : ", ") + n;
-  return s;
-}
-
-// A JSON value together with its path in the document, so that every check can name where it
-// failed: "bodies[3].shape.size".
-class Node {
- public:
-  Node(const json& value, std::string path, const std::string& source)
-      : v_(value), path_(std::move(path)), source_(source) {}
-
-  [[noreturn]] void fail(const std::string& what) const {
-    const std::string where =
-        path_.empty() ? "top level" : io::capped(path_, 2 * io::kMaxEchoChars);
-    throw FormatError(source_ + ": " + where + ": " + what);
-  }
-
-  const json& value() const { return v_; }
-  const std::string& path() const { return path_; }
-
-  const Node& requireObject() const {
-    if (!v_.is_object()) fail("expected an object, got " + shortDump(v_));
-    return *this;
-  }
-  bool has(const char* key) const { return v_.is_object() && v_.contains(key); }
-  Node at(const char* key) const {
-    requireObject();
-    if (!v_.contains(key)) fail(std::string("missing field \"") + key + "\"");
-    return child(key);
-  }
-  Node child(const std::string& key) const {
-    return Node(v_.at(key), path_.empty() ? key : path_ + "." + key, source_);
-  }
-  std::size_t arraySize() const {
-    if (!v_.is_array()) fail("expected an array, got " + shortDump(v_));
-    return v_.size();
-  }
-  Node item(std::size_t i) const {
-    return Node(v_.at(i), path_ + "[" + std::to_string(i) + "]", source_);
-  }
-
-  // Keys outside `allowed` (and "comment", allowed everywhere) are errors: they are typos.
-  void allowOnly(std::initializer_list<const char*> allowed) const {
-    requireObject();
-    for (auto it = v_.begin(); it != v_.end(); ++it) {
-      if (it.key() == "comment") continue;
-      bool known =
-          std::any_of(allowed.begin(), allowed.end(), [&](const char* a) { return it.key() == a; });
-      if (!known)
-        fail("unknown field " + inQuotes(it.key()) + " (allowed here: " + joinNames(allowed) + ")");
-    }
-  }
-  void forbid(const char* key, const std::string& why) const {
-    if (has(key)) child(key).fail("not allowed: " + why);
-  }
-
-  double number() const {
-    if (!v_.is_number()) fail("expected a number, got " + shortDump(v_));
-    double d = v_.get<double>();
-    if (!std::isfinite(d)) fail("expected a finite number, got " + shortDump(v_));
-    return d;
-  }
-  double positive() const {
-    double d = number();
-    if (d <= 0) fail("expected a positive number, got " + shortDump(v_));
-    return d;
-  }
-  double nonNegative() const {
-    double d = number();
-    if (d < 0) fail("expected a number >= 0, got " + shortDump(v_));
-    return d;
-  }
-  double inRange(double lo, double hi) const {
-    double d = number();
-    if (d < lo || d > hi) {
-      std::ostringstream os;
-      os << "expected a number in [" << lo << ", " << hi << "], got " << shortDump(v_);
-      fail(os.str());
-    }
-    return d;
-  }
-  long long integer(long long min, long long max) const {
-    double d = v_.is_number() ? v_.get<double>() : NAN;
-    if (!v_.is_number() || d != std::floor(d) || d < double(min) || d > double(max))
-      fail("expected an integer in [" + std::to_string(min) + ", " + std::to_string(max) +
-           "], got " + shortDump(v_));
-    return static_cast<long long>(d);
-  }
-  std::string string() const {
-    if (!v_.is_string() || v_.get<std::string>().empty())
-      fail("expected a non-empty string, got " + shortDump(v_));
-    return v_.get<std::string>();
-  }
-  bool boolean() const {
-    if (!v_.is_boolean()) fail("expected true or false, got " + shortDump(v_));
-    return v_.get<bool>();
-  }
-  Vec3 vec3(const char* what = "3 numbers") const {
-    if (!v_.is_array() || v_.size() != 3 ||
-        !std::all_of(v_.begin(), v_.end(), [](const json& e) { return e.is_number(); }))
-      fail(std::string("expected ") + what + ", got " + shortDump(v_));
-    Vec3 r{v_[0].get<double>(), v_[1].get<double>(), v_[2].get<double>()};
-    if (!std::all_of(r.begin(), r.end(), [](double d) { return std::isfinite(d); }))
-      fail(std::string("expected ") + what + ", got " + shortDump(v_));
-    return r;
-  }
-  Vec3 positiveVec3() const {
-    Vec3 r = vec3("3 positive numbers");
-    if (!std::all_of(r.begin(), r.end(), [](double d) { return d > 0; }))
-      fail("expected 3 positive numbers, got " + shortDump(v_));
-    return r;
-  }
-  Vec3 unitVec3() const {
-    Vec3 r = vec3("a direction (3 numbers, not all 0)");
-    // Scaled by the largest component first: the norm of [-1e308, -1, 0] overflows.
-    const double big = std::max({std::abs(r[0]), std::abs(r[1]), std::abs(r[2])});
-    if (big > 0) r = {r[0] / big, r[1] / big, r[2] / big};
-    double n = norm(r);
-    if (n < 1e-12) fail("expected a direction (3 numbers, not all 0), got " + shortDump(v_));
-    return {r[0] / n, r[1] / n, r[2] / n};
-  }
-
- private:
-  const json& v_;
-  std::string path_;
-  const std::string& source_;
-};
-
-// Optional fields: the default when absent, else the checked value.
-double numberOr(const Node& n, const char* key, double fallback, double (Node::*get)() const) {
-  return n.has(key) ? (n.child(key).*get)() : fallback;
-}
-Vec3 vec3Or(const Node& n, const char* key, const Vec3& fallback) {
-  return n.has(key) ? n.child(key).vec3() : fallback;
-}
+// The parser's pieces live in parse (scene_parse.hpp), shared with articulation.cpp.
+namespace parse {
 
 Quat parseOrientation(const Node& n) {
   if (n.value().is_array()) {
@@ -287,43 +133,69 @@ std::pair<double, double> zRangeOf(const Shape& s) {
   return {0, 0};
 }
 
-enum class BodyRole { Explicit, Template, UnrotatedTemplate };
-
 // Parses a body, or a generator's template body (no name or position: the generator sets
 // them; stacks and pyramids also keep their bodies unrotated).
+// The fields each role may have ("comment" aside).
+void allowBodyFields(const Node& n, BodyRole role) {
+  switch (role) {
+    case BodyRole::Explicit:
+      n.allowOnly({"name", "shape", "mass", "material", "position", "orientation", "velocity",
+                   "angular_velocity"});
+      return;
+    case BodyRole::Link:
+    case BodyRole::FixedBase:
+      n.allowOnly({"name", "shape", "mass", "inertia", "material", "position", "orientation",
+                   "parent", "joint"});
+      return;
+    case BodyRole::Template:
+    case BodyRole::UnrotatedTemplate:
+      n.forbid("name", "the generator names its bodies");
+      n.forbid("position", "the generator places its bodies");
+      if (role == BodyRole::UnrotatedTemplate)
+        n.forbid("orientation", "stack and pyramid bodies are not rotated (use a grid)");
+      n.allowOnly({"shape", "mass", "material", "orientation", "velocity", "angular_velocity"});
+      return;
+  }
+}
+
+// Mass, pose and velocity of a body that is not a plane.
+void parseMassAndPose(const Node& n, BodyRole role, Body& b) {
+  if (role == BodyRole::FixedBase) {
+    if (n.has("mass") && n.child("mass").number() != 0)
+      n.child("mass").fail("a fixed base is static: its mass must be 0 or omitted");
+  } else {
+    if (!n.has("mass")) n.fail("missing field \"mass\" (kg; 0 makes the body static)");
+    b.mass = n.child("mass").nonNegative();
+    const bool template_ = role == BodyRole::Template || role == BodyRole::UnrotatedTemplate;
+    if (template_ && b.mass == 0)
+      n.child("mass").fail("a generator's bodies must be dynamic (mass > 0)");
+    if (role == BodyRole::Link && b.mass == 0)
+      n.child("mass").fail("a link or floating base must be dynamic (mass > 0)");
+  }
+  b.position = vec3Or(n, "position", b.position);
+  if (n.has("orientation")) b.orientation = parseOrientation(n.child("orientation"));
+  b.velocity = vec3Or(n, "velocity", b.velocity);
+  b.angularVelocity = vec3Or(n, "angular_velocity", b.angularVelocity);
+  if (b.mass == 0 && (norm(b.velocity) != 0 || norm(b.angularVelocity) != 0))
+    n.fail("a static body (mass 0) cannot have a velocity");
+}
+
 Body parseBody(const Node& n, BodyRole role, const Scene& scene) {
   n.requireObject();
-  if (role == BodyRole::Explicit) {
-    n.allowOnly({"name", "shape", "mass", "material", "position", "orientation", "velocity",
-                 "angular_velocity"});
-  } else {
-    n.forbid("name", "the generator names its bodies");
-    n.forbid("position", "the generator places its bodies");
-    if (role == BodyRole::UnrotatedTemplate)
-      n.forbid("orientation", "stack and pyramid bodies are not rotated (use a grid)");
-    n.allowOnly({"shape", "mass", "material", "orientation", "velocity", "angular_velocity"});
-  }
+  allowBodyFields(n, role);
   Body b;
   if (role == BodyRole::Explicit) b.name = n.at("name").string();
   b.shape = parseShape(n.at("shape"));
   if (b.shape.type == ShapeType::Plane) {
-    if (role != BodyRole::Explicit) n.child("shape").fail("a generator cannot make planes");
+    if (role != BodyRole::Explicit)
+      n.child("shape").fail("a plane can only be an entry of \"bodies\"");
     if (n.has("mass") && n.child("mass").number() != 0)
       n.child("mass").fail("a plane is static: its mass must be 0 or omitted");
     const char* why = "a plane is placed by shape.normal and shape.offset and does not move";
     for (const char* key : {"position", "orientation", "velocity", "angular_velocity"})
       n.forbid(key, why);
   } else {
-    if (!n.has("mass")) n.fail("missing field \"mass\" (kg; 0 makes the body static)");
-    b.mass = n.child("mass").nonNegative();
-    if (role != BodyRole::Explicit && b.mass == 0)
-      n.child("mass").fail("a generator's bodies must be dynamic (mass > 0)");
-    b.position = vec3Or(n, "position", b.position);
-    if (n.has("orientation")) b.orientation = parseOrientation(n.child("orientation"));
-    b.velocity = vec3Or(n, "velocity", b.velocity);
-    b.angularVelocity = vec3Or(n, "angular_velocity", b.angularVelocity);
-    if (b.mass == 0 && (norm(b.velocity) != 0 || norm(b.angularVelocity) != 0))
-      n.fail("a static body (mass 0) cannot have a velocity");
+    parseMassAndPose(n, role, b);
   }
   if (n.has("material")) {
     const std::string m = n.child("material").string();
@@ -699,7 +571,9 @@ std::string stem(const std::string& source) {
   return p.extension() == ".json" ? p.stem().string() : p.filename().string();
 }
 
-}  // namespace
+}  // namespace parse
+
+using namespace parse;
 
 Vec3 rotate(const Quat& q, const Vec3& v) {
   // v + 2 u x (u x v + w v), u = (x, y, z): the expanded q v q^-1 for unit q.
@@ -812,7 +686,7 @@ Scene parseScene(const std::string& text, const std::string& sourceName) {
   }
   const Node root(doc, "", sourceName);
   root.allowOnly({"format", "name", "description", "gravity", "settings", "solver", "materials",
-                  "bodies", "joints"});
+                  "bodies", "articulations", "joints"});
   const Node format = root.at("format");
   if (!format.value().is_string() || format.value().get<std::string>() != kFormat)
     format.fail(std::string("expected \"") + kFormat + "\", got " + shortDump(format.value()));
@@ -847,14 +721,18 @@ Scene parseScene(const std::string& text, const std::string& sourceName) {
                    it->second);
     }
   }
+  for (Body& b : scene.bodies) b.inertia = inertiaOf(b.shape, b.mass);
+  // Articulations first: their link joints take scene.joints[0 ..), the file's joints follow.
+  if (root.has("articulations")) parseArticulations(root.child("articulations"), scene);
   if (scene.dynamicBodyCount() == 0)
     bodies.fail("a scene needs at least one dynamic body (mass > 0)");
-  for (Body& b : scene.bodies) b.inertia = inertiaOf(b.shape, b.mass);
 
   if (root.has("joints")) {
     const Node joints = root.child("joints");
+    const std::size_t first = scene.joints.size();
     for (std::size_t i = 0; i < joints.arraySize(); ++i)
       scene.joints.push_back(parseJoint(joints.item(i), i, scene));
+    checkArticulationsAlone(joints, scene, first);
   }
   checkSceneLimits(scene);
   return scene;

@@ -80,6 +80,7 @@ void checkBody(const Scene& scene, const Body& b) {
   at.unit("orientation", std::sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z));
   at.magnitude("velocity", b.velocity, kMaxSpeed, "m/s");
   at.magnitude("angular_velocity", b.angularVelocity, kMaxAngularSpeed, "rad/s");
+  for (double i : b.inertia) at.range("inertia", i, 0, kMaxInertia, "kg m^2");
 }
 
 void checkSpring(const Where& at, const char* field, const JointSpring& s) {

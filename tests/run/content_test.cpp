@@ -81,6 +81,10 @@ std::vector<Case> cases() {
   add("hull_stack", both, {"pgs", "dantzig", "lemke", "auto"}, 60);
   add("stack_1000", both, {"pgs", "auto"}, 2);
   add("boxes_3000", both, {"pgs", "auto"}, 3);
+  // Articulated bodies as jointed rigid bodies (maximal coordinates; articulation_test runs them
+  // in bullet-multibody with Bullet's own solvers).
+  for (const char* scene : {"arm_push", "legged_base", "spherical_chain", "limit_chain"})
+    add(scene, both, {"pgs", "dantzig", "lemke", "ldlt", "auto"}, 60);
   return out;
 }
 
@@ -121,7 +125,30 @@ constexpr const char* kHullsPgs =
     "point per hull face pair tilts the stack, whose islands reach a condition number of 1.7e4 "
     "after diagonal scaling; two steps end at 1.1e-3, just above the 1e-3 acceptance (a method "
     "limit at the engine's count)";
+constexpr const char* kChainPgs =
+    "pgs convergence on jointed chains (the articulated scenes in maximal coordinates: 4 to 6 "
+    "links, motors at their force bounds, limits, ground contacts): the worst step of 60 in "
+    "Bullet ends at 0.65 (arm_push), 0.34 (limit_chain), 0.098 (legged_base) and 0.0076 "
+    "(spherical_chain) after 50 sweeps and still at 0.016, 0.014, 0.0053 and 3.9e-5 after 1000, "
+    "against the 1e-3 acceptance (a method limit: the exact solvers and auto hold every step)";
+constexpr const char* kChainLdlt =
+    "ldlt refuses bounded rows (limits, motors, contacts) and its pgs fallback misses the 1e-3 "
+    "acceptance on the jointed chains (see kChainPgs)";
 const KnownFailure kKnownFailures[] = {
+    {"arm_push", "bullet", "pgs", kChainPgs, false},
+    {"arm_push", "ode", "pgs", kChainPgs, false},
+    {"arm_push", "bullet", "ldlt", kChainLdlt, false},
+    {"arm_push", "ode", "ldlt", kChainLdlt, false},
+    {"legged_base", "bullet", "pgs", kChainPgs, false},
+    {"legged_base", "ode", "pgs", kChainPgs, false},
+    {"legged_base", "bullet", "ldlt", kChainLdlt, false},
+    {"legged_base", "ode", "ldlt", kChainLdlt, false},
+    {"limit_chain", "bullet", "pgs", kChainPgs, false},
+    {"limit_chain", "ode", "pgs", kChainPgs, false},
+    {"limit_chain", "bullet", "ldlt", kChainLdlt, false},
+    {"limit_chain", "ode", "ldlt", kChainLdlt, false},
+    {"spherical_chain", "bullet", "pgs", kChainPgs, false},
+    {"spherical_chain", "ode", "pgs", kChainPgs, false},
     {"vehicle", "ode", "pgs", kVehiclePgs, false},
     {"vehicle", "ode", "ldlt", kVehicleLdlt, false},
     {"hull_stack", "ode", "pgs", kHullsPgs, false},

@@ -192,6 +192,8 @@ bool exempt(const Scene& s, int i, int j) {
     if (!jt.collideConnected &&
         ((jt.body0 == i && jt.body1 == j) || (jt.body0 == j && jt.body1 == i)))
       return true;
+  for (const auto& [link, base] : s.fixedBaseNeighbours())
+    if ((link == i && base == j) || (link == j && base == i)) return true;
   return false;
 }
 
@@ -232,6 +234,11 @@ const Expected kScenes[] = {
     {"slide_diagonal", 2, 1, 0},  // the friction models' anisotropy
     {"wall_120", 121, 120, 0},
     {"basic_demo", 126, 125, 0},  // Bullet's BasicDemo
+    // Articulated bodies: a link joint each.
+    {"arm_push", 8, 6, 4},
+    {"legged_base", 10, 9, 8},
+    {"spherical_chain", 8, 6, 5},  // Bullet's MultiDofDemo
+    {"limit_chain", 8, 6, 6},
 };
 
 TEST(SceneFiles, EveryFileIsListedAndLoadsWithItsCounts) {

@@ -10,7 +10,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 source "$(dirname "${BASH_SOURCE[0]}")/../cli/check.sh"
 header='setting,value,setting_applies,scene,engine,solver,step,solver_ms,step_ms,residual,iterations,status,fallbacks,choice,contacts,max_penetration,joint_error,energy,momentum,max_speed'
-engines=$("$mlcp" sweep --help | sed -n 's/.*all built: \([a-z, ]*\)).*/\1/p' | head -1 | tr -d ' ')
+engines=$("$mlcp" sweep --help | sed -n 's/.*default: \([a-z, ]*\)).*/\1/p' | head -1 | tr -d ' ')
 n_engines=$(tr ',' '\n' <<< "$engines" | grep -c .)
 
 # sweep_ok NAME FILE ROWS AWK_CHECK: header, row count, 20 fields per row, numeric columns, and

@@ -1,5 +1,5 @@
-// mlcp run SCENE --engine bullet|ode --solver NAME: a scene file stepped in an engine, one CSV
-// row of measures per step (see mlcp/scene/world.hpp for what each column means).
+// mlcp run SCENE --engine bullet|bullet-multibody|ode --solver NAME: a scene file stepped in an
+// engine, one CSV row of measures per step (see mlcp/scene/world.hpp for what each column means).
 #include <algorithm>
 #include <cmath>
 #include <filesystem>

@@ -22,6 +22,7 @@ std::vector<std::string> engineList() {
   std::vector<std::string> list;
 #ifdef MLCP_HAVE_BULLET
   list.push_back("bullet");
+  list.push_back("bullet-multibody");
 #endif
 #ifdef MLCP_HAVE_ODE
   list.push_back("ode");
@@ -29,16 +30,28 @@ std::vector<std::string> engineList() {
   return list;
 }
 
-std::string engineNames() {
+std::vector<std::string> defaultEngines() {
+  std::vector<std::string> list = engineList();
+  list.erase(std::remove(list.begin(), list.end(), "bullet-multibody"), list.end());
+  return list;
+}
+
+namespace {
+std::string joined(const std::vector<std::string>& list) {
   std::string s;
-  for (const std::string& e : engineList()) s += (s.empty() ? "" : ", ") + e;
+  for (const std::string& e : list) s += (s.empty() ? "" : ", ") + e;
   return s.empty() ? "none (built without engine adapters)" : s;
 }
+}  // namespace
+
+std::string engineNames() { return joined(engineList()); }
+std::string defaultEngineNames() { return joined(defaultEngines()); }
 
 std::unique_ptr<scene::World> makeWorld(const std::string& engine, const scene::Scene& s,
                                         const scene::RunSettings& run) {
 #ifdef MLCP_HAVE_BULLET
   if (engine == "bullet") return bullet::loadWorld(s, run);
+  if (engine == "bullet-multibody") return bullet::loadWorld(s, run, bullet::Coordinates::Reduced);
 #endif
 #ifdef MLCP_HAVE_ODE
   if (engine == "ode") return ode::loadWorld(s, run);

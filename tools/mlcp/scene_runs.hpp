@@ -13,9 +13,15 @@
 
 namespace mlcp::cli {
 
-// Engines this build can run ("bullet, ode"), for help texts and errors.
+// Engines this build can run ("bullet, bullet-multibody, ode"), for help texts and errors.
+// "bullet-multibody" is Bullet with its articulations as btMultiBodies (reduced coordinates).
 std::string engineNames();
 std::vector<std::string> engineList();
+// The engines a sweep or stability map runs when none is named: those every core solver runs in
+// ("bullet", "ode"; bullet-multibody takes Bullet's own solvers only until
+// mlcp::bullet::install() serves multibody worlds).
+std::vector<std::string> defaultEngines();
+std::string defaultEngineNames();  // the same, comma separated
 
 // The scene loaded into `engine`; throws std::invalid_argument for an unknown engine or solver
 // (the message lists the valid names).

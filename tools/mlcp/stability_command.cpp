@@ -144,7 +144,8 @@ std::string stabilityHelp() {
 // The grids: engines, solvers and each grid's axes, and what every cell runs.
 void addGridOptions(CLI::App* cmd, StabilityGrid& grid) {
   cmd->add_option("--engines", grid.engines,
-                  "engines, comma separated (default: all built: " + engineNames() + ")")
+                  "engines, comma separated (known: " + engineNames() +
+                      "; default: " + defaultEngineNames() + ")")
       ->delimiter(',');
   cmd->add_option("--solvers", grid.solvers,
                   "solvers, comma separated; stock names (bullet-*, ode-*) run in their own "

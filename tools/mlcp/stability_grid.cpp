@@ -8,10 +8,10 @@ namespace mlcp::cli {
 
 namespace {
 
-// Stock names run only in their own engine.
+// Stock names run only in their own engine ("bullet-si" in bullet and bullet-multibody).
 bool runsIn(const std::string& solver, const std::string& engine) {
   for (const std::string& e : engineList())
-    if (solver.rfind(e + "-", 0) == 0) return e == engine;
+    if (solver.rfind(e + "-", 0) == 0) return e == engine || engine.rfind(e + "-", 0) == 0;
   return true;
 }
 
@@ -24,7 +24,7 @@ StabilityGrid resolved(StabilityGrid g) {
     g.iterationCounts = {3, 20};
     g.seconds = 1;
   }
-  if (g.engines.empty()) g.engines = engineList();
+  if (g.engines.empty()) g.engines = defaultEngines();
   return g;
 }
 

@@ -398,7 +398,7 @@ Runner addSweepCommand(CLI::App& app) {
           "scene file, engine, solver, setting or value.");
   cmd->add_option("scenes", args->spec.scenes, "scene files (.json, mlcp-scene/1)")->required();
   cmd->add_option("--engines", args->spec.engines,
-                  "engines (default: all built: " + engineNames() + ")")
+                  "engines (known: " + engineNames() + "; default: " + defaultEngineNames() + ")")
       ->delimiter(',');
   cmd->add_option("--solvers", args->spec.solvers,
                   "core solver names and stock ones (bullet-si, bullet-nncg, bullet-mlcp-pgs, "

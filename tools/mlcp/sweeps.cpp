@@ -133,7 +133,7 @@ SweepPlan planSweep(const SweepSpec& spec) {
                                 "' is not iterations or tolerance");
   const std::vector<double> values = parseValues(spec);
   const std::vector<std::string> known = engineList();
-  const std::vector<std::string> engines = spec.engines.empty() ? known : spec.engines;
+  const std::vector<std::string> engines = spec.engines.empty() ? defaultEngines() : spec.engines;
   for (const std::string& e : engines)
     if (std::find(known.begin(), known.end(), e) == known.end())
       throw std::invalid_argument("unknown engine '" + e + "' (known: " + engineNames() + ")");

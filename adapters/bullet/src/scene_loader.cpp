@@ -6,6 +6,12 @@
 #include <BulletDynamics/ConstraintSolver/btHinge2Constraint.h>
 #include <BulletDynamics/ConstraintSolver/btNNCGConstraintSolver.h>
 #include <BulletDynamics/ConstraintSolver/btUniversalConstraint.h>
+#include <BulletDynamics/Featherstone/btMultiBodyConstraintSolver.h>
+#include <BulletDynamics/Featherstone/btMultiBodyDynamicsWorld.h>
+#include <BulletDynamics/Featherstone/btMultiBodyMLCPConstraintSolver.h>
+#include <BulletDynamics/MLCPSolvers/btDantzigSolver.h>
+#include <BulletDynamics/MLCPSolvers/btLemkeSolver.h>
+#include <BulletDynamics/MLCPSolvers/btSolveProjectedGaussSeidel.h>
 #include <btBulletDynamicsCommon.h>
 
 #include <algorithm>
@@ -14,7 +20,9 @@
 #include <stdexcept>
 #include <vector>
 
+#include "mlcp/bullet/worlds.hpp"
 #include "mlcp/registry.hpp"
+#include "scene_bullet.hpp"
 #include "scenes.hpp"
 
 namespace mlcp::bullet {
@@ -22,9 +30,6 @@ namespace mlcp::bullet {
 namespace {
 
 using scene::Vec3;
-
-btVector3 bt(const Vec3& v) { return btVector3(v[0], v[1], v[2]); }
-Vec3 vec(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
 
 double now() {
   using Clock = std::chrono::steady_clock;
@@ -90,14 +95,66 @@ btTransform jointFrame(const Vec3& anchor, const Vec3& axis, int axisColumn) {
   return btTransform(m, bt(anchor));
 }
 
+// The adapter's settings for a core solver run by these run settings.
+Settings coreSettings(const scene::RunSettings& run) {
+  Settings settings;
+  settings.options.maxIterations = run.iterations;
+  settings.options.tolerance = run.tolerance;
+  settings.warmStart = run.warmStart;
+  settings.fallback = run.fallback;
+  settings.acceptResidual = run.fallbackResidual;
+  settings.engineIterations = run.engineIterations;  // m_numIterations is run.iterations
+  settings.timeBudget = run.timeBudget;
+  if (run.pivotingSteps >= 0)
+    settings.newton.pivotingSteps = settings.newton.bodyPivotingSteps = run.pivotingSteps;
+  settings.friction = run.friction;
+  settings.frictionDirections = run.frictionDirections;
+  return settings;
+}
+
+// A btMultiBodyDynamicsWorld's solver, timed where the world hands it each island.
+template <class Base>
+class TimedMultiBody : public Base {
+ public:
+  using Base::Base;
+  void solveMultiBodyGroup(btCollisionObject** bodies, int numBodies,
+                           btPersistentManifold** manifolds, int numManifolds,
+                           btTypedConstraint** constraints, int numConstraints,
+                           btMultiBodyConstraint** multiBodyConstraints,
+                           int numMultiBodyConstraints, const btContactSolverInfo& info,
+                           btIDebugDraw* debugDrawer, btDispatcher* dispatcher) override {
+    const double t0 = now();
+    Base::solveMultiBodyGroup(bodies, numBodies, manifolds, numManifolds, constraints,
+                              numConstraints, multiBodyConstraints, numMultiBodyConstraints, info,
+                              debugDrawer, dispatcher);
+    seconds += now() - t0;
+  }
+  double seconds = 0;
+};
+
+// Bullet's own MLCP solvers by the name after "bullet-mlcp-" ("pgs", "dantzig", "lemke").
+std::unique_ptr<btMLCPSolverInterface> makeBulletMlcp(const std::string& which) {
+  if (which == "pgs") return std::make_unique<btSolveProjectedGaussSeidel>();
+  if (which == "dantzig") return std::make_unique<btDantzigSolver>();
+  if (which == "lemke") return std::make_unique<btLemkeSolver>();
+  return nullptr;
+}
+
 class BulletWorld : public scene::World {
  public:
-  BulletWorld(const scene::Scene& s, const scene::RunSettings& run) : scene::World(s) {
+  BulletWorld(const scene::Scene& s, const scene::RunSettings& run, Coordinates coordinates)
+      : scene::World(s), reduced_(coordinates == Coordinates::Reduced) {
     std::unique_ptr<btConstraintSolver> solver;
     const std::string& name = run.solver;
     if (run.friction == FrictionModel::Cone && name.rfind("bullet-", 0) == 0)
       throw std::invalid_argument("friction 'cone' needs a core solver; '" + name +
                                   "' is Bullet's own (box friction)");
+    iterations_ = run.iterations;
+    tolerance_ = run.tolerance;
+    if (reduced_) {
+      makeMultiBodyWorld(s, run);
+      return;
+    }
     if (name == "bullet-si") {
       solver = std::make_unique<btSequentialImpulseConstraintSolver>();
       fixedSweeps_ = true;
@@ -112,43 +169,16 @@ class BulletWorld : public scene::World {
       throw std::invalid_argument("unknown solver '" + name +
                                   "' for Bullet (known: " + worldSolverNames() + ")");
     } else {
-      Settings settings;
-      settings.options.maxIterations = run.iterations;
-      settings.options.tolerance = run.tolerance;
-      settings.warmStart = run.warmStart;
-      settings.fallback = run.fallback;
-      settings.acceptResidual = run.fallbackResidual;
-      settings.engineIterations = run.engineIterations;  // m_numIterations is run.iterations
-      settings.timeBudget = run.timeBudget;
-      if (run.pivotingSteps >= 0)
-        settings.newton.pivotingSteps = settings.newton.bodyPivotingSteps = run.pivotingSteps;
-      settings.friction = run.friction;
-      settings.frictionDirections = run.frictionDirections;
-      solver = scenes::makeBulletSolver(name, settings);  // throws for unknown names
+      solver = scenes::makeBulletSolver(name, coreSettings(run));  // throws for unknown names
       ours_ = static_cast<ConstraintSolver*>(solver.get());
     }
-    iterations_ = run.iterations;
-    tolerance_ = run.tolerance;
     timed_ = std::make_unique<TimedSolver>(std::move(solver));
     built_ = buildWorld(s, run);
     built_->world().setConstraintSolver(timed_.get());
   }
 
-  std::vector<scene::BodyState> states() const override {
-    const std::vector<btRigidBody*>& bodies = built_->bodies();
-    std::vector<scene::BodyState> out(bodies.size());
-    for (std::size_t i = 0; i < bodies.size(); ++i) {
-      const btRigidBody& b = *bodies[i];
-      const btTransform& t = b.getCenterOfMassTransform();
-      const btQuaternion q = t.getRotation();
-      out[i].position = vec(t.getOrigin());
-      out[i].orientation = {q.w(), q.x(), q.y(), q.z()};
-      out[i].velocity = vec(b.getLinearVelocity());
-      out[i].angularVelocity = vec(b.getAngularVelocity());
-    }
-    return out;
-  }
-  const char* engine() const override { return "bullet"; }
+  std::vector<scene::BodyState> states() const override { return built_->states(); }
+  const char* engine() const override { return reduced_ ? "bullet-multibody" : "bullet"; }
 
   bool captureNextStep(const std::string& folder) override {
     captured_.clear();
@@ -162,7 +192,9 @@ class BulletWorld : public scene::World {
 
  protected:
   void stepEngine(scene::StepMeasures& m) override {
-    timed_->seconds = 0;
+    double untimed = 0;  // ours in a multibody world: lastStep() has the time
+    double& seconds = multiBodySeconds_ ? *multiBodySeconds_ : timed_ ? timed_->seconds : untimed;
+    seconds = 0;
     const int fallbacksBefore = stock_ ? stock_->fallbacks() : 0;
     const double h = scene().settings.timeStep;
     built_->world().stepSimulation(h, 0, h);
@@ -171,7 +203,7 @@ class BulletWorld : public scene::World {
       ours_->rowSolver()->setCapture("");
       capturing_ = false;
     }
-    m.solverMs = 1e3 * timed_->seconds;
+    m.solverMs = 1e3 * seconds;
     if (ours_) {
       const StepStats& st = ours_->lastStep();
       m.solverMs = 1e3 * (st.seconds);
@@ -188,7 +220,7 @@ class BulletWorld : public scene::World {
       m.iterations = pivoting_ ? 0 : iterations_;
       m.status = m.residual <= tolerance_ ? "converged" : pivoting_ ? "failed" : "max-iterations";
     } else {
-      m.iterations = iterations_;
+      m.iterations = pivoting_ ? 0 : iterations_;
       m.status = "max-iterations";
     }
     double deepest = 0;
@@ -206,6 +238,45 @@ class BulletWorld : public scene::World {
   }
 
  private:
+  // A btMultiBodyDynamicsWorld: Bullet's own solvers by name (SI, or its MLCP path with its own
+  // MLCP solvers), or ours through install().
+  void makeMultiBodyWorld(const scene::Scene& s, const scene::RunSettings& run) {
+    const std::string& name = run.solver;
+    if (name.rfind("bullet-mlcp-", 0) == 0) mlcp_ = makeBulletMlcp(name.substr(12));
+    if (name != "bullet-si" && !mlcp_ && !RowSolver::known(name))
+      throw std::invalid_argument("unknown solver '" + name + "' for bullet-multibody (known: " +
+                                  worldSolverNames(Coordinates::Reduced) + ")");
+    built_ = buildWorld(s, run, Coordinates::Reduced);
+    auto& world = static_cast<btMultiBodyDynamicsWorld&>(built_->world());
+    if (mlcp_) {
+      pivoting_ = name != "bullet-mlcp-pgs";
+      auto solver = std::make_unique<TimedMultiBody<btMultiBodyMLCPConstraintSolver>>(mlcp_.get());
+      multiBodySeconds_ = &solver->seconds;
+      multiBodySolver_ = std::move(solver);
+    } else if (name == "bullet-si") {
+      auto solver = std::make_unique<TimedMultiBody<btMultiBodyConstraintSolver>>();
+      multiBodySeconds_ = &solver->seconds;
+      multiBodySolver_ = std::move(solver);
+    } else {
+      solver_ = std::make_unique<ConstraintSolver>(coreSettings(run));
+      ours_ = solver_.get();
+      try {
+        install(world, *solver_);  // the one call that puts a core solver in any Bullet world
+      } catch (const std::invalid_argument& e) {
+        throw scene::Unsupported("unsupported in bullet-multibody: solver '" + name + "' (" +
+                                 e.what() + ")");
+      }
+      return;
+    }
+    world.setMultiBodyConstraintSolver(multiBodySolver_.get());
+  }
+
+  bool reduced_ = false;
+  // Reduced: the solver in the world (ours, or Bullet's), destroyed after built_.
+  std::unique_ptr<ConstraintSolver> solver_;
+  std::unique_ptr<btMLCPSolverInterface> mlcp_;
+  std::unique_ptr<btMultiBodyConstraintSolver> multiBodySolver_;
+  double* multiBodySeconds_ = nullptr;
   std::unique_ptr<TimedSolver> timed_;
   ConstraintSolver* ours_ = nullptr;
   scenes::StockMlcp* stock_ = nullptr;
@@ -219,15 +290,23 @@ class BulletWorld : public scene::World {
 
 }  // namespace
 
-BulletScene::BulletScene(const scene::Scene& s, const scene::RunSettings& run)
+BulletScene::BulletScene(const scene::Scene& s, const scene::RunSettings& run,
+                         Coordinates coordinates)
     : timeStep_(s.settings.timeStep) {
   gCalculateCombinedRestitutionCallback = &maxRestitution;
   config_ = std::make_unique<btDefaultCollisionConfiguration>();
   dispatcher_ = std::make_unique<btCollisionDispatcher>(config_.get());
   broadphase_ = std::make_unique<btDbvtBroadphase>();
-  stockSolver_ = std::make_unique<btSequentialImpulseConstraintSolver>();
-  world_ = std::make_unique<btDiscreteDynamicsWorld>(dispatcher_.get(), broadphase_.get(),
-                                                     stockSolver_.get(), config_.get());
+  if (coordinates == Coordinates::Reduced) {
+    auto solver = std::make_unique<btMultiBodyConstraintSolver>();
+    world_ = std::make_unique<btMultiBodyDynamicsWorld>(dispatcher_.get(), broadphase_.get(),
+                                                        solver.get(), config_.get());
+    stockSolver_ = std::move(solver);
+  } else {
+    stockSolver_ = std::make_unique<btSequentialImpulseConstraintSolver>();
+    world_ = std::make_unique<btDiscreteDynamicsWorld>(dispatcher_.get(), broadphase_.get(),
+                                                       stockSolver_.get(), config_.get());
+  }
   world_->setGravity(bt(s.gravity));
   btContactSolverInfo& info = world_->getSolverInfo();
   info.m_timeStep = s.settings.timeStep;
@@ -240,18 +319,45 @@ BulletScene::BulletScene(const scene::Scene& s, const scene::RunSettings& run)
   info.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS | SOLVER_ENABLE_FRICTION_DIRECTION_CACHING |
                        SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION;
   if (!run.warmStart) info.m_solverMode &= ~SOLVER_USE_WARMSTARTING;
+  addContent(s, coordinates);
+}
 
-  for (const scene::Body& b : s.bodies) addBody(s, b);
-  for (const scene::Joint& j : s.joints) addJoint(j);
+void BulletScene::addContent(const scene::Scene& s, Coordinates coordinates) {
+  // Reduced: the articulations' bodies and link joints are the btMultiBodies' (one owner each).
+  std::vector<bool> inMultiBody(s.bodies.size(), false), jointInMultiBody(s.joints.size(), false);
+  if (coordinates == Coordinates::Reduced)
+    for (const scene::Articulation& a : s.articulations) {
+      inMultiBody[a.base] = true;
+      for (const scene::ArticulatedLink& l : a.links)
+        inMultiBody[l.body] = jointInMultiBody[l.joint] = true;
+    }
+  linkOf_.assign(s.bodies.size(), {nullptr, -1});
+  for (std::size_t i = 0; i < s.bodies.size(); ++i) {
+    if (!inMultiBody[i])
+      addBody(s, s.bodies[i]);
+    else
+      bodyPointers_.push_back(nullptr);
+  }
+  for (std::size_t i = 0; i < s.joints.size(); ++i)
+    if (!jointInMultiBody[i]) addJoint(s.joints[i]);
+  if (coordinates == Coordinates::Reduced)
+    for (const scene::Articulation& a : s.articulations) addMultiBody(s, a);
+  else
+    ignoreFixedBaseContacts(s, {bodyPointers_.begin(), bodyPointers_.end()});
 }
 
 BulletScene::~BulletScene() {
   for (auto& c : constraints_) world_->removeConstraint(c.get());
   for (auto& b : bodies_) world_->removeRigidBody(b.get());
+  if (auto* mw = dynamic_cast<btMultiBodyDynamicsWorld*>(world_.get())) {
+    for (auto& c : multiBodyConstraints_) mw->removeMultiBodyConstraint(c.get());
+    for (auto& c : colliders_) mw->removeCollisionObject(c.get());
+    for (auto& m : multiBodies_) mw->removeMultiBody(m.get());
+  }
   world_.reset();
 }
 
-void BulletScene::addBody(const scene::Scene& s, const scene::Body& b) {
+std::unique_ptr<btCollisionShape> BulletScene::makeShape(const scene::Body& b) {
   std::unique_ptr<btCollisionShape> shape;
   switch (b.shape.type) {
     case scene::ShapeType::Plane:
@@ -279,21 +385,20 @@ void BulletScene::addBody(const scene::Scene& s, const scene::Body& b) {
       break;
     }
   }
+  return shape;
+}
+
+void BulletScene::addBody(const scene::Scene& s, const scene::Body& b) {
+  std::unique_ptr<btCollisionShape> shape = makeShape(b);
   btTransform pose;
   pose.setIdentity();
-  if (b.shape.type != scene::ShapeType::Plane) {
-    pose.setOrigin(bt(b.position));
-    pose.setRotation(
-        btQuaternion(b.orientation.x, b.orientation.y, b.orientation.z, b.orientation.w));
-  }
+  if (b.shape.type != scene::ShapeType::Plane) pose = poseOf(b);
   motion_.push_back(std::make_unique<btDefaultMotionState>(pose));
   btRigidBody::btRigidBodyConstructionInfo ci(b.mass, motion_.back().get(), shape.get(),
                                               bt(b.inertia));
-  const scene::Material& mat = s.materials[b.material];
-  ci.m_friction = std::sqrt(mat.friction);
-  ci.m_restitution = mat.restitution;
   bodies_.push_back(std::make_unique<btRigidBody>(ci));
   btRigidBody* body = bodies_.back().get();
+  setMaterial(*body, s.materials[b.material]);
   bodyPointers_.push_back(body);
   if (!b.isStatic()) {
     body->setLinearVelocity(bt(b.velocity));
@@ -305,8 +410,8 @@ void BulletScene::addBody(const scene::Scene& s, const scene::Body& b) {
 }
 
 void BulletScene::addJoint(const scene::Joint& j) {
-  btRigidBody& a = *bodies_[j.body0];
-  btRigidBody& b = j.body1 >= 0 ? *bodies_[j.body1] : btTypedConstraint::getFixedBody();
+  btRigidBody& a = *bodyPointers_[j.body0];
+  btRigidBody& b = j.body1 >= 0 ? *bodyPointers_[j.body1] : btTypedConstraint::getFixedBody();
   const btTransform ta = a.getCenterOfMassTransform().inverse();
   const btTransform tb = b.getCenterOfMassTransform().inverse();
   // Bullet's slider offset is B's relative to A (its hinge angle is A's relative to B, as the
@@ -414,22 +519,25 @@ std::unique_ptr<btTypedConstraint> BulletScene::makeJoint(const scene::Joint& j,
                            scene::toString(j.type));
 }
 
-std::unique_ptr<BulletScene> buildWorld(const scene::Scene& scene, const scene::RunSettings& run) {
-  return std::make_unique<BulletScene>(scene, run);
+std::unique_ptr<BulletScene> buildWorld(const scene::Scene& scene, const scene::RunSettings& run,
+                                        Coordinates coordinates) {
+  return std::make_unique<BulletScene>(scene, run, coordinates);
 }
 
 std::unique_ptr<BulletScene> buildWorld(const scene::Scene& scene) {
   return buildWorld(scene, scene::RunSettings::fromScene(scene));
 }
 
-std::string worldSolverNames() {
-  return solverNames() +
-         ", bullet-si, bullet-nncg, bullet-mlcp-pgs, bullet-mlcp-dantzig, bullet-mlcp-lemke";
+std::string worldSolverNames(Coordinates coordinates) {
+  const char* nncg = coordinates == Coordinates::Maximal ? ", bullet-nncg" : "";
+  return solverNames() + ", bullet-si" + nncg +
+         ", bullet-mlcp-pgs, bullet-mlcp-dantzig, bullet-mlcp-lemke";
 }
 
 std::unique_ptr<scene::World> loadWorld(const scene::Scene& scene,
-                                        const scene::RunSettings& settings) {
-  return std::make_unique<BulletWorld>(scene, settings);
+                                        const scene::RunSettings& settings,
+                                        Coordinates coordinates) {
+  return std::make_unique<BulletWorld>(scene, settings, coordinates);
 }
 
 }  // namespace mlcp::bullet

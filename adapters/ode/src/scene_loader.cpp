@@ -161,8 +161,9 @@ const char* className(int cls) {
   }
 }
 
-int indexOf(dBodyID b) {
-  return static_cast<int>(reinterpret_cast<std::intptr_t>(dBodyGetData(b)));
+// The scene index of a geom's body (static ones included).
+int indexOf(dGeomID g) {
+  return static_cast<int>(reinterpret_cast<std::intptr_t>(dGeomGetData(g)));
 }
 
 class OdeWorld : public scene::World {
@@ -306,6 +307,8 @@ OdeScene::OdeScene(const scene::Scene& s, const scene::RunSettings& run)
   try {
     for (std::size_t i = 0; i < s.bodies.size(); ++i) addBody(s, static_cast<int>(i));
     for (const scene::Joint& j : s.joints) addJoint(j);
+    for (const auto& [link, base] : s.fixedBaseNeighbours())
+      noCollide_.insert(std::minmax(link, base));
   } catch (...) {  // scene::Unsupported: no destructor runs for a constructor that throws
     release();
     throw;
@@ -351,6 +354,7 @@ void OdeScene::addBody(const scene::Scene& s, int index) {
     case scene::ShapeType::ConvexHull: g = createConvex(b.shape); break;
   }
   materialOf_[g] = b.material;
+  dGeomSetData(g, reinterpret_cast<void*>(static_cast<std::intptr_t>(index)));
   const dQuaternion q = {b.orientation.w, b.orientation.x, b.orientation.y, b.orientation.z};
   if (b.isStatic()) {
     bodies_.push_back(nullptr);
@@ -452,7 +456,7 @@ void OdeScene::nearCallback(void* data, dGeomID g1, dGeomID g2) {
   auto* w = static_cast<OdeScene*>(data);
   dBodyID b1 = dGeomGetBody(g1), b2 = dGeomGetBody(g2);
   if (!b1 && !b2) return;
-  if (b1 && b2 && w->noCollide_.count(std::minmax(indexOf(b1), indexOf(b2)))) return;
+  if (w->noCollide_.count(std::minmax(indexOf(g1), indexOf(g2)))) return;
   const int n = w->maxContactsPerPair_;
   w->buffer_.resize(n);
   const int found = dCollide(g1, g2, n, &w->buffer_[0].geom, sizeof(dContact));

@@ -21,6 +21,7 @@ inline constexpr double kMaxLength = 1e4;      // m: box edges, radii, capsule l
 inline constexpr double kMaxCoordinate = 1e5;  // m: |positions|, |anchors|, |plane offsets|
 inline constexpr double kMinMass = 1e-4;       // kg, of a dynamic body (0 is static)
 inline constexpr double kMaxMass = 1e8;        // kg
+inline constexpr double kMaxInertia = 1e16;    // kg m^2: an articulated body's given "inertia"
 inline constexpr double kMaxSpeed = 1e4;       // m/s: |velocity| components, |motor velocity|
 inline constexpr double kMaxAngularSpeed = 1e4;  // rad/s: |angular velocity| components
 inline constexpr double kMaxGravity = 1e4;       // m/s^2: |gravity| components

@@ -24,6 +24,21 @@
 //   step to step (so last step's friction impulses are a warm start); at most 4 contacts per
 //   pair (Bullet's manifolds) whatever the scene says.
 //
+// Articulated bodies (mlcp/scene/articulation.hpp) load in one of two ways:
+// - Coordinates::Maximal (engine "bullet"): a btDiscreteDynamicsWorld; links are btRigidBodies
+//   joined by the scene's hinge, slider, point-to-point and fixed constraints, with their limits
+//   and motors, exactly as any jointed bodies of a scene;
+// - Coordinates::Reduced (engine "bullet-multibody"): a btMultiBodyDynamicsWorld; each articulation
+//   is a btMultiBody (setupRevolute/Prismatic/Spherical/Fixed from the scene's poses, anchors and
+//   axes), its shapes btMultiBodyLinkColliders, limits btMultiBodyJointLimitConstraints and motors
+//   btMultiBodyJointMotors (max impulse max_force * h); no damping (btMultiBody's default is
+//   0.04), self-collision on except parent and child (as the maximal loaders). Every other body is
+//   the btRigidBody it is in "bullet". The world solves with Bullet's own
+//   btMultiBodyConstraintSolver (SI, "bullet-si"), or with Bullet's MLCP path
+//   btMultiBodyMLCPConstraintSolver ("bullet-mlcp-pgs", "-dantzig", "-lemke"); a core solver is
+//   put in by mlcp::bullet::install(world, solver) (worlds.hpp), and where install() refuses the
+//   world, loadWorld says so in one line (scene::Unsupported).
+//
 // Solver names: any mlcp::solverNames() name runs through mlcp::bullet::ConstraintSolver (its
 // statistics fill the measures); the stock ones are
 //   bullet-si            btSequentialImpulseConstraintSolver
@@ -34,10 +49,14 @@
 // Stock SI and NNCG report no residual (NaN), `iterations` sweeps and status max-iterations.
 #pragma once
 
+#include <BulletDynamics/Featherstone/btMultiBody.h>
+#include <BulletDynamics/Featherstone/btMultiBodyConstraint.h>
+#include <BulletDynamics/Featherstone/btMultiBodyLinkCollider.h>
 #include <btBulletDynamicsCommon.h>
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "mlcp/scene/world.hpp"
@@ -49,22 +68,38 @@ namespace mlcp::bullet {
 // constraints), destroyed in the right order. The world starts with a stock
 // btSequentialImpulseConstraintSolver owned here; world().setConstraintSolver(&yours) swaps it
 // (yours must outlive the steps; Bullet does not take ownership).
+enum class Coordinates { Maximal, Reduced };
+
 class BulletScene {
  public:
-  // Settings used: gravity, time step, erp, cfm (scene), iterations and warmStart (run).
-  BulletScene(const scene::Scene& scene, const scene::RunSettings& run);
+  // Settings used: gravity, time step, erp, cfm (scene), iterations and warmStart (run). Reduced:
+  // a btMultiBodyDynamicsWorld whose articulations are btMultiBodies (see above).
+  BulletScene(const scene::Scene& scene, const scene::RunSettings& run,
+              Coordinates coordinates = Coordinates::Maximal);
   ~BulletScene();
   BulletScene(const BulletScene&) = delete;
   BulletScene& operator=(const BulletScene&) = delete;
 
   btDiscreteDynamicsWorld& world() { return *world_; }
   const btDiscreteDynamicsWorld& world() const { return *world_; }
-  // Every scene body, static ones included, in scene order.
+  // Every scene body, static ones included, in scene order; nullptr for the bodies of a
+  // btMultiBody (Reduced).
   const std::vector<btRigidBody*>& bodies() const { return bodyPointers_; }
+  // Reduced: the articulations' btMultiBodies, in scene order; empty in Maximal.
+  const std::vector<btMultiBody*>& multiBodies() const { return multiBodyPointers_; }
+  // Every scene body's pose and velocity, rigid or a btMultiBody's base or link.
+  std::vector<scene::BodyState> states() const;
   double timeStep() const { return timeStep_; }
 
  private:
+  // The bodies, joints and (Reduced) btMultiBodies of the scene.
+  void addContent(const scene::Scene& s, Coordinates coordinates);
+  std::unique_ptr<btCollisionShape> makeShape(const scene::Body& b);
   void addBody(const scene::Scene& s, const scene::Body& b);
+  // Reduced: the articulation as a btMultiBody with its colliders, limits and motors.
+  void addMultiBody(const scene::Scene& s, const scene::Articulation& a);
+  btMultiBodyLinkCollider* addCollider(const scene::Scene& s, const scene::Body& b, btMultiBody* mb,
+                                       int link);
   void addJoint(const scene::Joint& j);
   // The joint types beyond ball, hinge, slider and fixed (see the mapping above).
   std::unique_ptr<btTypedConstraint> makeJoint(const scene::Joint& j, btRigidBody& a,
@@ -81,18 +116,28 @@ class BulletScene {
   std::vector<std::unique_ptr<btRigidBody>> bodies_;
   std::vector<btRigidBody*> bodyPointers_;
   std::vector<std::unique_ptr<btTypedConstraint>> constraints_;
+  // Reduced: per scene body, the btMultiBody holding it and its link (-1 the base).
+  std::vector<std::pair<btMultiBody*, int>> linkOf_;
+  std::vector<std::unique_ptr<btMultiBody>> multiBodies_;
+  std::vector<btMultiBody*> multiBodyPointers_;
+  std::vector<std::unique_ptr<btMultiBodyLinkCollider>> colliders_;
+  std::vector<std::unique_ptr<btMultiBodyConstraint>> multiBodyConstraints_;
 };
 
 // The scene's stock world; the second form takes iterations and warmStart from the scene's
 // solver defaults (RunSettings::fromScene).
-std::unique_ptr<BulletScene> buildWorld(const scene::Scene& scene, const scene::RunSettings& run);
+std::unique_ptr<BulletScene> buildWorld(const scene::Scene& scene, const scene::RunSettings& run,
+                                        Coordinates coordinates = Coordinates::Maximal);
 std::unique_ptr<BulletScene> buildWorld(const scene::Scene& scene);
 
-// Throws std::invalid_argument for an unknown solver name (the message lists the known ones).
+// Throws std::invalid_argument for an unknown solver name (the message lists the known ones),
+// scene::Unsupported for a solver the world cannot take. World::engine() is "bullet" (Maximal)
+// or "bullet-multibody" (Reduced).
 std::unique_ptr<scene::World> loadWorld(const scene::Scene& scene,
-                                        const scene::RunSettings& settings);
+                                        const scene::RunSettings& settings,
+                                        Coordinates coordinates = Coordinates::Maximal);
 
 // Every solver name loadWorld accepts, comma separated.
-std::string worldSolverNames();
+std::string worldSolverNames(Coordinates coordinates = Coordinates::Maximal);
 
 }  // namespace mlcp::bullet
