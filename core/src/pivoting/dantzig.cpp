@@ -45,10 +45,13 @@ std::string redundantRowsNote(int redundant) {
 bool frictionPassesEnd(double res, int pass, const Options& opt, const std::string& singular,
                        Result& result) {
   if (res <= opt.tolerance) {
-    std::ostringstream os;
+    // Every converged friction solve writes this: built without an ostringstream, whose locale
+    // set-up costs more than a small island's pivoting.
     result.status = Status::Converged;
-    os << "friction bounds settled after " << pass << " pass" << (pass > 1 ? "es" : "") << singular;
-    result.message = os.str();
+    result.message = "friction bounds settled after ";
+    result.message += std::to_string(pass);
+    result.message += pass > 1 ? " passes" : " pass";
+    result.message += singular;
     return true;
   }
   if (pass >= opt.maxIterations) {
