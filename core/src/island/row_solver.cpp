@@ -11,6 +11,7 @@
 #include "mlcp/io.hpp"
 #include "mlcp/registry.hpp"
 #include "mlcp/residual.hpp"
+#include "mlcp/solvers/dantzig.hpp"
 
 namespace mlcp {
 
@@ -98,11 +99,19 @@ struct RowSolver::Impl::Slot {
   // More solves by the policy's singular-island solver first: set after an exact method ended
   // short of the tolerance on the island's contact rows.
   int singularFirst = 0;
+  // More dantzig solves on A + delta I at once (DantzigParams::regularised): set after one broke
+  // down on A and was retried regularised. A resting pile breaks down every step (coplanar
+  // contacts without cfm), and the attempt on A before the retry cost as much as the retry.
+  int regulariseFirst = 0;
 };
 
 namespace {
 // Islands not solved for this many calls lose their workspaces (once there are this many).
 constexpr std::size_t kSlotLimit = 1024;
+// Solves of an island that go to dantzig's regularised problem at once after a breakdown before
+// the plain problem is tried again (the contacts may have changed). The cost of a wrong guess is
+// one cold solve on A + delta I where a warm one on A would have done.
+constexpr int kRegulariseSolves = 8;
 }  // namespace
 
 namespace {
@@ -264,6 +273,11 @@ Result RowSolver::Impl::run(const RowSystem& rows, const std::string& name, cons
   }
   Solver* solver = assembledSolver(island, name);
   solver->setOptions(o);
+  auto* dantzig = equals(name, "dantzig") ? dynamic_cast<DantzigSolver*>(solver) : nullptr;
+  if (dantzig) {
+    dantzig->params().regularised = island.regulariseFirst > 0;
+    if (island.regulariseFirst > 0) --island.regulariseFirst;
+  }
   // The rows for this solve only, cleared on every way out (a throw included): the solver is
   // kept per island and must not hold them past this call.
   struct Rows {
@@ -271,7 +285,11 @@ Result RowSolver::Impl::run(const RowSystem& rows, const std::string& name, cons
     ~Rows() { solver->useRows(nullptr); }
   } scope{solver};
   solver->useRows(&rows);
-  return solver->solveWithGuess(assembled_, start, x);
+  Result r = solver->solveWithGuess(assembled_, start, x);
+  // A breakdown on A: the next solves go to A + delta I at once, the one after them tries A again.
+  if (dantzig && !dantzig->params().regularised && dantzig->regularised())
+    island.regulariseFirst = kRegulariseSolves;
+  return r;
 }
 
 void RowSolver::Impl::notePgsCost(int rows, int sweeps, double seconds) {

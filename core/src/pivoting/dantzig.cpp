@@ -661,10 +661,12 @@ DantzigSolver::DantzigSolver(DantzigSolver&&) noexcept = default;
 DantzigSolver& DantzigSolver::operator=(DantzigSolver&&) noexcept = default;
 
 int DantzigSolver::passes() const { return ws_->passes; }
+bool DantzigSolver::regularised() const { return ws_->regularised; }
 
 void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
   Workspace& ws = *ws_;
   ws.passes = 0;
+  ws.regularised = false;
   if (problem.size() == 0) {
     result.status = Status::Converged;
     result.message = "empty problem";
@@ -672,7 +674,7 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
   }
   // A tiny island's guessed index sets (warm, or the cold guess of dantzig_small.hpp): the same
   // steps on fixed-size arrays, else the general path.
-  if (detail::smallDenseApplies(problem) &&
+  if (!params_.regularised && detail::smallDenseApplies(problem) &&
       detail::solveSmallDense(problem, options().pivotTolerance, x)) {
     ws.passes = 1;
     result.status = Status::Converged;
@@ -683,10 +685,51 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
   runPivoting(problem, x, result);
 }
 
+namespace {
+// max |A_ii| (max |A_ij|, or 1, when the diagonal is zero): Workspace::setScales's pivot scale,
+// read from the problem before any set-up.
+double diagonalScale(const Problem& pb) {
+  double dMax = 0, aMax = 0;
+  if (pb.isSparse()) {
+    const SparseMatrix& A = pb.sparseA();
+    for (int k = 0; k < A.outerSize(); ++k)
+      for (SparseMatrix::InnerIterator it(A, k); it; ++it) {
+        aMax = std::max(aMax, std::abs(it.value()));
+        if (it.row() == it.col()) dMax = std::max(dMax, std::abs(it.value()));
+      }
+  } else {
+    dMax = pb.denseA().diagonal().cwiseAbs().maxCoeff();
+    if (!(dMax > 0)) aMax = pb.denseA().cwiseAbs().maxCoeff();
+  }
+  return dMax > 0 ? dMax : (aMax > 0 ? aMax : 1.0);
+}
+}  // namespace
+
+// The solve on A + delta I from zero (Limits in dantzig.hpp): after a breakdown of the solve on A
+// (why: its message, spent: its pivots), or at once when DantzigParams::regularised asks for it.
+void DantzigSolver::regularise(const Problem& problem, Vector& x, Result& result, double scale,
+                               const std::string& why, int spent) {
+  Workspace& ws = *ws_;
+  const double delta = params_.breakdownShift * scale;
+  ws.shift = delta;
+  x = Vector::Zero(problem.size());
+  runPivoting(problem, x, result);
+  ws.shift = 0;
+  ws.regularised = true;
+  result.iterations += spent;
+  std::ostringstream os;
+  os << "regularised: A + " << delta << " I " << why << "; " << result.message;
+  result.message = os.str();
+}
+
 void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& result) {
   const Options& opt = options();
   Workspace& ws = *ws_;
   const int n = problem.size();
+  if (ws.shift == 0 && params_.regularised) {
+    regularise(problem, x, result, diagonalScale(problem), "(asked for)", 0);
+    return;
+  }
   const bool exact = opt.frictionBounds == FrictionBounds::Exact;
   const bool friction = problem.hasFindex();
   const bool useGuess = !x.isZero(0.0);
@@ -712,18 +755,8 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
       // Pivoting breaks down on a singular A (redundant joints, coplanar contacts): once more
       // on A + delta I, cold (the guess led into the breakdown: docs/decisions.md, "Degenerate
       // rows and singular islands"); the residual is measured on A.
-      const std::string first = ws.message;
-      const int spent = totalPivots;
-      const double delta = params_.breakdownShift * ws.scale;
-      ws.shift = delta;
-      x = Vector::Zero(n);
-      runPivoting(problem, x, result);
-      ws.shift = 0;
-      result.iterations += spent;
-      std::ostringstream os;
-      os << "regularised: A + " << delta << " I after a breakdown (" << first << "); "
-         << result.message;
-      result.message = os.str();
+      regularise(problem, x, result, ws.scale, "after a breakdown (" + ws.message + ")",
+                 totalPivots);
       return;
     }
     if (o != Outcome::Done) {

@@ -87,6 +87,7 @@ struct OrderedProblem {
   // pivoting that broke down on a singular A: A + shift I is positive definite, its answer
   // solves A's (consistent, or nearly: engines' drift) system up to ~shift |x|.
   double shift = 0, scale = 0;
+  bool regularised = false;  // the last solve's answer is the one on A + shift I
 
   // A's row i (dense storage) and its product with v over positions 0 .. len-1.
   const double* denseRow(int i) const {
