@@ -580,10 +580,11 @@ void DantzigSolver::Workspace::gatherNormals(Vector& g) const {
   for (size_t k = 0; k < frictionRows.size(); ++k) g[k] = std::abs(x[findex[frictionRows[k]]]);
 }
 
-dantzig::FrictionIteration DantzigSolver::Workspace::startFrictionIteration(int depth,
-                                                                            bool exactFriction) {
+dantzig::FrictionIteration& DantzigSolver::Workspace::startFrictionIteration(int depth,
+                                                                             bool exactFriction) {
   const int nf = static_cast<int>(frictionRows.size());
-  FrictionIteration fi;
+  FrictionIteration& fi = friction;
+  fi = FrictionIteration{0, 0, 0, kInf, 1.0, std::move(fi.g), std::move(fi.nu), std::move(fi.f)};
   fi.depth = std::max(1, depth);
   fi.g.resize(nf);
   fi.nu.resize(nf);
@@ -593,6 +594,15 @@ dantzig::FrictionIteration DantzigSolver::Workspace::startFrictionIteration(int 
     histF.resize(nf, fi.depth);
   }
   return fi;
+}
+
+double DantzigSolver::Workspace::residualOf(const Problem& pb, const Vector& xs) {
+  if (pb.isSparse())
+    residualW.noalias() = pb.sparseA() * xs;
+  else
+    residualW.noalias() = pb.denseA() * xs;
+  residualW += pb.b;
+  return accuracy(pb, xs, residualW).residual;
 }
 
 // Anderson acceleration of nu <- g(nu) = |x_normal(nu)|: piecewise affine, so within one active
@@ -736,10 +746,11 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
   // A guess's friction values fix the first pass's friction bounds only when the guess is close
   // (a residual within kTrustedGuess): an engine's cached impulses give bounds so far off that
   // the second pass redoes most pivots (docs/methods/pivoting.md, "Dantzig: friction bounds").
-  const bool trustFriction = useGuess && exact && friction && residual(problem, x) <= kTrustedGuess;
+  const bool trustFriction =
+      useGuess && exact && friction && ws.residualOf(problem, x) <= kTrustedGuess;
   ws.setUp(problem, x, opt, useGuess, trustFriction);
   const bool firstFixedOnce = friction && !trustFriction;
-  FrictionIteration fi = ws.startFrictionIteration(params_.andersonDepth, friction && exact);
+  FrictionIteration& fi = ws.startFrictionIteration(params_.andersonDepth, friction && exact);
   int totalPivots = 0;
   for (int it = 1;; ++it) {
     ws.passes = it;
@@ -772,7 +783,7 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
       return;
     }
     // Exact friction: the bounds settle, the passes run out, or the next pass gets new bounds.
-    const double res = residual(problem, x);
+    const double res = ws.residualOf(problem, x);
     if (frictionPassesEnd(res, it, opt, singular, result)) return;
     if (!ws.nextFrictionBounds(fi, it, params_)) {
       std::ostringstream os;

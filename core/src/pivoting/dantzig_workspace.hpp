@@ -306,6 +306,8 @@ struct DantzigSolver::Workspace : dantzig::ClampedSet {
   using Outcome = dantzig::Outcome;
 
   // ---- scratch ----
+  dantzig::FrictionIteration friction;
+  Vector residualW;
   std::vector<double> a, r, z, dxFull, dwN;
   std::vector<int> queue, violators;
 
@@ -372,7 +374,11 @@ struct DantzigSolver::Workspace : dantzig::ClampedSet {
   }
   // ------------------------------------------------------------ friction passes
   // The fixed point's state for this solve (histories sized only for exact friction).
-  dantzig::FrictionIteration startFrictionIteration(int depth, bool exactFriction);
+  // The solve's friction iteration (friction below), reset; its vectors keep their storage.
+  dantzig::FrictionIteration& startFrictionIteration(int depth, bool exactFriction);
+  // The residual (residual.hpp) of xs (in the problem's order) on pb, w in residualW: no
+  // allocation once the size has been seen.
+  double residualOf(const Problem& pb, const Vector& xs);
   // The next pass's friction bounds from this pass's normals; false when they did not move.
   bool nextFrictionBounds(dantzig::FrictionIteration& fi, int it, const DantzigParams& params);
   void setFrictionBounds(const Vector& nu);
