@@ -202,13 +202,18 @@ std::string RowSystem::validate() const {
 }
 
 std::vector<Vector6> RowSystem::bodyVelocities(const Vector& x) const {
-  std::vector<Vector6> v(bodies.size(), Vector6::Zero());
+  std::vector<Vector6> v;
+  bodyVelocities(x, v);
+  return v;
+}
+
+void RowSystem::bodyVelocities(const Vector& x, std::vector<Vector6>& v) const {
+  v.assign(bodies.size(), Vector6::Zero());
   for (int i = 0; i < size(); ++i) {
     const ConstraintRow& r = rows[i];
     if (r.bodyA >= 0) v[r.bodyA] += applyInverseMass(bodies[r.bodyA], r.jA) * x[i];
     if (r.bodyB >= 0) v[r.bodyB] += applyInverseMass(bodies[r.bodyB], r.jB) * x[i];
   }
-  return v;
 }
 
 namespace {
@@ -243,8 +248,13 @@ double RowSystem::articulatedSpeed(const Vector& x) const {
 }
 
 Vector RowSystem::slack(const Vector& x) const {
-  const std::vector<Vector6> v = bodyVelocities(x);
-  Vector w(size());
+  Vector w;
+  slack(x, bodyVelocities(x), w);
+  return w;
+}
+
+void RowSystem::slack(const Vector& x, const std::vector<Vector6>& v, Vector& w) const {
+  w.resize(size());
   for (int i = 0; i < size(); ++i) {
     const ConstraintRow& r = rows[i];
     double wi = cfm[i] * x[i] + b[i];
@@ -252,12 +262,11 @@ Vector RowSystem::slack(const Vector& x) const {
     if (r.bodyB >= 0) wi += r.jB.dot(v[r.bodyB]);
     w[i] = wi;
   }
-  if (sides.empty()) return w;
+  if (sides.empty()) return;
   const std::vector<int> at = articulatedOffsets(*this);
   const Vector u = articulatedVelocities(x);
   for (const ArticulatedSide& a : sides)
     w[a.row] += sideDot(jacobian.data() + a.at, u.data() + at[a.body], articulated[a.body]);
-  return w;
 }
 
 double RowSystem::impulseEnergy(const Vector& x) const { return 0.5 * x.dot(slack(x) - b); }

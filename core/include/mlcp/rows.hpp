@@ -101,6 +101,9 @@ class RowSystem {
   void assemble(bool sparse, Problem& into, AssembleScratch& scratch) const;
   // w = A x + b computed through body velocities, O(nnz J).
   Vector slack(const Vector& x) const;
+  // The same into w, from the body velocities v = bodyVelocities(x) the caller already holds
+  // (a per-island caller reuses both buffers: no allocation once the sizes have been seen).
+  void slack(const Vector& x, const std::vector<Vector6>& v, Vector& w) const;
   // e(x) = 1/2 x^T A x = 1/2 x^T (w - b), O(nnz J): the kinetic energy of the velocity change
   // M^-1 J^T x the impulses make (plus the cfm's share), whatever the bodies' velocities. An
   // exploded answer (impulses along nearly dependent rows, 1e9 times a drifted loop's error)
@@ -108,6 +111,8 @@ class RowSystem {
   double impulseEnergy(const Vector& x) const;
   // Body velocity changes M^-1 J^T x, 6 per body ([linear; angular]).
   std::vector<Vector6> bodyVelocities(const Vector& x) const;
+  // The same into v (resized to bodies.size(), its storage reused).
+  void bodyVelocities(const Vector& x, std::vector<Vector6>& v) const;
   // Articulated velocity changes sum_i W_i x_i, per articulated body its `articulated[k]`
   // entries, concatenated in body order.
   Vector articulatedVelocities(const Vector& x) const;
