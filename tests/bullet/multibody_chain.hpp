@@ -28,13 +28,22 @@ constexpr double kDt = 1.0 / 60.0;  // s
 // The chain world; everything it makes it owns.
 class Chain {
  public:
+  // Makes the world (a btMultiBodyDynamicsWorld, or a world derived from it).
+  using WorldMaker = btMultiBodyDynamicsWorld* (*)(btDispatcher*, btBroadphaseInterface*,
+                                                   btMultiBodyConstraintSolver*,
+                                                   btCollisionConfiguration*);
+  static btMultiBodyDynamicsWorld* plainWorld(btDispatcher* d, btBroadphaseInterface* b,
+                                              btMultiBodyConstraintSolver* s,
+                                              btCollisionConfiguration* c) {
+    return new btMultiBodyDynamicsWorld(d, b, s, c);
+  }
+
   // motorSpeed: the first joint's target velocity (rad/s; 0 holds it against its max impulse).
   // solver: the world's multibody solver (null: Bullet's btMultiBodyConstraintSolver).
   explicit Chain(bool splitImpulse = true, double motorSpeed = -1,
-                 btMultiBodyConstraintSolver* solver = nullptr)
+                 btMultiBodyConstraintSolver* solver = nullptr, WorldMaker make = plainWorld)
       : motorSpeed_(motorSpeed) {
-    world_ = std::make_unique<btMultiBodyDynamicsWorld>(&dispatcher_, &broadphase_,
-                                                        solver ? solver : &stock_, &config_);
+    world_.reset(make(&dispatcher_, &broadphase_, solver ? solver : &stock_, &config_));
     world_->setGravity(btVector3(0, -9.81, 0));
     world_->getSolverInfo().m_splitImpulse = splitImpulse;
     addBox(btVector3(5, 0.5, 5), btVector3(0, -0.5, 0), 0);  // the ground

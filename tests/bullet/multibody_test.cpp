@@ -113,7 +113,7 @@ Settled settle(bool split, const char* name, bool correction) {
 }
 
 TEST(BulletMultiBody, AJointAtItsLimitHoldsIt) {
-  // Bullet's defaults (split impulse on): SI leaves the joints deep past their limits (0.48 rad
+  // Bullet's defaults (split impulse on): SI leaves the joints deep past their limits (0.57 rad
   // here); exact answers on Bullet's rows as they are leave less, with the correction 1e-3.
   const Settled si = settle(true, "stock", false);
   EXPECT_GT(si.violation, 0.1);  // what the correction is for

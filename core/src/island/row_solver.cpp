@@ -519,10 +519,11 @@ bool RowSolver::Impl::throwsBodies(const RowSystem& rows, const Vector& x, doubl
     return false;
   }
   rows.bodyVelocities(x, velocities_);
-  return throwsFromVelocities(rows, factor);
+  return throwsFromVelocities(rows, x, factor);
 }
 
-bool RowSolver::Impl::throwsFromVelocities(const RowSystem& rows, double factor) const {
+bool RowSolver::Impl::throwsFromVelocities(const RowSystem& rows, const Vector& x,
+                                           double factor) const {
   const double limit = factor * rows.b.lpNorm<Eigen::Infinity>();
   for (const Vector6& v : velocities_)
     if (v.head<3>().squaredNorm() > limit * limit) return true;

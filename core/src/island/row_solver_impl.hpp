@@ -108,7 +108,7 @@ class RowSolver::Impl {
   // The velocities go to velocities_ (reused: no allocation per island).
   bool throwsBodies(const RowSystem& rows, const Vector& x, double factor);
   // Whether velocities_ (some x's) move a body by more than factor ||b||_inf.
-  bool throwsFromVelocities(const RowSystem& rows, double factor) const;
+  bool throwsFromVelocities(const RowSystem& rows, const Vector& x, double factor) const;
   // Stage 0's start: `start`, or zeros (coldStart_) when it throws a body by 1000 ||b||_inf, far
   // beyond any answer's 10 (kStartSpeedFactor, row_solver.cpp). A start is the last
   // step's impulses matched to this step's rows; where last step's rows were nearly dependent

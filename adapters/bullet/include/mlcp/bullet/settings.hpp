@@ -67,7 +67,7 @@ struct Settings : RowSolverSettings {
   // Multibody worlds' joint limits. Bullet makes a limit row only once the joint is past its
   // limit, and with split impulse on moves a violation deeper than
   // m_splitImpulsePenetrationThreshold into m_rhsPenetration, which its multibody solver never
-  // reads (SI leaves a 4-link arm 0.48 rad past +-0.25 rad limits). true: that error is put back
+  // reads (SI leaves a 4-link arm 0.57 rad past +-0.25 rad limits). true: that error is put back
   // into the row's rhs (corrected at m_erp2), and every one-sided multibody row (a limit) aims
   // 1e-3 (rad or m) inside its violation, so that an exact answer does not put the joint exactly
   // on its limit, lose the row the next step and let it fall free for one (the arm then holds
