@@ -537,10 +537,9 @@ TEST(Dantzig, BreakdownShiftIsTheRetrysDelta) {
   EXPECT_LE(residuals[0], residuals[1]);
 }
 
-// DantzigParams::regularised goes to A + delta I at once: from zero, the same answer, bit for
-// bit, as the retry after the breakdown on the bridge island, without the pivots of the attempt
-// on A; from that answer as the start, converged again in fewer pivots (the next step of a pile
-// at rest); a regular problem asked the same way is solved on A + delta I too, and says so.
+// DantzigParams::regularised goes to A + delta I at once: the same answer, bit for bit, as the
+// retry after the breakdown on the bridge island, without the pivots of the attempt on A; a
+// regular problem asked the same way is solved on A + delta I too, and says so.
 TEST(Dantzig, RegularisedAtOnceIsTheRetrysAnswer) {
   const Problem p = io::readProblemJson(std::string(MLCP_SOURCE_DIR) +
                                         "/tests/data/plank_bridge_bullet_step26.json");
@@ -556,13 +555,6 @@ TEST(Dantzig, RegularisedAtOnceIsTheRetrysAnswer) {
   EXPECT_EQ(xAtOnce, xRetry);
   EXPECT_LT(a.iterations, r.iterations);
   EXPECT_EQ(a.status, r.status);
-  ASSERT_TRUE(a.converged()) << a.message;
-  Vector xWarm;
-  const Result w = atOnce.solveWithGuess(p, xAtOnce, xWarm);
-  EXPECT_TRUE(w.converged()) << w.message;
-  EXPECT_TRUE(atOnce.regularised());
-  EXPECT_LT(w.iterations, a.iterations);
-  EXPECT_LE(accuracy(p, xWarm).residual, 1e-6);
 
   const Problem regular = test::seedLemkeExample();
   Vector x;

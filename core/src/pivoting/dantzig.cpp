@@ -715,29 +715,15 @@ double diagonalScale(const Problem& pb) {
 }
 }  // namespace
 
-// The solve on A + delta I (Limits in dantzig.hpp): after a breakdown of the solve on A (why: its
-// message, spent: its pivots) from zero, or at once when DantzigParams::regularised asks for it
-// (fromStart): from the caller's start, and from zero when that did not converge. A pile at rest
-// settles from its last answer in a pass or two; the bridge's planks, whose cached impulses lead
-// the friction passes astray (docs/decisions.md), still get the cold solve.
+// The solve on A + delta I from zero (Limits in dantzig.hpp): after a breakdown of the solve on A
+// (why: its message, spent: its pivots), or at once when DantzigParams::regularised asks for it.
 void DantzigSolver::regularise(const Problem& problem, Vector& x, Result& result, double scale,
-                               const std::string& why, int spent, bool fromStart) {
+                               const std::string& why, int spent) {
   Workspace& ws = *ws_;
   const double delta = params_.breakdownShift * scale;
   ws.shift = delta;
-  if (fromStart) {
-    const Vector start = x;
-    runPivoting(problem, x, result);
-    const bool again = result.status != Status::Converged && result.status != Status::TimeLimit;
-    if (again && !start.isZero(0.0)) {
-      spent += result.iterations;
-      x.setZero(problem.size());
-      runPivoting(problem, x, result);
-    }
-  } else {
-    x = Vector::Zero(problem.size());
-    runPivoting(problem, x, result);
-  }
+  x = Vector::Zero(problem.size());
+  runPivoting(problem, x, result);
   ws.shift = 0;
   ws.regularised = true;
   result.iterations += spent;
@@ -751,7 +737,7 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
   Workspace& ws = *ws_;
   const int n = problem.size();
   if (ws.shift == 0 && params_.regularised) {
-    regularise(problem, x, result, diagonalScale(problem), "(asked for)", 0, true);
+    regularise(problem, x, result, diagonalScale(problem), "(asked for)", 0);
     return;
   }
   const bool exact = opt.frictionBounds == FrictionBounds::Exact;
@@ -781,7 +767,7 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
       // on A + delta I, cold (the guess led into the breakdown: docs/decisions.md, "Degenerate
       // rows and singular islands"); the residual is measured on A.
       regularise(problem, x, result, ws.scale, "after a breakdown (" + ws.message + ")",
-                 totalPivots, false);
+                 totalPivots);
       return;
     }
     if (o != Outcome::Done) {

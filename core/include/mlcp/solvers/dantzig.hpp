@@ -52,10 +52,9 @@ struct DantzigParams {
   // The shift delta of the retry after a breakdown, relative to max |A_ii| ("Limits" above).
   // Default kDantzigBreakdownShift (1e-10, thresholds.hpp).
   double breakdownShift = kDantzigBreakdownShift;
-  // Solve A + delta I at once (delta as after a breakdown), without the attempt on A: for a
-  // caller that knows the problem breaks down (RowSolver, for an island whose last solve did).
-  // From the caller's start, and from zero (the retry's start) when that does not converge; the
-  // residual is still measured on A. Default false.
+  // Solve A + delta I from zero at once (delta as after a breakdown), without the attempt on A:
+  // for a caller that knows the problem breaks down (RowSolver, for an island whose last solve
+  // did). The answer is the retry's; the residual is still measured on A. Default false.
   bool regularised = false;
   // Exact friction: the normals' history depth of Anderson's extrapolation, the passes without
   // a new lowest bound change after which plain damped iteration takes over, and its damping
@@ -90,7 +89,7 @@ class DantzigSolver : public Solver {
   struct Workspace;
   void runPivoting(const Problem& problem, Vector& x, Result& result);
   void regularise(const Problem& problem, Vector& x, Result& result, double scale,
-                  const std::string& why, int spent, bool fromStart);
+                  const std::string& why, int spent);
   std::unique_ptr<Workspace> ws_;
   DantzigParams params_;
 };
