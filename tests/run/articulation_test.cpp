@@ -174,6 +174,28 @@ TEST(Articulations, BadArticulationsAreRefusedInOneLine) {
       << errorOf(loop);
 }
 
+TEST(Articulations, LinksAreStoredParentFirstWhateverTheFileOrder) {
+  // The file lists b before its parent a; c names a by its index.
+  const Scene s =
+      mlcp::scene::parseScene(sceneWith(link("b", "\"a\"", kHinge) + "," + link("a", "-1", kHinge) +
+                                        "," + link("c", "1", kHinge)),
+                              "order.json");
+  ASSERT_EQ(s.articulations.size(), 1u);
+  const auto& art = s.articulations[0];
+  ASSERT_EQ(art.links.size(), 3u);
+  const char* names[] = {"a", "b", "c"};
+  const int parents[] = {-1, 0, 0};
+  for (std::size_t k = 0; k < 3; ++k) {
+    const auto& l = art.links[k];
+    EXPECT_EQ(s.bodies[l.body].name, names[k]);
+    EXPECT_EQ(l.parent, parents[k]);
+    // Joints hold [link, parent], or [link] on the fixed base (a static body: the world).
+    EXPECT_EQ(s.joints[l.joint].body0, l.body);
+    EXPECT_EQ(s.joints[l.joint].body1, l.parent < 0 ? -1 : art.links[l.parent].body);
+  }
+  EXPECT_TRUE(s.bodies[art.base].isStatic());
+}
+
 TEST(Articulations, CoreSolversInAMultiBodyWorldSayWhyInOneLine) {
   const Scene s = load("limit_chain");
   try {
@@ -231,6 +253,42 @@ double worstViolation(const Scene& s, const std::vector<BodyState>& states) {
       worst = std::max({worst, q - j.limits.upper, j.limits.lower - q});
     }
   return worst;
+}
+
+// The prismatic offset of the joint's body0 relative to body1 along the axis, 0 at the start.
+double sliderOffset(const Scene& s, const std::vector<BodyState>& states,
+                    const mlcp::scene::Joint& j) {
+  const auto& c = states[j.body0];
+  const auto& p = states[j.body1];
+  const Quat turned = mlcp::scene::relative(p.orientation, s.bodies[j.body1].orientation);
+  const mlcp::scene::Vec3 d{c.position[0] - p.position[0], c.position[1] - p.position[1],
+                            c.position[2] - p.position[2]};
+  const auto now = mlcp::scene::rotate(Quat{turned.w, -turned.x, -turned.y, -turned.z}, d);
+  double offset = 0;
+  for (int k = 0; k < 3; ++k)
+    offset +=
+        j.axis[k] * (now[k] - (s.bodies[j.body0].position[k] - s.bodies[j.body1].position[k]));
+  return offset;
+}
+
+// arm_push's turret motor (+1 rad/s) turns the arm into its upper limit of 1 rad and the wrist's
+// (-0.1 m/s) pushes the paddle into its lower limit of -0.02 m, with the same signs in reduced
+// and maximal coordinates.
+TEST(Articulations, MotorsDriveIntoTheSameLimitsInEveryEngine) {
+  const Scene s = load("arm_push");
+  const auto& turret = s.joints[s.articulations[0].links[0].joint];
+  const auto& wrist = s.joints[s.articulations[0].links[3].joint];
+  ASSERT_EQ(turret.type, mlcp::scene::JointType::Hinge);
+  ASSERT_EQ(wrist.type, mlcp::scene::JointType::Slider);
+  for (const char* e : kEngines) {
+    auto w = makeWorld(e, s, std::string(e) == "bullet-multibody" ? "bullet-si" : "auto");
+    for (int i = 0; i < 120; ++i) w->step();
+    const auto states = w->states();
+    EXPECT_NEAR(hingeAngle(s, states, turret), 1.0, 0.02) << e;
+    EXPECT_NEAR(sliderOffset(s, states, wrist), -0.02, 0.005) << e;
+    std::cout << "arm_push " << e << ": turret " << hingeAngle(s, states, turret) << " rad, wrist "
+              << sliderOffset(s, states, wrist) << " m\n";
+  }
 }
 
 // limit_chain after 300 steps (5 s): the joints at their limits, the chain on the ground. Bullet
