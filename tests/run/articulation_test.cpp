@@ -209,6 +209,26 @@ TEST(Articulations, CoreSolversInAMultiBodyWorldSayWhyInOneLine) {
   EXPECT_THROW(makeWorld("bullet-multibody", s, "bullet-nncg"), std::invalid_argument);
 }
 
+// Without articulations a btMultiBodyDynamicsWorld holds the same rigid bodies and joints, and
+// Bullet's multibody SI solves their rows as its rigid SI does: the ragdoll (hinges, cone-twists,
+// contacts) moves the same in bullet-multibody as in bullet.
+TEST(Articulations, ScenesWithoutArticulationsRunAsInBullet) {
+  const Scene s = load("ragdoll");
+  ASSERT_TRUE(s.articulations.empty());
+  auto rigid = makeWorld("bullet", s, "bullet-si");
+  auto multi = makeWorld("bullet-multibody", s, "bullet-si");
+  for (int i = 0; i < 60; ++i) {
+    rigid->step();
+    multi->step();
+  }
+  const auto a = rigid->states(), b = multi->states();
+  for (std::size_t i = 0; i < a.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(b[i].position[c], a[i].position[c], 1e-9) << s.bodies[i].name;
+      EXPECT_NEAR(b[i].velocity[c], a[i].velocity[c], 1e-9) << s.bodies[i].name;
+    }
+}
+
 // 120 steps: finite, every body within 10 m of the origin and slower than 20 m/s.
 void expectRunsBounded(const std::string& engine, const Scene& s, const std::string& solver) {
   SCOPED_TRACE(engine + " " + solver);
