@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <cmath>
 #include <limits>
 #include <sstream>
 #include <type_traits>
@@ -50,6 +51,44 @@ bool rowsValid(const RowSystem& s) {
 }
 
 using Touching = std::vector<std::vector<std::pair<int, const Vector6*>>>;  // per body
+
+// The articulated bodies' widths, every side's row, body and storage, and J, W finite.
+std::string articulatedError(const RowSystem& s) {
+  std::ostringstream os;
+  const std::size_t na = s.articulated.size();
+  for (std::size_t k = 0; k < na; ++k)
+    if (s.articulated[k] <= 0) {
+      os << "articulated body " << k << " has width " << s.articulated[k] << " (must be > 0)";
+      return os.str();
+    }
+  if (s.jacobian.size() != s.unitImpulse.size()) {
+    os << "articulated storage disagrees: jacobian " << s.jacobian.size() << ", unitImpulse "
+       << s.unitImpulse.size();
+    return os.str();
+  }
+  for (std::size_t k = 0; k < s.sides.size(); ++k) {
+    const ArticulatedSide& a = s.sides[k];
+    if (a.row < 0 || a.row >= s.size() || a.body < 0 || a.body >= static_cast<int>(na) ||
+        a.at < 0 || a.at + s.articulated[a.body] > static_cast<int>(s.jacobian.size())) {
+      os << "articulated side " << k << " names row " << a.row << " of " << s.size() << ", body "
+         << a.body << " of " << na << ", storage at " << a.at << " of " << s.jacobian.size();
+      return os.str();
+    }
+    for (int e = 0; e < s.articulated[a.body]; ++e)
+      if (!std::isfinite(s.jacobian[a.at + e]) || !std::isfinite(s.unitImpulse[a.at + e])) {
+        os << "articulated side " << k << " (row " << a.row << ") has a non-finite J or W";
+        return os.str();
+      }
+  }
+  return "";
+}
+
+// J . W over one articulated side's width.
+inline double sideDot(const double* j, const double* w, int width) {
+  double v = 0;
+  for (int e = 0; e < width; ++e) v += j[e] * w[e];
+  return v;
+}
 
 // Row i of the sparse A (RowSystem::assemble): every row j sharing a body with i, in increasing
 // j, A_ij = [i == j] cfm_i + sum over the bodies k of i (increasing k) of
@@ -108,8 +147,10 @@ int mergeRow(const RowSystem& s, int i, const Touching& touching, SparseMatrix* 
 
 struct RowSystem::AssembleScratch::Buffers {
   Touching touching;  // per body, the rows touching it (row order) and their Jacobian there
-  std::vector<int> patternBodies;               // bodies.size(), then bodyA, bodyB per row
-  std::vector<int> patternOuter, patternInner;  // the pattern's compressed index arrays
+  std::vector<std::vector<int>> articulatedTouching;  // per articulated body, its sides
+  std::vector<std::vector<int>> columns;              // articulated systems: each row's columns
+  std::vector<int> patternBodies;                     // bodies.size(), then bodyA, bodyB per row
+  std::vector<int> patternOuter, patternInner;        // the pattern's compressed index arrays
   std::vector<int> valueSlot;  // per product, in assembly order: its index in A's values
   DenseMatrix dense;           // empty between calls: A's storage is taken from `into`
   SparseMatrix sparse;
@@ -137,6 +178,7 @@ std::string RowSystem::validate() const {
       return os.str();
     }
   }
+  if (std::string why = articulatedError(*this); !why.empty()) return why;
   if (rowsValid(*this)) return "";
   for (int i = 0; i < n; ++i) {
     const ConstraintRow& r = rows[i];
@@ -160,18 +202,59 @@ std::string RowSystem::validate() const {
 }
 
 std::vector<Vector6> RowSystem::bodyVelocities(const Vector& x) const {
-  std::vector<Vector6> v(bodies.size(), Vector6::Zero());
+  std::vector<Vector6> v;
+  bodyVelocities(x, v);
+  return v;
+}
+
+void RowSystem::bodyVelocities(const Vector& x, std::vector<Vector6>& v) const {
+  v.assign(bodies.size(), Vector6::Zero());
   for (int i = 0; i < size(); ++i) {
     const ConstraintRow& r = rows[i];
     if (r.bodyA >= 0) v[r.bodyA] += applyInverseMass(bodies[r.bodyA], r.jA) * x[i];
     if (r.bodyB >= 0) v[r.bodyB] += applyInverseMass(bodies[r.bodyB], r.jB) * x[i];
   }
+}
+
+namespace {
+// Where each articulated body's velocities start in articulatedVelocities' vector (one entry
+// more: the total).
+std::vector<int> articulatedOffsets(const RowSystem& s) {
+  std::vector<int> at(s.articulated.size() + 1, 0);
+  for (std::size_t k = 0; k < s.articulated.size(); ++k) at[k + 1] = at[k] + s.articulated[k];
+  return at;
+}
+}  // namespace
+
+Vector RowSystem::articulatedVelocities(const Vector& x) const {
+  const std::vector<int> at = articulatedOffsets(*this);
+  Vector v = Vector::Zero(at.back());
+  for (const ArticulatedSide& a : sides) {
+    const double* w = unitImpulse.data() + a.at;
+    for (int e = 0; e < articulated[a.body]; ++e) v[at[a.body] + e] += w[e] * x[a.row];
+  }
   return v;
 }
 
+double RowSystem::articulatedSpeed(const Vector& x) const {
+  if (sides.empty()) return 0;
+  const std::vector<int> at = articulatedOffsets(*this);
+  const Vector v = articulatedVelocities(x);
+  double speed = 0;
+  for (std::size_t k = 0; k < articulated.size(); ++k)
+    for (int e = std::min(3, articulated[k]); e < articulated[k]; ++e)
+      speed = std::max(speed, std::abs(v[at[k] + e]));
+  return speed;
+}
+
 Vector RowSystem::slack(const Vector& x) const {
-  const std::vector<Vector6> v = bodyVelocities(x);
-  Vector w(size());
+  Vector w;
+  slack(x, bodyVelocities(x), w);
+  return w;
+}
+
+void RowSystem::slack(const Vector& x, const std::vector<Vector6>& v, Vector& w) const {
+  w.resize(size());
   for (int i = 0; i < size(); ++i) {
     const ConstraintRow& r = rows[i];
     double wi = cfm[i] * x[i] + b[i];
@@ -179,7 +262,11 @@ Vector RowSystem::slack(const Vector& x) const {
     if (r.bodyB >= 0) wi += r.jB.dot(v[r.bodyB]);
     w[i] = wi;
   }
-  return w;
+  if (sides.empty()) return;
+  const std::vector<int> at = articulatedOffsets(*this);
+  const Vector u = articulatedVelocities(x);
+  for (const ArticulatedSide& a : sides)
+    w[a.row] += sideDot(jacobian.data() + a.at, u.data() + at[a.body], articulated[a.body]);
 }
 
 double RowSystem::impulseEnergy(const Vector& x) const { return 0.5 * x.dot(slack(x) - b); }
@@ -205,15 +292,34 @@ void collectTouching(const RowSystem& s, Touching& touching) {
   }
 }
 
+void collectArticulated(const RowSystem& s, std::vector<std::vector<int>>& touching) {
+  if (touching.size() < s.articulated.size()) touching.resize(s.articulated.size());
+  for (std::size_t k = 0; k < s.articulated.size(); ++k) touching[k].clear();
+  for (int k = 0; k < static_cast<int>(s.sides.size()); ++k) touching[s.sides[k].body].push_back(k);
+}
+
 // Every entry of A as add(row, column, value) in one fixed order: diag(cfm), then per body the
 // products of the rows touching it. Dense and sparse storage sum them in this order.
+// Articulated bodies follow the rigid ones: per articulated body, J_j . W_i over its sides.
 template <class Add>
-void forEachProduct(const RowSystem& s, const Touching& touching, Add&& add) {
+void forEachProduct(const RowSystem& s, const Buffers& scratch, Add&& add) {
+  const Touching& touching = scratch.touching;
   for (int i = 0; i < s.size(); ++i) add(i, i, s.cfm[i]);
   for (std::size_t k = 0; k < s.bodies.size(); ++k) {
     for (const auto& [i, ji] : touching[k]) {
       const Vector6 mji = applyInverseMass(s.bodies[k], *ji);
       for (const auto& [j, jj] : touching[k]) add(i, j, jj->dot(mji));
+    }
+  }
+  if (s.sides.empty()) return;
+  for (std::size_t k = 0; k < s.articulated.size(); ++k) {
+    for (const int si : scratch.articulatedTouching[k]) {
+      const ArticulatedSide& a = s.sides[si];
+      const double* w = s.unitImpulse.data() + a.at;
+      for (const int sj : scratch.articulatedTouching[k]) {
+        const ArticulatedSide& c = s.sides[sj];
+        add(a.row, c.row, sideDot(s.jacobian.data() + c.at, w, s.articulated[k]));
+      }
     }
   }
 }
@@ -241,7 +347,7 @@ bool samePattern(const RowSystem& s, const Problem& p, const Buffers& scratch) {
 void writeValues(const RowSystem& s, SparseMatrix& A, Buffers& scratch) {
   auto& slots = scratch.valueSlot;
   if (slots.empty())
-    forEachProduct(s, scratch.touching, [&](int i, int j, double) {
+    forEachProduct(s, scratch, [&](int i, int j, double) {
       const int* first = A.innerIndexPtr() + A.outerIndexPtr()[i];
       const int* last = A.innerIndexPtr() + A.outerIndexPtr()[i + 1];
       slots.push_back(static_cast<int>(std::lower_bound(first, last, j) - A.innerIndexPtr()));
@@ -249,7 +355,41 @@ void writeValues(const RowSystem& s, SparseMatrix& A, Buffers& scratch) {
   double* values = A.valuePtr();
   std::fill_n(values, A.nonZeros(), 0.0);
   const int* slot = slots.data();
-  forEachProduct(s, scratch.touching, [&](int, int, double v) { values[*slot++] += v; });
+  forEachProduct(s, scratch, [&](int, int, double v) { values[*slot++] += v; });
+}
+
+// An articulated system's sparse pattern: each row's columns, the union over the bodies it
+// touches (rigid and articulated) of their rows, sorted. Never remembered (samePattern keys it
+// with an impossible body count): the values are then written by writeValues in
+// forEachProduct's order, the dense path's.
+void writeArticulatedPattern(const RowSystem& s, SparseMatrix& A, Buffers& scratch) {
+  const int n = s.size();
+  auto& columns = scratch.columns;
+  columns.resize(n);
+  for (int i = 0; i < n; ++i) columns[i].assign(1, i);
+  for (std::size_t k = 0; k < s.bodies.size(); ++k)
+    for (const auto& entry : scratch.touching[k])
+      for (const auto& other : scratch.touching[k]) columns[entry.first].push_back(other.first);
+  for (std::size_t k = 0; k < s.articulated.size(); ++k)
+    for (const int a : scratch.articulatedTouching[k])
+      for (const int c : scratch.articulatedTouching[k])
+        columns[s.sides[a].row].push_back(s.sides[c].row);
+  A.resize(n, n);
+  int* outer = A.outerIndexPtr();
+  outer[0] = 0;
+  for (int i = 0; i < n; ++i) {
+    std::sort(columns[i].begin(), columns[i].end());
+    columns[i].erase(std::unique(columns[i].begin(), columns[i].end()), columns[i].end());
+    outer[i + 1] = outer[i] + static_cast<int>(columns[i].size());
+  }
+  A.resizeNonZeros(outer[n]);
+  for (int i = 0; i < n; ++i)
+    std::copy(columns[i].begin(), columns[i].end(), A.innerIndexPtr() + outer[i]);
+  scratch.valueSlot.clear();
+  scratch.patternOuter.clear();
+  scratch.patternInner.clear();
+  scratch.patternBodies.assign(1, -1);  // no body count matches: never reused
+  writeValues(s, A, scratch);
 }
 
 // A new pattern: each row written in place, its columns the merge of its bodies' row lists;
@@ -280,6 +420,7 @@ void writePattern(const RowSystem& s, SparseMatrix& A, Buffers& scratch) {
 void RowSystem::assemble(bool sparse, Problem& p, AssembleScratch& cache) const {
   Buffers& scratch = *cache.buffers_;
   collectTouching(*this, scratch.touching);
+  collectArticulated(*this, scratch.articulatedTouching);
   p.b = b;
   p.lo = lo;
   p.hi = hi;
@@ -288,14 +429,16 @@ void RowSystem::assemble(bool sparse, Problem& p, AssembleScratch& cache) const 
     DenseMatrix& A = scratch.dense;
     p.swapA(A);  // A now holds the problem's previous dense storage
     A.setZero(size(), size());
-    forEachProduct(*this, scratch.touching, [&](int i, int j, double v) { A(i, j) += v; });
+    forEachProduct(*this, scratch, [&](int i, int j, double v) { A(i, j) += v; });
     p.swapA(A);
     return;
   }
   const bool known = samePattern(*this, p, scratch);
   SparseMatrix& A = scratch.sparse;
   p.swapA(A);  // A now holds the problem's previous sparse matrix (its storage is reused)
-  if (known)
+  if (hasArticulated())
+    writeArticulatedPattern(*this, A, scratch);
+  else if (known)
     writeValues(*this, A, scratch);
   else
     writePattern(*this, A, scratch);

@@ -1,7 +1,8 @@
 // The drop-in in Bullet's other worlds (mlcp/bullet/worlds.hpp): a btDiscreteDynamicsWorldMt
 // hands its large islands to a second solver slot, which install() and SolverPool fill; a
-// btMultiBodyDynamicsWorld never calls the solver and is refused, by install() and at the
-// first step; one solver shared by threads is serialized by its mutex.
+// btMultiBodyDynamicsWorld never calls solveGroup: install() gives it the solver's
+// MultiBodySolver (a pool is refused there), and a swap by hand throws at the first step; one
+// solver shared by threads is serialized by its mutex.
 #include "mlcp/bullet/worlds.hpp"
 
 #include <BulletDynamics/ConstraintSolver/btSequentialImpulseConstraintSolverMt.h>
@@ -135,17 +136,24 @@ TEST(BulletWorlds, PoolInAnMtWorldWithoutIslandsDoesNotThrow) {
   EXPECT_NO_THROW(mt.step(2));
 }
 
-TEST(BulletWorlds, MultiBodyWorldIsRefusedByInstall) {
+TEST(BulletWorlds, MultiBodyWorldIsServedByInstall) {
   sc::World mb(1.0 / 60.0, false, sc::WorldKind::MultiBody);
   ConstraintSolver mine(exact());
+  mlcp::bullet::install(mb.world(), mine);
+  EXPECT_EQ(mb.world().getConstraintSolver(),
+            static_cast<btConstraintSolver*>(&mine.multiBodySolver()));
+  sc::stack(mb, 2);
+  mb.step(5);
+  EXPECT_GT(mine.lastStep().groups, 0);
+  EXPECT_GT(mine.lastStep().islands, 0);
+  EXPECT_EQ(mine.lastStep().status, mlcp::Status::Converged) << mine.lastStep().message;
+  SolverPool pool(exact(), 1);
   try {
-    mlcp::bullet::install(mb.world(), mine);
-    FAIL() << "install accepted a btMultiBodyDynamicsWorld";
+    mlcp::bullet::install(mb.world(), pool);
+    FAIL() << "install put a pool in a btMultiBodyDynamicsWorld";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("btMultiBodyDynamicsWorld"), std::string::npos);
   }
-  SolverPool pool(exact(), 1);
-  EXPECT_THROW(mlcp::bullet::install(mb.world(), pool), std::invalid_argument);
 }
 
 TEST(BulletWorlds, MultiBodyWorldSwappedBySetConstraintSolverThrowsAtItsFirstStep) {
@@ -158,7 +166,7 @@ TEST(BulletWorlds, MultiBodyWorldSwappedBySetConstraintSolverThrowsAtItsFirstSte
       mb.step();
       FAIL() << "a multibody world stepped silently past our solver";
     } catch (const std::logic_error& e) {
-      EXPECT_NE(std::string(e.what()).find("btMultiBodyDynamicsWorld"), std::string::npos);
+      EXPECT_NE(std::string(e.what()).find("mlcp::bullet::install"), std::string::npos);
     }
     EXPECT_EQ(mine->lastStep().groups, 0);
   }

@@ -12,6 +12,7 @@
 #include "common/contact_scenes.hpp"
 #include "common/expect_solved.hpp"
 #include "common/generators.hpp"
+#include "common/redundant_joint.hpp"
 #include "linalg/body_space.hpp"  // BodySpaceSystem (internal)
 #include "mlcp/io.hpp"
 #include "mlcp/registry.hpp"
@@ -536,30 +537,40 @@ TEST(Dantzig, BreakdownShiftIsTheRetrysDelta) {
   EXPECT_LE(residuals[0], residuals[1]);
 }
 
+// DantzigParams::regularised goes to A + delta I at once: the same answer, bit for bit, as the
+// retry after the breakdown on the bridge island, without the pivots of the attempt on A; a
+// regular problem asked the same way is solved on A + delta I too, and says so.
+TEST(Dantzig, RegularisedAtOnceIsTheRetrysAnswer) {
+  const Problem p = io::readProblemJson(std::string(MLCP_SOURCE_DIR) +
+                                        "/tests/data/plank_bridge_bullet_step26.json");
+  DantzigSolver retry, atOnce;
+  for (DantzigSolver* s : {&retry, &atOnce}) s->options().tolerance = 1e-6;
+  atOnce.params().regularised = true;
+  Vector xRetry, xAtOnce;
+  const Result r = retry.solve(p, xRetry);
+  const Result a = atOnce.solve(p, xAtOnce);
+  EXPECT_TRUE(retry.regularised());
+  EXPECT_TRUE(atOnce.regularised());
+  EXPECT_NE(a.message.find("(asked for)"), std::string::npos) << a.message;
+  EXPECT_EQ(xAtOnce, xRetry);
+  EXPECT_LT(a.iterations, r.iterations);
+  EXPECT_EQ(a.status, r.status);
+
+  const Problem regular = test::seedLemkeExample();
+  Vector x;
+  EXPECT_TRUE(atOnce.solve(regular, x).converged());
+  EXPECT_TRUE(atOnce.regularised());
+  DantzigSolver plain;
+  EXPECT_TRUE(plain.solve(regular, x).converged());
+  EXPECT_FALSE(plain.regularised());
+}
+
 // Redundant joints: a ball joint given twice (the second copy's rows scaled, as Bullet's two
 // point-to-point constraints on one hinge line repeat a direction), its rhs off by a drift of
 // 1e-9: A is singular and the system consistent up to that drift. dantzig and ldlt (sparse) answer
 // it through A + delta I and say so; the residual on A itself is at the drift's level.
 TEST(Dantzig, RedundantJointsAreSolvedRegularised) {
-  RowSystem s;
-  BodyInverseMass body;
-  body.invMass = 1;
-  body.invInertia = Eigen::Matrix3d::Identity() * 2;
-  s.bodies = {body};
-  const Eigen::Vector3d arm(0.3, 0.5, 0);
-  for (int copy = 0; copy < 2; ++copy)
-    for (int k = 0; k < 3; ++k) {
-      ConstraintRow r;
-      r.bodyA = 0;
-      const Eigen::Vector3d e = Eigen::Vector3d::Unit(k) * (copy ? 2.0 : 1.0);
-      r.jA << e, arm.cross(e);
-      s.rows.push_back(r);
-    }
-  s.b.resize(6);
-  s.b << 0.1, -0.2, 0.3, 0.2 + 1e-9, -0.4, 0.6 - 1e-9;
-  s.lo = Vector::Constant(6, -kInf);
-  s.hi = Vector::Constant(6, kInf);
-  s.cfm = Vector::Zero(6);
+  const RowSystem s = test::redundantBallJoint(1e-9);
   const Problem p = s.assemble(true);
   DantzigSolver d;
   LdltSolver l;

@@ -11,6 +11,7 @@
 
 #include "common/broken_solvers.hpp"
 #include "common/contact_scenes.hpp"
+#include "common/redundant_joint.hpp"
 #include "mlcp/io.hpp"
 #include "mlcp/residual.hpp"
 #include "mlcp/solvers/dantzig.hpp"
@@ -636,6 +637,34 @@ TEST(ChoiceCounts, CountsInNameOrder) {
   EXPECT_EQ(d.toString(), "dantzig:3 ldlt:1 none:2 pgs:2");
   d.clear();
   EXPECT_EQ(d.toString(), "");
+}
+
+}  // namespace
+}  // namespace mlcp
+
+namespace mlcp {
+namespace {
+
+// A ball joint given twice, its second copy's rhs off by a drift: A is singular, the rows are
+// inconsistent and dantzig's pivoting on A breaks down (a zero pivot with nothing to stop the
+// step). The island's next solves go to A + delta I at
+// once (DantzigParams::regularised, set by RowSolver's per-island memory) with the same answer.
+TEST(RowSolver, AnIslandWhoseDantzigBrokeDownIsRegularisedAtOnce) {
+  const RowSystem s = test::redundantBallJoint(1e-4);
+  RowSolverSettings settings;
+  settings.solver = "dantzig";
+  RowSolver solver(settings);
+  Vector x1, x2;
+  const IslandSolve first = solver.solve(s, Vector::Zero(6), x1, 7);
+  const auto* dantzig = dynamic_cast<const DantzigSolver*>(solver.cachedSolver(7, "dantzig"));
+  ASSERT_TRUE(dantzig);
+  ASSERT_TRUE(dantzig->regularised()) << first.result.message;
+  EXPECT_FALSE(dantzig->params().regularised);
+  const IslandSolve second = solver.solve(s, Vector::Zero(6), x2, 7);
+  EXPECT_TRUE(dantzig->params().regularised);
+  EXPECT_NE(second.result.message.find("(asked for)"), std::string::npos) << second.result.message;
+  EXPECT_EQ(x2, x1);
+  EXPECT_EQ(second.result.status, first.result.status);
 }
 
 }  // namespace

@@ -49,6 +49,34 @@ TEST(OdeEdge, DisabledBodiesAreNotStepped) {
   EXPECT_NE(before[13 + 2], after[13 + 2]) << "the enabled body should move";
 }
 
+TEST(OdeEdge, EachStepReportsOnlyItsOwnIslands) {
+  // The statistics' entries are reused from step to step: a step with fewer islands, or an island
+  // without the rows it had, reports nothing of the step before.
+  auto free = freeBodies();
+  Stepper stepper("dantzig");
+  ASSERT_TRUE(stepper.step(free->world, 0.01));
+  ASSERT_EQ(stepper.lastStep().islands.size(), 2u);
+  dBodyDisable(free->bodies[0]);
+  ASSERT_TRUE(stepper.step(free->world, 0.01));
+  ASSERT_EQ(stepper.lastStep().islands.size(), 1u);
+  EXPECT_EQ(stepper.lastStep().islands[0].bodies, 1);
+
+  auto box = boxOnPlane();
+  Stepper boxStepper("dantzig");
+  box->step([&](dWorldID w, dReal h) { ASSERT_TRUE(boxStepper.step(w, h)); }, 0.01);
+  ASSERT_EQ(boxStepper.lastStep().islands.size(), 1u);
+  ASSERT_GT(boxStepper.lastStep().islands[0].rows, 0);
+  ASSERT_TRUE(boxStepper.step(box->world, 0.01));  // no collision: no contact joints
+  ASSERT_EQ(boxStepper.lastStep().islands.size(), 1u);
+  const IslandStats& island = boxStepper.lastStep().islands[0];
+  EXPECT_EQ(island.rows, 0);
+  EXPECT_EQ(island.joints, 0);
+  EXPECT_EQ(island.choice, "none");
+  EXPECT_EQ(island.message, "no constraint rows");
+  EXPECT_EQ(island.iterations, 0);
+  EXPECT_FALSE(island.warmStarted);
+}
+
 TEST(OdeEdge, AutoDisableWorksAsWithDWorldStep) {
   auto s = boxOnPlane(0.0);
   dWorldSetAutoDisableFlag(s->world, 1);

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "mlcp/bullet/multibody_solver.hpp"
 #include "mlcp/registry.hpp"
 #include "mlcp/residual.hpp"
 
@@ -34,9 +35,10 @@ void worst(StepStats& into, const StepStats& from) {
 constexpr const char* kUnservedWorld =
     "mlcp::bullet::ConstraintSolver: the world stepped without calling solveGroup, so this "
     "solver solves nothing in it. A btMultiBodyDynamicsWorld solves through its "
-    "btMultiBodyConstraintSolver, which setConstraintSolver does not replace: multibody worlds "
-    "are not supported (keep Bullet's solver there). For a btDiscreteDynamicsWorldMt use "
-    "mlcp::bullet::install with a SolverPool (mlcp/bullet/worlds.hpp)";
+    "btMultiBodyConstraintSolver, which setConstraintSolver does not replace: use "
+    "mlcp::bullet::install(world, solver), which sets the solver's MultiBodySolver there. For a "
+    "btDiscreteDynamicsWorldMt use mlcp::bullet::install with a SolverPool "
+    "(mlcp/bullet/worlds.hpp)";
 
 }  // namespace
 
@@ -82,6 +84,11 @@ ConstraintSolver::ConstraintSolver(const Settings& settings) : settings_(setting
 }
 
 ConstraintSolver::~ConstraintSolver() = default;
+
+MultiBodySolver& ConstraintSolver::multiBodySolver() {
+  if (!multiBody_) multiBody_ = std::make_unique<MultiBodySolver>(*this);
+  return *multiBody_;
+}
 
 btScalar ConstraintSolver::solveGroup(btCollisionObject** bodies, int numBodies,
                                       btPersistentManifold** manifolds, int numManifolds,
@@ -169,13 +176,7 @@ btScalar ConstraintSolver::solveGroupCacheFriendlyIterations(
       current_.status = Status::MaxIterations;
     }
   } else {
-    rows_->setEngineSweeps(info.m_numIterations);
-    if (settings_.engineIterations) {
-      // pgs/gs as SI runs them: a fixed sweep count, the residual checked once, at the end.
-      for (auto [name, options] : {std::pair(&settings_.solver, &rows_->options()),
-                                   std::pair(&settings_.fallback, &rows_->fallbackOptions())})
-        if (*name == "pgs" || *name == "gs") useEngineIterations(*options, info.m_numIterations);
-    }
+    useEngineSweeps(info);
     const Start start = !settings_.warmStart ? Start::Zero
                         : settings_.siStart  ? Start::AppliedImpulse
                                              : Start::CachedImpulse;
@@ -194,20 +195,43 @@ btScalar ConstraintSolver::solveGroupCacheFriendlyIterations(
   return 0;
 }
 
+void ConstraintSolver::useEngineSweeps(const btContactSolverInfo& info) {
+  rows_->setEngineSweeps(info.m_numIterations);
+  if (!settings_.engineIterations) return;
+  // pgs/gs as SI runs them: a fixed sweep count, the residual checked once, at the end.
+  for (auto [name, options] : {std::pair(&settings_.solver, &rows_->options()),
+                               std::pair(&settings_.fallback, &rows_->fallbackOptions())})
+    if (*name == "pgs" || *name == "gs") useEngineIterations(*options, info.m_numIterations);
+}
+
+void ConstraintSolver::recordSi(const RowSystem& s, const Vector& answer, int sweeps) {
+  Result r;
+  r.status = Status::MaxIterations;
+  r.iterations = sweeps;
+  const Accuracy a = accuracy(answer, s.slack(answer), s.lo, s.hi, s.findex,
+                              s.b.size() ? s.b.lpNorm<Eigen::Infinity>() : 0.0);
+  applyAccuracy(r, a, settings_.options.tolerance);
+  record(r, s.size(), "si");
+  if (settings_.keepIslands) records_.push_back({s, answer, answer, r, "si", false, false});
+}
+
+void ConstraintSolver::recordSolve(const IslandSolve& solved, int rows) {
+  const Result& result = solved.result;
+  current_.assembleSeconds += solved.assembleSeconds;
+  current_.fallbacks += solved.fellBack;
+  current_.screened.add(solved.screened);
+  current_.failures += !solved.accepted;
+  current_.coneIslands += solved.friction == FrictionModel::Cone;
+  if (current_.message.empty() && (solved.fellBack || !solved.accepted))
+    current_.message = result.message;
+  record(result, rows, solved.choice);
+}
+
 void ConstraintSolver::measureSi(int sweeps) {
   current_.inertRows += builder_.inertRows();
   for (int k = 0; k < builder_.count(); ++k) {
     Island& island = builder_.island(k);
-    const RowSystem& s = island.system;
-    Result r;
-    r.status = Status::MaxIterations;
-    r.iterations = sweeps;
-    const Accuracy a = accuracy(island.start, s.slack(island.start), s.lo, s.hi, s.findex,
-                                s.b.size() ? s.b.lpNorm<Eigen::Infinity>() : 0.0);
-    applyAccuracy(r, a, settings_.options.tolerance);
-    record(r, s.size(), "si");
-    if (settings_.keepIslands)
-      records_.push_back({s, island.start, island.start, r, "si", false, false});
+    recordSi(island.system, island.start, sweeps);
   }
 }
 
@@ -301,14 +325,7 @@ void ConstraintSolver::solveIsland(Island& island, std::uint64_t key, bool split
   const Vector& start = split ? island.splitStart : island.start;
   const IslandSolve solved = rows_->solve(s, start, x_, key);
   const Result& result = solved.result;
-  current_.assembleSeconds += solved.assembleSeconds;
-  current_.fallbacks += solved.fellBack;
-  current_.screened.add(solved.screened);
-  current_.failures += !solved.accepted;
-  current_.coneIslands += solved.friction == FrictionModel::Cone;
-  if (current_.message.empty() && (solved.fellBack || !solved.accepted))
-    current_.message = result.message;
-  record(result, n, solved.choice);
+  recordSolve(solved, n);
 
   // Store impulses: the change from the start goes through Bullet's own body update.
   const Vector& x = x_;

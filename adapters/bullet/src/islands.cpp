@@ -9,20 +9,11 @@
 #include "mlcp/bullet/constraint_solver.hpp"
 #include "mlcp/island/row_screen.hpp"
 #include "mlcp/solvers/row_pgs.hpp"
+#include "row_values.hpp"
 
 namespace mlcp::bullet {
 
 namespace {
-
-Eigen::Vector3d toEigen(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
-
-// Contacts use 1e10 as "unbounded" and joints BT_INFINITY; both mean +inf to us.
-double bound(btScalar v) {
-  const double d = static_cast<double>(v);
-  if (d >= 1e10) return kInf;
-  if (d <= -1e10) return -kInf;
-  return d;
-}
 
 // A friction row's direction (the impulse on body A per unit x). Bullet zeroes the normal of a
 // side without a rigid body (static ground), so it is taken from the side that has one.
@@ -183,15 +174,8 @@ bool IslandBuilder::linkRows(int n) {
 
 void IslandBuilder::addBody(Island& isl, int d) {
   const btSolverBody& sb = (*in_.bodies)[d];
-  const btRigidBody* rb = sb.m_originalBody;
-  BodyInverseMass m;
-  m.invMass = rb->getInvMass();
-  const Eigen::Vector3d af = toEigen(sb.m_angularFactor);
-  const btMatrix3x3& I = rb->getInvInertiaTensorWorld();
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) m.invInertia(r, c) = af[r] * I[r][c] * af[c];
   if (!sameUpdate(sb)) isl.perRowWriteBack = true;
-  isl.system.bodies.push_back(m);
+  isl.system.bodies.push_back(detail::inverseMassOf(sb));
 }
 
 void IslandBuilder::openIsland() {
@@ -422,11 +406,7 @@ void IslandBuilder::readSolverInfo(const btContactSolverInfo& info) {
   const double splitB = scaled && rhsPenetration != 0 ? -rhsPenetration / jd : 0.0;
   out.b = split ? splitB : scaled ? -c.m_rhs / jd : 0.0;
   if (std::abs(out.b) >= kBeyondReach) isl.beyondReach = true;
-  if (cfm_ == CfmModel::StockMlcp)
-    out.cfm = stockCfm_;
-  else
-    out.cfm = scaled ? std::max(0.0, c.m_cfm / jd) : 0.0;
-  if (cfm_ == CfmModel::Regularized && findex >= 0 && out.cfm == 0) out.cfm = stockCfm_;
+  out.cfm = detail::rowCfm(c.m_cfm, jd, scaled, cfm_, stockCfm_, findex >= 0);
   return splitB;
 }
 
@@ -434,16 +414,7 @@ void IslandBuilder::readSolverInfo(const btContactSolverInfo& info) {
                                                              int findex,
                                                              RowPgs::RowView& out) const {
   out.findex = findex;
-  if (findex >= 0) {
-    out.lo = -std::abs(c.m_friction);
-    out.hi = std::abs(c.m_friction);
-  } else if (i >= nj_) {  // contact
-    out.lo = 0;
-    out.hi = kInf;
-  } else {
-    out.lo = bound(c.m_lowerLimit);
-    out.hi = bound(c.m_upperLimit);
-  }
+  detail::rowBounds(c, i >= nj_, findex, out.lo, out.hi);
 }
 
 [[gnu::always_inline]] inline RowPgs::RowView IslandBuilder::view(Island& isl, int r, bool split,

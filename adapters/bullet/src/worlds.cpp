@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "mlcp/bullet/multibody_solver.hpp"
+
 namespace mlcp::bullet {
 
 namespace {
@@ -19,13 +21,19 @@ struct MtSlot : btDiscreteDynamicsWorldMt {
   }
 };
 
-// Throws for the worlds that never call solveGroup; sets the solver in every slot otherwise.
-void setEverySlot(btDiscreteDynamicsWorld& world, btConstraintSolver& solver) {
-  if (dynamic_cast<btMultiBodyDynamicsWorld*>(&world))
+// The multibody world this world is, or null; throws for the deformable world, whose solver
+// (btDeformableMultiBodyConstraintSolver) also solves the deformable bodies' rows.
+btMultiBodyDynamicsWorld* multiBodyWorld(btDiscreteDynamicsWorld& world) {
+  if (world.getWorldType() == BT_DEFORMABLE_MULTIBODY_DYNAMICS_WORLD)
     throw std::invalid_argument(
-        "mlcp::bullet::install: a btMultiBodyDynamicsWorld solves every island through its "
-        "btMultiBodyConstraintSolver and never calls a btConstraintSolver's solveGroup: "
-        "multibody worlds are not supported (keep Bullet's solver there)");
+        "mlcp::bullet::install: a btDeformableMultiBodyDynamicsWorld solves its deformable "
+        "bodies in its own btDeformableMultiBodyConstraintSolver, which this library does not "
+        "replace (keep Bullet's solver there)");
+  return dynamic_cast<btMultiBodyDynamicsWorld*>(&world);
+}
+
+// Sets the solver in every slot of a rigid-body world.
+void setEverySlot(btDiscreteDynamicsWorld& world, btConstraintSolver& solver) {
   world.setConstraintSolver(&solver);
   if (auto* mt = dynamic_cast<btDiscreteDynamicsWorldMt*>(&world)) mt->*MtSlot::slot() = &solver;
 }
@@ -75,11 +83,25 @@ void SolverPool::allSolved(const btContactSolverInfo& info, btIDebugDraw* debugD
 }
 
 void install(btDiscreteDynamicsWorld& world, ConstraintSolver& solver) {
-  setEverySlot(world, solver);
-  std::lock_guard<std::mutex> lock(solver.mutex_);
-  solver.worldChecked_ = true;  // a world this function accepts calls solveGroup
+  btMultiBodyDynamicsWorld* multiBody = multiBodyWorld(world);
+  MultiBodySolver* served = nullptr;
+  {
+    std::lock_guard<std::mutex> lock(solver.mutex_);
+    solver.worldChecked_ = true;  // a world this function accepts calls a solver it installs
+    if (multiBody) served = &solver.multiBodySolver();
+  }
+  if (served)
+    multiBody->setMultiBodyConstraintSolver(served);  // its rigid slot too (the same object)
+  else
+    setEverySlot(world, solver);
 }
 
-void install(btDiscreteDynamicsWorld& world, SolverPool& pool) { setEverySlot(world, pool); }
+void install(btDiscreteDynamicsWorld& world, SolverPool& pool) {
+  if (multiBodyWorld(world))
+    throw std::invalid_argument(
+        "mlcp::bullet::install: a btMultiBodyDynamicsWorld solves its islands one after the other "
+        "through one btMultiBodyConstraintSolver: install a ConstraintSolver there, not a pool");
+  setEverySlot(world, pool);
+}
 
 }  // namespace mlcp::bullet

@@ -473,12 +473,12 @@ void mlcp::ode::Stepper::Impl::runIsland(const dxStepperProcessingCallContext* c
   const unsigned nb = ctx->m_islandBodiesCount;
   const dReal h = ctx->m_stepSize;
 
-  IslandStats st;
+  const int island = static_cast<int>(islandsUsed);
+  IslandStats& st = nextIslandStats();
   st.bodies = static_cast<int>(nb);
   if (primary.forwards()) {
     forwardIsland(ctx, st);
     st.islandSeconds = nowSeconds() - t0;
-    stats.islands.push_back(std::move(st));
     return;
   }
 
@@ -505,8 +505,14 @@ void mlcp::ode::Stepper::Impl::runIsland(const dxStepperProcessingCallContext* c
   // Stage 6: store impulses and integrate.
   storeImpulses(body, nb, w, w.x, h, w.bodyTmp);
   st.islandSeconds = nowSeconds() - t0;
-  if (options.keepProblems && m > 0) keepProblem(w, static_cast<int>(stats.islands.size()));
-  stats.islands.push_back(std::move(st));
+  if (options.keepProblems && m > 0) keepProblem(w, island);
+}
+
+mlcp::ode::IslandStats& mlcp::ode::Stepper::Impl::nextIslandStats() {
+  if (islandsUsed == stats.islands.size()) stats.islands.emplace_back();
+  IslandStats& st = stats.islands[islandsUsed++];
+  st = IslandStats{};  // the strings keep their buffers (a short string's move copies)
+  return st;
 }
 
 void mlcp::ode::Stepper::Impl::forwardIsland(const dxStepperProcessingCallContext* ctx,

@@ -109,7 +109,11 @@ struct mlcp::ode::Stepper::Impl {
   Options stepOptions;
   Method primary, reference;
   bool hasReference = false;
+  // This step's statistics: stats.islands[0 .. islandsUsed) are this step's islands; the
+  // entries after them are last steps', reused (nextIslandStats) so that an island's statistics
+  // allocate nothing in steady state, and dropped at the end of the step.
   StepStats stats;
+  size_t islandsUsed = 0;
   WarmStartCache warm;
   IslandWork work;
   // Settings::keepProblems: this step's islands, and last step's entries whose buffers
@@ -127,6 +131,8 @@ struct mlcp::ode::Stepper::Impl {
                                 unsigned nj);
   static unsigned estimateMaxCallCount(unsigned activeThreads, unsigned allowedThreads);
 
+  // The next island's statistics, reset to IslandStats{}.
+  IslandStats& nextIslandStats();
   // The step's options from the settings and the world (engineIterations).
   void beginStep(dxWorld* world);
   // One island through the stages of mlcp/ode/stepper.hpp, its statistics appended to stats.

@@ -164,7 +164,11 @@ bool Stepper::step(dWorldID world, dReal h) {
   if (!world) throw std::invalid_argument("mlcp::ode::Stepper::step: null world");
   if (!(h > 0)) throw std::invalid_argument("mlcp::ode::Stepper::step: step size must be > 0");
   const double t0 = nowSeconds();
-  impl_->stats.islands.clear();
+  impl_->islandsUsed = 0;
+  struct DropUnused {  // last steps' entries beyond this step's islands, however step() ends
+    Impl& impl;
+    ~DropUnused() { impl.stats.islands.resize(impl.islandsUsed); }
+  } dropUnused{*impl_};
   if (!impl_->problems.empty()) {
     // Reversed, so that island k takes last step's island k's buffers (sizes match).
     auto& spare = impl_->spareProblems;

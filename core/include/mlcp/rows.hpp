@@ -14,6 +14,14 @@
 //
 // Bodies with invMass == 0 and a zero invInertia are static; a row's body index -1 means "the
 // world" (its block is ignored).
+//
+// Articulated bodies (a Featherstone multibody: base and joint velocities in one vector of
+// width 6 + ndof) have no block-diagonal M^-1 an engine hands over; it gives, per row side, J
+// and W = M^-1 J^T (Bullet's m_jacobians and m_deltaVelocitiesUnitImpulse). A row may have,
+// besides its rigid bodies, one ArticulatedSide per articulated body it touches (an engine row
+// with the same body on both sides passes J_A + J_B and W_A + W_B as one side). Then
+// A_ij = sum over shared rigid bodies J_i M^-1 J_j^T + sum over shared articulated bodies
+// J_j . W_i + [i == j] cfm_i: W_i = M^-1 J_i^T makes it symmetric, as the rigid part is.
 #pragma once
 
 #include <Eigen/Dense>
@@ -40,12 +48,26 @@ struct ConstraintRow {
   Vector6 jB = Vector6::Zero();  // [linear; angular] Jacobian on body B
 };
 
+// One row's part on one articulated body: J at jacobian[at .. at + width) and W = M^-1 J^T at
+// unitImpulse[at .. at + width), width = RowSystem::articulated[body].
+struct ArticulatedSide {
+  int row = -1;   // index into RowSystem::rows
+  int body = -1;  // index into RowSystem::articulated
+  int at = 0;     // offset into RowSystem::jacobian and RowSystem::unitImpulse
+};
+
 class RowSystem {
  public:
   std::vector<BodyInverseMass> bodies;
   std::vector<ConstraintRow> rows;
   Vector b, lo, hi, cfm;    // per row; cfm >= 0 is added to A's diagonal
   std::vector<int> findex;  // per row or empty
+  // Articulated bodies (see above): each one's velocity width (> 0), the row sides on them (any
+  // order) and their J and W, stored flat. Empty for rigid-only systems.
+  std::vector<int> articulated;
+  std::vector<ArticulatedSide> sides;
+  std::vector<double> jacobian, unitImpulse;
+  bool hasArticulated() const { return !sides.empty(); }
 
   int size() const { return static_cast<int>(rows.size()); }
   // "" when well formed, otherwise the first thing wrong (sizes, body indices, NaN/Inf, and
@@ -79,6 +101,9 @@ class RowSystem {
   void assemble(bool sparse, Problem& into, AssembleScratch& scratch) const;
   // w = A x + b computed through body velocities, O(nnz J).
   Vector slack(const Vector& x) const;
+  // The same into w, from the body velocities v = bodyVelocities(x) the caller already holds
+  // (a per-island caller reuses both buffers: no allocation once the sizes have been seen).
+  void slack(const Vector& x, const std::vector<Vector6>& v, Vector& w) const;
   // e(x) = 1/2 x^T A x = 1/2 x^T (w - b), O(nnz J): the kinetic energy of the velocity change
   // M^-1 J^T x the impulses make (plus the cfm's share), whatever the bodies' velocities. An
   // exploded answer (impulses along nearly dependent rows, 1e9 times a drifted loop's error)
@@ -86,6 +111,15 @@ class RowSystem {
   double impulseEnergy(const Vector& x) const;
   // Body velocity changes M^-1 J^T x, 6 per body ([linear; angular]).
   std::vector<Vector6> bodyVelocities(const Vector& x) const;
+  // The same into v (resized to bodies.size(), its storage reused).
+  void bodyVelocities(const Vector& x, std::vector<Vector6>& v) const;
+  // Articulated velocity changes sum_i W_i x_i, per articulated body its `articulated[k]`
+  // entries, concatenated in body order.
+  Vector articulatedVelocities(const Vector& x) const;
+  // The largest |entry| of articulatedVelocities(x) over base linear velocities (entries 3..5,
+  // Bullet's order: base angular, base linear, joints) and joint rates; 0 without articulated
+  // bodies. RowSolver's speed guard reads it beside the rigid bodies' linear speeds.
+  double articulatedSpeed(const Vector& x) const;
 };
 
 }  // namespace mlcp

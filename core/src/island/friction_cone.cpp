@@ -22,6 +22,9 @@ std::string FrictionCone::build(const RowSystem& rows, int directions, bool spar
   if (directions < 3) return "the friction cone needs at least 3 directions per contact";
   directions_ = directions;
   if (std::string why = rows.validate(); !why.empty()) return why;
+  // The direction rows are combinations of 6-wide rigid blocks (buildDirections).
+  if (rows.hasArticulated())
+    return "rows with articulated sides: the cone is built from rigid rows only (box kept)";
   boxSize_ = rows.size();
   if (std::string why = groupContacts(rows); !why.empty()) {
     contacts_.clear();

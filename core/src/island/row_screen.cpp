@@ -57,8 +57,40 @@ Verdict beyondReach(const RowSystem& s, int i, bool fx, double& fixedAt) {
   return Verdict::BeyondReach;
 }
 
+// A side whose row, body and storage are in range (validation reports the others).
+bool sideInRange(const RowSystem& s, const ArticulatedSide& a) {
+  if (a.row < 0 || a.row >= s.size() || a.body < 0 ||
+      a.body >= static_cast<int>(s.articulated.size()))
+    return false;
+  return a.at >= 0 && a.at + s.articulated[a.body] <= static_cast<int>(s.jacobian.size()) &&
+         s.unitImpulse.size() == s.jacobian.size();
+}
+
+// Each row's articulated share of A_ii and of ref (J . W and |J| |W| per side), and whether a
+// side has a non-zero J (rows.hpp); empty without articulated sides.
+struct ArticulatedShares {
+  std::vector<double> aii, ref;
+  std::vector<char> jacobian;
+  explicit ArticulatedShares(const RowSystem& s) {
+    if (!s.hasArticulated()) return;
+    const int n = s.size();
+    aii.assign(n, 0.0);
+    ref.assign(n, 0.0);
+    jacobian.assign(n, 0);
+    for (const ArticulatedSide& a : s.sides) {
+      if (!sideInRange(s, a)) continue;
+      const int width = s.articulated[a.body];
+      const Eigen::Map<const Vector> j(s.jacobian.data() + a.at, width);
+      const Eigen::Map<const Vector> w(s.unitImpulse.data() + a.at, width);
+      aii[a.row] += j.dot(w);
+      ref[a.row] += j.norm() * w.norm();
+      jacobian[a.row] |= !j.isZero(0);
+    }
+  }
+};
+
 // fixedAt: the row's answer when the verdict is BeyondReach (left 0 otherwise).
-Verdict judge(const RowSystem& s, int i, bool fx, double& fixedAt) {
+Verdict judge(const RowSystem& s, const ArticulatedShares& art, int i, bool fx, double& fixedAt) {
   const ConstraintRow& r = s.rows[i];
   const int nb = static_cast<int>(s.bodies.size());
   // Rows naming bodies out of range are validation's to report.
@@ -71,8 +103,10 @@ Verdict judge(const RowSystem& s, int i, bool fx, double& fixedAt) {
   const double lo = s.lo[i], hi = s.hi[i];
   if (lo == kInf || hi == -kInf || lo > hi) return Verdict::EmptyBounds;
   if (std::abs(s.b[i]) >= kBeyondReach) return beyondReach(s, i, fx, fixedAt);
-  if ((!a || r.jA.isZero(0)) && (!b || r.jB.isZero(0))) return Verdict::NoJacobian;
-  double aii = 0, ref = 0;
+  const bool articulated = !art.aii.empty();
+  if ((!a || r.jA.isZero(0)) && (!b || r.jB.isZero(0)) && !(articulated && art.jacobian[i]))
+    return Verdict::NoJacobian;
+  double aii = articulated ? art.aii[i] : 0.0, ref = articulated ? art.ref[i] : 0.0;
   if (a) side(s.bodies[r.bodyA], r.jA, aii, ref);
   if (b) side(s.bodies[r.bodyB], r.jB, aii, ref);
   if (s.cfm[i] == 0 && !(aii > kZeroDiagonal * ref)) return Verdict::ZeroDiagonal;
@@ -102,8 +136,9 @@ bool RowScreen::screen(const RowSystem& s) {
   inert_.assign(n, 0);
   fixed_.assign(n, 0.0);
   bool any = false;
+  const ArticulatedShares art(s);
   for (int i = 0; i < n; ++i) {
-    const Verdict v = judge(s, i, fx, fixed_[i]);
+    const Verdict v = judge(s, art, i, fx, fixed_[i]);
     count(counts_, v);
     inert_[i] = v != Verdict::Keep;
     any |= inert_[i] != 0;
@@ -151,9 +186,28 @@ bool RowScreen::screen(const RowSystem& s) {
       }
     }
   }
+  keepArticulated(s, place);
   for (int i = 0; i < n; ++i)
     if (fixed_[i] != 0) fix(s, i);
   return true;
+}
+
+// The kept rows' articulated sides, renumbered; J and W stay where they are stored.
+void RowScreen::keepArticulated(const RowSystem& s, const std::vector<int>& place) {
+  kept_.articulated = s.articulated;
+  kept_.sides.clear();
+  if (!s.hasArticulated()) {
+    kept_.jacobian.clear();
+    kept_.unitImpulse.clear();
+    return;
+  }
+  kept_.jacobian = s.jacobian;
+  kept_.unitImpulse = s.unitImpulse;
+  for (ArticulatedSide a : s.sides) {
+    if (!sideInRange(s, a) || place[a.row] < 0) continue;
+    a.row = place[a.row];
+    kept_.sides.push_back(a);
+  }
 }
 
 // Row i fixed at c = fixed_[i]: each kept row's b_j += J_j M^-1 J_i^T c on the bodies they share.
@@ -174,6 +228,16 @@ void RowScreen::fix(const RowSystem& s, int i) {
   for (int k = 0; k < kept_.size(); ++k) {
     const ConstraintRow& q = kept_.rows[k];
     kept_.b[k] += on(q.bodyA, q.jA) + on(q.bodyB, q.jB);
+  }
+  // The articulated sides of row i push the kept sides on the same bodies: J_k . W_i c.
+  for (const ArticulatedSide& a : s.sides) {
+    if (a.row != i || !sideInRange(s, a)) continue;
+    const int width = s.articulated[a.body];
+    const Eigen::Map<const Vector> w(s.unitImpulse.data() + a.at, width);
+    for (const ArticulatedSide& q : kept_.sides)
+      if (q.body == a.body)
+        kept_.b[q.row] +=
+            Eigen::Map<const Vector>(kept_.jacobian.data() + q.at, width).dot(w) * fixed_[i];
   }
 }
 

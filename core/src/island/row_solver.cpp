@@ -11,6 +11,7 @@
 #include "mlcp/io.hpp"
 #include "mlcp/registry.hpp"
 #include "mlcp/residual.hpp"
+#include "mlcp/solvers/dantzig.hpp"
 
 namespace mlcp {
 
@@ -98,11 +99,19 @@ struct RowSolver::Impl::Slot {
   // More solves by the policy's singular-island solver first: set after an exact method ended
   // short of the tolerance on the island's contact rows.
   int singularFirst = 0;
+  // More dantzig solves on A + delta I at once (DantzigParams::regularised): set after one broke
+  // down on A and was retried regularised. A resting pile breaks down every step (coplanar
+  // contacts without cfm), and the attempt on A before the retry cost as much as the retry.
+  int regulariseFirst = 0;
 };
 
 namespace {
 // Islands not solved for this many calls lose their workspaces (once there are this many).
 constexpr std::size_t kSlotLimit = 1024;
+// Solves of an island that go to dantzig's regularised problem at once after a breakdown before
+// the plain problem is tried again (the contacts may have changed). The cost of a wrong guess is
+// one cold solve on A + delta I where a warm one on A would have done.
+constexpr int kRegulariseSolves = 8;
 }  // namespace
 
 namespace {
@@ -264,6 +273,11 @@ Result RowSolver::Impl::run(const RowSystem& rows, const std::string& name, cons
   }
   Solver* solver = assembledSolver(island, name);
   solver->setOptions(o);
+  auto* dantzig = equals(name, "dantzig") ? dynamic_cast<DantzigSolver*>(solver) : nullptr;
+  if (dantzig) {
+    dantzig->params().regularised = island.regulariseFirst > 0;
+    if (island.regulariseFirst > 0) --island.regulariseFirst;
+  }
   // The rows for this solve only, cleared on every way out (a throw included): the solver is
   // kept per island and must not hold them past this call.
   struct Rows {
@@ -271,7 +285,11 @@ Result RowSolver::Impl::run(const RowSystem& rows, const std::string& name, cons
     ~Rows() { solver->useRows(nullptr); }
   } scope{solver};
   solver->useRows(&rows);
-  return solver->solveWithGuess(assembled_, start, x);
+  Result r = solver->solveWithGuess(assembled_, start, x);
+  // A breakdown on A: the next solves go to A + delta I at once, the one after them tries A again.
+  if (dantzig && !dantzig->params().regularised && dantzig->regularised())
+    island.regulariseFirst = kRegulariseSolves;
+  return r;
 }
 
 void RowSolver::Impl::notePgsCost(int rows, int sweeps, double seconds) {
@@ -301,17 +319,16 @@ double RowSolver::Impl::engineShare(const RowSystem& rows, const Vector& start) 
   return std::max((settings_.engineCostFactor - 1) * engine, 1e-9);
 }
 
-namespace {
-Accuracy startAccuracy(const RowSystem& rows, const Vector& start) {
-  return accuracy(start, rows.slack(start), rows.lo, rows.hi, rows.findex,
-                  rows.b.lpNorm<Eigen::Infinity>());
+Accuracy RowSolver::Impl::rowAccuracy(const RowSystem& rows, const Vector& x, bool fresh) {
+  if (fresh || velocities_.size() != rows.bodies.size()) rows.bodyVelocities(x, velocities_);
+  rows.slack(x, velocities_, slack_);
+  return accuracy(x, slack_, rows.lo, rows.hi, rows.findex, rows.b.lpNorm<Eigen::Infinity>());
 }
-}  // namespace
 
 bool RowSolver::Impl::startSolves(const RowSystem& rows, const Vector& start, double tolerance,
                                   bool withinTolerance, Vector& x, Result& r) {
   if (start.size() != rows.size()) return false;  // the solver reports the wrong size
-  const Accuracy a = startAccuracy(rows, start);
+  const Accuracy a = rowAccuracy(rows, start, false);
   const double limit =
       withinTolerance ? tolerance : std::min(kExactStart * tolerance, kExactStartLimit);
   if (!a.finite || !(a.residual <= limit)) return false;
@@ -326,7 +343,7 @@ bool RowSolver::Impl::startSolves(const RowSystem& rows, const Vector& start, do
 
 void RowSolver::Impl::keepStartIfBetter(const RowSystem& rows, const Vector& start, Vector& x,
                                         Result& r, double tolerance) {
-  const Accuracy a = startAccuracy(rows, start);
+  const Accuracy a = rowAccuracy(rows, start);
   if (takeStartIfBetter(r, a, tolerance)) x = start;
 }
 
@@ -435,10 +452,7 @@ Result RowSolver::Impl::fallBack(const RowSystem& rows, const Vector& start, Vec
     const int n = rows.size();
     x = start.allFinite() ? start : Vector::Zero(n);
     r.message += "; start kept";
-    applyAccuracy(
-        r,
-        accuracy(x, rows.slack(x), rows.lo, rows.hi, rows.findex, rows.b.lpNorm<Eigen::Infinity>()),
-        settings_.options.tolerance);
+    applyAccuracy(r, rowAccuracy(rows, x), settings_.options.tolerance);
   }
   return r;
 }
@@ -490,19 +504,30 @@ void RowSolver::Impl::continueShort(const RowSystem& rows, Vector& x, Slot& isla
   island.singularFirst = policy.singularIslandSolves;
 }
 
+// Leaves the returned start's velocities in velocities_ (startSolves reads them).
 const Vector& RowSolver::Impl::saneStart(const RowSystem& rows, const Vector& start) {
   if (!throwsBodies(rows, start, kStartSpeedFactor)) return start;
   coldStart_.setZero(rows.size());
+  velocities_.assign(rows.bodies.size(), Vector6::Zero());
   return coldStart_;
 }
 
 // Stage 5's trigger for acceptable answers (kSpeedFactor).
 bool RowSolver::Impl::throwsBodies(const RowSystem& rows, const Vector& x, double factor) {
-  if (x.size() != rows.size()) return false;
+  if (x.size() != rows.size()) {
+    velocities_.clear();
+    return false;
+  }
+  rows.bodyVelocities(x, velocities_);
+  return throwsFromVelocities(rows, x, factor);
+}
+
+bool RowSolver::Impl::throwsFromVelocities(const RowSystem& rows, const Vector& x,
+                                           double factor) const {
   const double limit = factor * rows.b.lpNorm<Eigen::Infinity>();
-  for (const Vector6& v : rows.bodyVelocities(x))
+  for (const Vector6& v : velocities_)
     if (v.head<3>().squaredNorm() > limit * limit) return true;
-  return false;
+  return rows.articulatedSpeed(x) > limit;
 }
 
 // Stage 5 (safe application): x, r are the lowest-residual answer, and it is not acceptable, or
@@ -559,7 +584,7 @@ void RowSolver::Impl::holdStill(const RowSystem& rows, const Vector& start, Vect
   r.status = Status::Failed;
   r.message += std::string("; every answer throws a body (pgs's too): ") +
                (useStart ? "the start" : "no impulses") + " applied";
-  applyAccuracy(r, startAccuracy(rows, x), settings_.options.tolerance);
+  applyAccuracy(r, rowAccuracy(rows, x), settings_.options.tolerance);
   out.choice = useStart ? kStartChoice : "none";
   out.friction = FrictionModel::Box;
   out.energyGuard = true;

@@ -105,7 +105,10 @@ class RowSolver::Impl {
   // Stage 5: an unacceptable answer moving the bodies far more than pgs's is replaced by pgs's.
   // throwsBodies: x changes some body's linear velocity by more than factor ||b||_inf (an
   // acceptable answer beyond kSpeedFactor = 10 is judged by keepSafe too).
-  static bool throwsBodies(const RowSystem& rows, const Vector& x, double factor);
+  // The velocities go to velocities_ (reused: no allocation per island).
+  bool throwsBodies(const RowSystem& rows, const Vector& x, double factor);
+  // Whether velocities_ (some x's) move a body by more than factor ||b||_inf.
+  bool throwsFromVelocities(const RowSystem& rows, const Vector& x, double factor) const;
   // Stage 0's start: `start`, or zeros (coldStart_) when it throws a body by 1000 ||b||_inf, far
   // beyond any answer's 10 (kStartSpeedFactor, row_solver.cpp). A start is the last
   // step's impulses matched to this step's rows; where last step's rows were nearly dependent
@@ -131,11 +134,15 @@ class RowSolver::Impl {
   // are that answer.
   // withinTolerance: the start need only meet the tolerance (an island under the engine-relative
   // cap, where a solve that would change it by less costs several times the engine's solver).
-  static bool startSolves(const RowSystem& rows, const Vector& start, double tolerance,
-                          bool withinTolerance, Vector& x, Result& r);
+  // velocities_ must hold the start's (saneStart leaves them there).
+  bool startSolves(const RowSystem& rows, const Vector& start, double tolerance,
+                   bool withinTolerance, Vector& x, Result& r);
   // A time-limited answer x is replaced by the start when the start's residual is lower.
-  static void keepStartIfBetter(const RowSystem& rows, const Vector& start, Vector& x, Result& r,
-                                double tolerance);
+  void keepStartIfBetter(const RowSystem& rows, const Vector& start, Vector& x, Result& r,
+                         double tolerance);
+  // The accuracy of x on the rows (residual.hpp), through velocities_ and slack_; fresh: the
+  // velocities are computed here, else velocities_ already holds x's.
+  Accuracy rowAccuracy(const RowSystem& rows, const Vector& x, bool fresh = true);
   void capture(const RowSystem& rows);
   void capture(const Problem& problem);
 
@@ -147,8 +154,10 @@ class RowSolver::Impl {
   double solveStart_ = 0;  // the current solve's start, until its primary's run() reads it
   Vector xFallback_;
   RowScreen screen_;
-  Vector keptStart_, keptX_;  // the kept rows' start and answer when rows were screened
-  Vector coldStart_;          // zeros: the start that replaces one that throws a body
+  Vector keptStart_, keptX_;         // the kept rows' start and answer when rows were screened
+  Vector coldStart_;                 // zeros: the start that replaces one that throws a body
+  std::vector<Vector6> velocities_;  // M^-1 J^T x of the last x looked at (start or answer)
+  Vector slack_;                     // w = A x + b of rowAccuracy's x
   std::unordered_map<std::uint64_t, std::unique_ptr<Slot>> slots_;
   std::uint64_t lastKey_ = 0;  // the key of lastSlot_
   Slot* lastSlot_ = nullptr;   // the island solved last (slots_ owns it)

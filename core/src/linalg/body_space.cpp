@@ -20,7 +20,8 @@ bool BodySpaceSystem::prepareFor(const RowSystem& rows, const Problem& problem, 
 }
 
 bool BodySpaceSystem::prepare(const RowSystem& rows, int n) {
-  if (rows.size() != n || rows.cfm.size() != n) return false;
+  // Articulated sides have no 6x6 M^-1 block to factor: the callers keep to the assembled A.
+  if (rows.size() != n || rows.cfm.size() != n || rows.hasArticulated()) return false;
   const int nb = static_cast<int>(rows.bodies.size());
   // R per body; bodies whose W is 0 (static) are left out of S.
   std::vector<Eigen::Matrix3d> angular(nb);

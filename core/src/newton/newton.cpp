@@ -227,7 +227,7 @@ void NewtonSolver::run(const Problem& pb, Vector& x, Result& result) {
 void NewtonSolver::pivotingPhase(const Problem& pb, Vector& x, Result& result, std::ostream& os) {
   Work& wk = *work_;
   const RowSystem* rows = wk.system.rows();
-  const bool body = rows != nullptr && rows->size() == pb.size();
+  const bool body = rows != nullptr && rows->size() == pb.size() && !rows->hasArticulated();
   const int steps = body ? params_.bodyPivotingSteps : params_.pivotingSteps;
   if (steps <= 0 || !wk.system.isSparse() || !wk.system.symmetric() || outOfTime()) return;
   wk.pivoting.setRows(body ? rows : nullptr);

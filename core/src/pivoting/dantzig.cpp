@@ -5,6 +5,7 @@
 #include <cstring>
 #include <optional>
 #include <sstream>
+#include <string>
 
 #include "linalg/sparse_pattern.hpp"
 #include "linalg/symmetry.hpp"
@@ -45,10 +46,13 @@ std::string redundantRowsNote(int redundant) {
 bool frictionPassesEnd(double res, int pass, const Options& opt, const std::string& singular,
                        Result& result) {
   if (res <= opt.tolerance) {
-    std::ostringstream os;
+    // Every converged friction solve writes this: built without an ostringstream, whose locale
+    // set-up costs more than a small island's pivoting.
     result.status = Status::Converged;
-    os << "friction bounds settled after " << pass << " pass" << (pass > 1 ? "es" : "") << singular;
-    result.message = os.str();
+    result.message = "friction bounds settled after ";
+    result.message += std::to_string(pass);
+    result.message += pass > 1 ? " passes" : " pass";
+    result.message += singular;
     return true;
   }
   if (pass >= opt.maxIterations) {
@@ -577,10 +581,11 @@ void DantzigSolver::Workspace::gatherNormals(Vector& g) const {
   for (size_t k = 0; k < frictionRows.size(); ++k) g[k] = std::abs(x[findex[frictionRows[k]]]);
 }
 
-dantzig::FrictionIteration DantzigSolver::Workspace::startFrictionIteration(int depth,
-                                                                            bool exactFriction) {
+dantzig::FrictionIteration& DantzigSolver::Workspace::startFrictionIteration(int depth,
+                                                                             bool exactFriction) {
   const int nf = static_cast<int>(frictionRows.size());
-  FrictionIteration fi;
+  FrictionIteration& fi = friction;
+  fi = FrictionIteration{0, 0, 0, kInf, 1.0, std::move(fi.g), std::move(fi.nu), std::move(fi.f)};
   fi.depth = std::max(1, depth);
   fi.g.resize(nf);
   fi.nu.resize(nf);
@@ -590,6 +595,15 @@ dantzig::FrictionIteration DantzigSolver::Workspace::startFrictionIteration(int 
     histF.resize(nf, fi.depth);
   }
   return fi;
+}
+
+double DantzigSolver::Workspace::residualOf(const Problem& pb, const Vector& xs) {
+  if (pb.isSparse())
+    residualW.noalias() = pb.sparseA() * xs;
+  else
+    residualW.noalias() = pb.denseA() * xs;
+  residualW += pb.b;
+  return accuracy(pb, xs, residualW).residual;
 }
 
 // Anderson acceleration of nu <- g(nu) = |x_normal(nu)|: piecewise affine, so within one active
@@ -658,10 +672,12 @@ DantzigSolver::DantzigSolver(DantzigSolver&&) noexcept = default;
 DantzigSolver& DantzigSolver::operator=(DantzigSolver&&) noexcept = default;
 
 int DantzigSolver::passes() const { return ws_->passes; }
+bool DantzigSolver::regularised() const { return ws_->regularised; }
 
 void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
   Workspace& ws = *ws_;
   ws.passes = 0;
+  ws.regularised = false;
   if (problem.size() == 0) {
     result.status = Status::Converged;
     result.message = "empty problem";
@@ -669,7 +685,7 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
   }
   // A tiny island's guessed index sets (warm, or the cold guess of dantzig_small.hpp): the same
   // steps on fixed-size arrays, else the general path.
-  if (detail::smallDenseApplies(problem) &&
+  if (!params_.regularised && detail::smallDenseApplies(problem) &&
       detail::solveSmallDense(problem, options().pivotTolerance, x)) {
     ws.passes = 1;
     result.status = Status::Converged;
@@ -680,20 +696,62 @@ void DantzigSolver::run(const Problem& problem, Vector& x, Result& result) {
   runPivoting(problem, x, result);
 }
 
+namespace {
+// max |A_ii| (max |A_ij|, or 1, when the diagonal is zero): Workspace::setScales's pivot scale,
+// read from the problem before any set-up.
+double diagonalScale(const Problem& pb) {
+  double dMax = 0, aMax = 0;
+  if (pb.isSparse()) {
+    const SparseMatrix& A = pb.sparseA();
+    for (int k = 0; k < A.outerSize(); ++k)
+      for (SparseMatrix::InnerIterator it(A, k); it; ++it) {
+        aMax = std::max(aMax, std::abs(it.value()));
+        if (it.row() == it.col()) dMax = std::max(dMax, std::abs(it.value()));
+      }
+  } else {
+    dMax = pb.denseA().diagonal().cwiseAbs().maxCoeff();
+    if (!(dMax > 0)) aMax = pb.denseA().cwiseAbs().maxCoeff();
+  }
+  return dMax > 0 ? dMax : (aMax > 0 ? aMax : 1.0);
+}
+}  // namespace
+
+// The solve on A + delta I from zero (Limits in dantzig.hpp): after a breakdown of the solve on A
+// (why: its message, spent: its pivots), or at once when DantzigParams::regularised asks for it.
+void DantzigSolver::regularise(const Problem& problem, Vector& x, Result& result, double scale,
+                               const std::string& why, int spent) {
+  Workspace& ws = *ws_;
+  const double delta = params_.breakdownShift * scale;
+  ws.shift = delta;
+  x = Vector::Zero(problem.size());
+  runPivoting(problem, x, result);
+  ws.shift = 0;
+  ws.regularised = true;
+  result.iterations += spent;
+  std::ostringstream os;
+  os << "regularised: A + " << delta << " I " << why << "; " << result.message;
+  result.message = os.str();
+}
+
 void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& result) {
   const Options& opt = options();
   Workspace& ws = *ws_;
   const int n = problem.size();
+  if (ws.shift == 0 && params_.regularised) {
+    regularise(problem, x, result, diagonalScale(problem), "(asked for)", 0);
+    return;
+  }
   const bool exact = opt.frictionBounds == FrictionBounds::Exact;
   const bool friction = problem.hasFindex();
   const bool useGuess = !x.isZero(0.0);
   // A guess's friction values fix the first pass's friction bounds only when the guess is close
   // (a residual within kTrustedGuess): an engine's cached impulses give bounds so far off that
   // the second pass redoes most pivots (docs/methods/pivoting.md, "Dantzig: friction bounds").
-  const bool trustFriction = useGuess && exact && friction && residual(problem, x) <= kTrustedGuess;
+  const bool trustFriction =
+      useGuess && exact && friction && ws.residualOf(problem, x) <= kTrustedGuess;
   ws.setUp(problem, x, opt, useGuess, trustFriction);
   const bool firstFixedOnce = friction && !trustFriction;
-  FrictionIteration fi = ws.startFrictionIteration(params_.andersonDepth, friction && exact);
+  FrictionIteration& fi = ws.startFrictionIteration(params_.andersonDepth, friction && exact);
   int totalPivots = 0;
   for (int it = 1;; ++it) {
     ws.passes = it;
@@ -709,18 +767,8 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
       // Pivoting breaks down on a singular A (redundant joints, coplanar contacts): once more
       // on A + delta I, cold (the guess led into the breakdown: docs/decisions.md, "Degenerate
       // rows and singular islands"); the residual is measured on A.
-      const std::string first = ws.message;
-      const int spent = totalPivots;
-      const double delta = params_.breakdownShift * ws.scale;
-      ws.shift = delta;
-      x = Vector::Zero(n);
-      runPivoting(problem, x, result);
-      ws.shift = 0;
-      result.iterations += spent;
-      std::ostringstream os;
-      os << "regularised: A + " << delta << " I after a breakdown (" << first << "); "
-         << result.message;
-      result.message = os.str();
+      regularise(problem, x, result, ws.scale, "after a breakdown (" + ws.message + ")",
+                 totalPivots);
       return;
     }
     if (o != Outcome::Done) {
@@ -736,7 +784,7 @@ void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& resul
       return;
     }
     // Exact friction: the bounds settle, the passes run out, or the next pass gets new bounds.
-    const double res = residual(problem, x);
+    const double res = ws.residualOf(problem, x);
     if (frictionPassesEnd(res, it, opt, singular, result)) return;
     if (!ws.nextFrictionBounds(fi, it, params_)) {
       std::ostringstream os;

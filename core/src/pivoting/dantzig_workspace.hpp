@@ -87,6 +87,7 @@ struct OrderedProblem {
   // pivoting that broke down on a singular A: A + shift I is positive definite, its answer
   // solves A's (consistent, or nearly: engines' drift) system up to ~shift |x|.
   double shift = 0, scale = 0;
+  bool regularised = false;  // the last solve's answer is the one on A + shift I
 
   // A's row i (dense storage) and its product with v over positions 0 .. len-1.
   const double* denseRow(int i) const {
@@ -305,6 +306,8 @@ struct DantzigSolver::Workspace : dantzig::ClampedSet {
   using Outcome = dantzig::Outcome;
 
   // ---- scratch ----
+  dantzig::FrictionIteration friction;
+  Vector residualW;
   std::vector<double> a, r, z, dxFull, dwN;
   std::vector<int> queue, violators;
 
@@ -371,7 +374,11 @@ struct DantzigSolver::Workspace : dantzig::ClampedSet {
   }
   // ------------------------------------------------------------ friction passes
   // The fixed point's state for this solve (histories sized only for exact friction).
-  dantzig::FrictionIteration startFrictionIteration(int depth, bool exactFriction);
+  // The solve's friction iteration (friction below), reset; its vectors keep their storage.
+  dantzig::FrictionIteration& startFrictionIteration(int depth, bool exactFriction);
+  // The residual (residual.hpp) of xs (in the problem's order) on pb, w in residualW: no
+  // allocation once the size has been seen.
+  double residualOf(const Problem& pb, const Vector& xs);
   // The next pass's friction bounds from this pass's normals; false when they did not move.
   bool nextFrictionBounds(dantzig::FrictionIteration& fi, int it, const DantzigParams& params);
   void setFrictionBounds(const Vector& nu);

@@ -29,6 +29,7 @@ Result RowPgs::solve(const RowSystem& s, Vector& x) {
     return result;
   };
   if (!(opt.relaxation > 0 && opt.relaxation < 2)) return invalid("relaxation outside (0, 2)");
+  if (s.hasArticulated()) return solveArticulated(s, x, t0);
   // Validation is folded into the packing pass below (rowValid per row); RowSystem::validate
   // runs only to name what is wrong.
   if (!arraysAndBodiesValid(s)) return invalid(s.validate());

@@ -92,6 +92,8 @@ class RowScreen {
 
  private:
   void fix(const RowSystem& s, int i);
+  // kept_'s articulated sides: those of kept rows, renumbered by place (-1: left out).
+  void keepArticulated(const RowSystem& s, const std::vector<int>& place);
 
   ScreenCounts counts_;
   std::vector<unsigned char> inert_;

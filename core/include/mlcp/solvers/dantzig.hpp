@@ -20,7 +20,8 @@
 //
 // Cost: a pivot O(|C|^2) plus O(|N| n) (O(nnz) of N's rows for sparse A), O(n^3) at worst;
 // memory A permuted (dense n^2, or CSR/CSC) and L (U) at n^2, reused while n does not grow. No
-// state carries from one solve to the next. Large contact islands are newton's (policy.hpp).
+// state carries from one solve to the next (regularised() only reports the last one). Large
+// contact islands are newton's (policy.hpp).
 //
 // Limits: a P-matrix (SPD A: cfm > 0) always solves; a consistent PSD problem (cfm = 0) usually
 // does, rows with a zero pivot and w = 0 left free (counted in the message). A breakdown (Failed,
@@ -51,6 +52,10 @@ struct DantzigParams {
   // The shift delta of the retry after a breakdown, relative to max |A_ii| ("Limits" above).
   // Default kDantzigBreakdownShift (1e-10, thresholds.hpp).
   double breakdownShift = kDantzigBreakdownShift;
+  // Solve A + delta I from zero at once (delta as after a breakdown), without the attempt on A:
+  // for a caller that knows the problem breaks down (RowSolver, for an island whose last solve
+  // did). The answer is the retry's; the residual is still measured on A. Default false.
+  bool regularised = false;
   // Exact friction: the normals' history depth of Anderson's extrapolation, the passes without
   // a new lowest bound change after which plain damped iteration takes over, and its damping
   // factor (docs/methods/pivoting.md, "Dantzig: friction bounds"). Defaults 6, 20 and 0.3.
@@ -73,6 +78,9 @@ class DantzigSolver : public Solver {
 
   // Friction fixed-point passes of the last solve (1 without findex or with FixedOnce).
   int passes() const;
+  // Whether the last solve's answer came from A + delta I (a breakdown's retry, or
+  // DantzigParams::regularised).
+  bool regularised() const;
 
  protected:
   void run(const Problem& problem, Vector& x, Result& result) override;
@@ -80,6 +88,8 @@ class DantzigSolver : public Solver {
  private:
   struct Workspace;
   void runPivoting(const Problem& problem, Vector& x, Result& result);
+  void regularise(const Problem& problem, Vector& x, Result& result, double scale,
+                  const std::string& why, int spent);
   std::unique_ptr<Workspace> ws_;
   DantzigParams params_;
 };

@@ -43,6 +43,8 @@ namespace mlcp {
 // point give the same iterates bit for bit. The step is omega / A_ii from our own A_ii, not an
 // engine's 1 / A_ii. Alternatives not taken: docs/decisions.md, "RowPgs: packing, sweeps and
 // check".
+// Rows with articulated sides (rows.hpp) are swept unpacked, the same update through J and
+// W = M^-1 J^T per side (core/src/projection/articulated_pgs.cpp): O(nnz J) a sweep, no A.
 class RowPgs {
  public:
   Options& options() { return options_; }
@@ -115,6 +117,8 @@ class RowPgs {
   // CPU variants (core/src/projection/row_pack.hpp: internal).
   struct Packing;
   static Result negativeRows();
+  // solve(RowSystem) on a system with articulated sides (see above).
+  Result solveArticulated(const RowSystem& system, Vector& x, double t0);
   // After the engine path's packing: per-body changes offered when the bases are finite, then
   // iterate().
   Result iteratePacked(int bodies, Vector& x, double bNorm, double t0);

@@ -30,9 +30,11 @@
 // linear or angular factors Bullet's body update treats differently is written back row by row.
 // "si" runs Bullet's own iterations, with the same statistics.
 //
-// Limits. A btMultiBodyDynamicsWorld never calls solveGroup: a world that steps without it makes
-// allSolved throw std::logic_error, so the swap never silently does nothing (install() and
-// SolverPool members skip the check; the same page, "Bullet: worlds served"). solveGroup,
+// Limits. A btMultiBodyDynamicsWorld never calls solveGroup: it solves through the
+// MultiBodySolver install() gives it (mlcp/bullet/multibody_solver.hpp). A world that steps
+// without calling solveGroup makes allSolved throw std::logic_error, so a swap by hand that does
+// nothing never goes unnoticed (install() and SolverPool members skip the check; the same page,
+// "Bullet: worlds served"). solveGroup,
 // prepareSolve and allSolved hold a mutex: one instance solves one group at a time; for parallel
 // groups give each thread its own (SolverPool). The warm-start memory is the instance's: one
 // solver per world.
@@ -49,6 +51,7 @@
 #include <vector>
 
 #include "mlcp/bullet/islands.hpp"
+#include "mlcp/bullet/settings.hpp"
 #include "mlcp/island/row_solver.hpp"
 #include "mlcp/result.hpp"
 #include "mlcp/rows.hpp"
@@ -59,91 +62,9 @@ class btDiscreteDynamicsWorld;
 
 namespace mlcp::bullet {
 
-// How the diagonal regularisation (CFM) of each row is taken.
-enum class CfmModel {
-  // cfm_i = m_cfm / m_jacDiagABInv: what Bullet's SI iteration converges to (contacts
-  // globalCfm / dt, friction 0, joints their own CFM times A_ii). With several contacts on one
-  // face the friction rows are linearly dependent (4 contacts: 8 rows for 3 tangential degrees
-  // of freedom), so A has singular principal blocks and pivoting methods can fail on it.
-  Engine,
-  // Engine, except that friction rows without a CFM of their own take their contact's,
-  // globalCfm / dt, as ODE does for every row: the redundant friction rows of a resting box
-  // become a regular problem (answers move by O(cfm) impulse). The default.
-  Regularized,
-  // globalCfm / dt on every row, per-row CFM ignored: what the stock btMLCPSolver assembles. Only
-  // for diffing against stock.
-  StockMlcp,
-};
-
-// The island solver's settings (mlcp::RowSolverSettings: solver "auto", options with tolerance
-// 1e-6, fallback "pgs" with at most 100 sweeps, acceptResidual 1e-3, denseAssemblyMaxRows 64,
-// engineIterations; documented in mlcp/island/row_solver.hpp, the shape the ODE adapter's settings
-// share), plus Bullet's own. `solver` may also be "si": Bullet's own sequential impulse
-// iterations. engineIterations (default true) gives pgs/gs btContactSolverInfo::m_numIterations
-// sweeps, as SI and the stock MLCP solvers run. options.warmStart is governed by warmStart below.
-struct Settings : RowSolverSettings {
-  // Start every solve from last step's impulses (stage 4 above). Default true.
-  bool warmStart = true;
-  // With warmStart: start contacts and friction where SI starts them, from the cached impulse
-  // times m_warmstartingFactor (0.85), the impulse SI's setup has applied, instead of the
-  // cached impulse itself. SI's damping of the start lowers the residual fixed-sweep pgs reaches
-  // on stacks (docs/benchmarks.md, "Bullet: pgs from SI's start"); exact solvers do not depend
-  // on the start. Default false.
-  bool siStart = false;
-  // Regularisation model; see CfmModel. Default Regularized.
-  CfmModel cfm = CfmModel::Regularized;
-  // Keep every island's rows, start, answer and result of the last step (for tests and tools;
-  // costs copies). Default false.
-  bool keepIslands = false;
-  // With "si": also measure the residual of SI's answer (costs about one sweep; excluded from
-  // StepStats::seconds). Default true.
-  bool measureSi = true;
-  // "pgs" islands packed straight from Bullet's rows and written back per body
-  // (docs/methods/adapters.md, "Bullet: the pgs path"). false: through RowSolver on a RowSystem
-  // copy like every other solver (the same iterates; for side-by-side runs of the two). Default
-  // true.
-  bool packInPlace = true;
-};
-
-// One solved problem (an island, or its split-impulse twin) of the last step.
-struct IslandRecord {
-  RowSystem system;
-  Vector start;        // warm start given to the solver
-  Vector x;            // the answer written back
-  Result result;       // of the answer written back
-  std::string solver;  // which solver gave it ("dantzig", "ldlt", "pgs" after a fallback, "si")
-  bool split = false;  // the split-impulse (position) problem
-  bool fellBack = false;
-};
-
-// Statistics of one simulation step (every solveGroup call between prepareSolve and the next
-// prepareSolve, which btDiscreteDynamicsWorld issues once per step).
-struct StepStats {
-  int groups = 0;       // solveGroup calls
-  int islands = 0;      // problems solved (connected components, split-impulse twins included)
-  int rows = 0;         // rows handed to solvers
-  int inertRows = 0;    // rows touching no dynamic body (no effect; left at their start value)
-  int iterations = 0;   // sweeps or pivots, summed over islands
-  double residual = 0;  // worst scaled natural-map residual over islands (NaN if not measured)
-  Status status = Status::Converged;  // worst status over islands (after the fallback)
-  double seconds = 0;          // wall time of stages 2-7 (SI: its iterations), summed over groups
-  double measureSeconds = 0;   // time spent measuring residuals outside the solve (si only)
-  double assembleSeconds = 0;  // part of `seconds` spent assembling A for matrix-based solvers
-  int fallbacks = 0;           // islands whose primary answer was rejected (the fallback ran)
-  int failures = 0;            // islands whose returned answer is still rejected
-  std::string message;         // why the first rejected answer was rejected ("" if none)
-  ChoiceCounts choices;        // which solver answered, per island ("dantzig:3 ldlt:1")
-  int packedIslands = 0;       // of `islands`: "pgs" answers packed straight from Bullet's rows
-  int coneIslands = 0;    // of `islands`: answered by the friction cone's LCP (Settings::friction)
-  ScreenCounts screened;  // degenerate rows screened by reason (row_screen.hpp), summed
-};
-
-// Adds `from`'s counts and times to `into`; keeps the worst residual and status, and the first
-// message.
-void accumulate(StepStats& into, const StepStats& from);
-
 class SolverPool;
 class ConstraintSolver;
+class MultiBodySolver;
 // Puts the solver in every solver slot of the world, or refuses the world (mlcp/bullet/worlds.hpp).
 void install(btDiscreteDynamicsWorld& world, ConstraintSolver& solver);
 
@@ -163,6 +84,9 @@ class ConstraintSolver : public btSequentialImpulseConstraintSolver {
   // The shared island solver (null with "si"): its capture hook writes each island's problem
   // ("pgs" islands go through it while a capture is set: the capture needs the RowSystem).
   RowSolver* rowSolver() { return rows_.get(); }
+  // The drop-in for multibody worlds (multibody_solver.hpp), made on first use, owned here; it
+  // solves with this solver's settings and island solver into lastStep(). install() sets it.
+  MultiBodySolver& multiBodySolver();
 
   // Serialized by the solver's mutex (see "Limits" above).
   btScalar solveGroup(btCollisionObject** bodies, int numBodies, btPersistentManifold** manifolds,
@@ -190,7 +114,12 @@ class ConstraintSolver : public btSequentialImpulseConstraintSolver {
   // internalApplyPushImpulse with x - applied), and set the applied impulses to x.
   void applyPerRow(Island& island, const Vector& x, bool split);
   void measureSi(int sweeps);
+  // One island's statistics into the step: SI's answer (its residual measured), or RowSolver's.
+  void recordSi(const RowSystem& s, const Vector& answer, int sweeps);
+  void recordSolve(const IslandSolve& solved, int rows);
   void record(const Result& r, int rows, const std::string& choice);
+  // RowSolver told the engine's sweep count; pgs/gs run it under Settings::engineIterations.
+  void useEngineSweeps(const btContactSolverInfo& info);
   // prepareSolve's and allSolved's work, with the mutex held by the caller.
   void openStep(int numBodies);
   void finishStep();
@@ -198,6 +127,7 @@ class ConstraintSolver : public btSequentialImpulseConstraintSolver {
   void checkWorld();
 
   friend class SolverPool;
+  friend class MultiBodySolver;
   friend void install(btDiscreteDynamicsWorld& world, ConstraintSolver& solver);
 
   Settings settings_;
@@ -216,6 +146,7 @@ class ConstraintSolver : public btSequentialImpulseConstraintSolver {
   int stepBodies_ = 0;         // prepareSolve's numBodies of the open step
   bool worldChecked_ = false;  // the check ran (or install()/SolverPool made it unneeded)
   bool unserved_ = false;      // the world stepped without calling solveGroup
+  std::unique_ptr<MultiBodySolver> multiBody_;
 };
 
 }  // namespace mlcp::bullet

@@ -1,5 +1,8 @@
 // mlcp/bullet/worlds.hpp: the drop-in in every kind of Bullet world, or a clear refusal.
 //
+//     mlcp::bullet::install(*multiBodyWorld, solver);  // btMultiBodyDynamicsWorld: the solver's
+//                                                       // MultiBodySolver, lastStep() as above
+//
 //     mlcp::bullet::ConstraintSolver solver(settings);
 //     mlcp::bullet::install(*world, solver);        // btDiscreteDynamicsWorld: the same as
 //                                                   // world->setConstraintSolver(&solver)
@@ -17,9 +20,12 @@
 //   at least 250 manifolds (s_minimumContactManifoldsForBatching) to a second solver, a protected
 //   member without a setter; install() fills both slots, so every island reaches the pool or
 //   solver given. Its members still see merged groups and split them into connected components.
-// - btMultiBodyDynamicsWorld (and the worlds derived from it) keeps its own solver for every
-//   island and calls only prepareSolve and allSolved on ours: install() throws, and a
-//   ConstraintSolver set there by hand throws from allSolved at the first step.
+// - btMultiBodyDynamicsWorld and btSoftMultiBodyDynamicsWorld solve every island through a
+//   btMultiBodyConstraintSolver (setConstraintSolver does not reach it): install() sets the
+//   ConstraintSolver's MultiBodySolver there (multibody_solver.hpp); a ConstraintSolver set by
+//   hand with setConstraintSolver throws from allSolved at the first step. A pool is refused
+//   there (the world solves its islands on one solver), and so is
+//   btDeformableMultiBodyDynamicsWorld (its solver also solves the deformable bodies).
 //
 // Threads. Debian's Bullet 3.24 is built without BT_THREADSAFE: btParallelFor runs on the
 // calling thread and every call takes member 0. Under a user's own threaded btITaskScheduler the
@@ -36,6 +42,7 @@
 #include <vector>
 
 #include "mlcp/bullet/constraint_solver.hpp"
+#include "mlcp/bullet/multibody_solver.hpp"
 
 class btDiscreteDynamicsWorld;
 
@@ -75,10 +82,11 @@ class SolverPool : public btConstraintSolverPoolMt {
 };
 
 // Puts the solver (or pool) in every solver slot of the world so that every island reaches it:
-// setConstraintSolver, and for a btDiscreteDynamicsWorldMt also its large-island slot. Throws
-// std::invalid_argument for a btMultiBodyDynamicsWorld (or a world derived from it), which would
-// never call it. A single ConstraintSolver in a btDiscreteDynamicsWorldMt serializes the
-// parallel part (its mutex); a SolverPool solves it in parallel where Bullet is thread-safe.
+// setConstraintSolver, and for a btDiscreteDynamicsWorldMt also its large-island slot; in a
+// btMultiBodyDynamicsWorld (or a world derived from it) the solver's MultiBodySolver, by
+// setMultiBodyConstraintSolver. Throws std::invalid_argument for a deformable world, and for a
+// pool in a multibody world. A single ConstraintSolver in a btDiscreteDynamicsWorldMt serializes
+// the parallel part (its mutex); a SolverPool solves it in parallel where Bullet is thread-safe.
 void install(btDiscreteDynamicsWorld& world, ConstraintSolver& solver);
 void install(btDiscreteDynamicsWorld& world, SolverPool& pool);
 
