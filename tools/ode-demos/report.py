@@ -53,16 +53,18 @@ def main():
         for solver in solvers:
             rec, meta = read(runs, demo, solver)
             row = {"demo": demo, "solver": solver, "status": status(rec, meta),
-                   "keys": meta.get("keys", "")}
+                   "keys": meta.get("keys", ""), "instructions": meta.get("instructions", "")}
             if rec:
                 row.update(rec)
             if rec and srec and srec["median_step_ms"] > 0 and (sstat.startswith("ok") or sstat == "nan"):
                 row["step_vs_stock"] = rec["median_step_ms"] / srec["median_step_ms"]
                 row["speed_vs_stock"] = rec["max_speed"] / srec["max_speed"] if srec["max_speed"] > 0 else None
+            if row["instructions"] and smeta.get("instructions"):
+                row["instructions_vs_stock"] = int(row["instructions"]) / int(smeta["instructions"])
             rows.append(row)
 
     cols = ["demo", "solver", "status", "called", "frames", "steps", "median_step_ms", "step_vs_stock",
-            "total_step_ms", "nan_steps", "first_nan_frame", "max_speed", "speed_vs_stock",
+            "instructions", "instructions_vs_stock", "total_step_ms", "nan_steps", "first_nan_frame", "max_speed", "speed_vs_stock",
             "frames_unconverged", "steps_unconverged", "steps_fallback", "steps_rejected", "islands",
             "islands_unconverged", "rows", "max_rows", "worst_residual", "choices", "worst_message", "keys"]
     with open(csv_out, "w", newline="") as f:
@@ -101,6 +103,15 @@ def main():
                   and status(*read(runs, r["demo"], base)).startswith("ok")]
         bad += len(failed)
         gm = math.exp(sum(math.log(x) for x in ratios) / len(ratios)) if ratios else float("nan")
+        instr = [r["instructions_vs_stock"] for r in rows if r["solver"] == solver
+                 and r.get("instructions_vs_stock") and r["status"].startswith("ok")]
+        if instr:
+            gi = math.exp(sum(math.log(x) for x in instr) / len(instr))
+            worst_i = sorted(((r["instructions_vs_stock"], r["demo"]) for r in rows if r["solver"] == solver
+                              and r.get("instructions_vs_stock")), reverse=True)[:5]
+            print("%s: geometric mean of instructions in the step calls against stock %.2fx over %d demos; "
+                  "above 3x: %d; most: %s" % (solver, gi, len(instr), sum(1 for x in instr if x > 3),
+                                               ", ".join("%s %.1fx" % (d, x) for x, d in worst_i)))
         print("%s: geometric mean step_vs_stock %.2fx over %d demos; above 3x: %d; worst: %s; "
               "frames unconverged (all demos): %d; crashed/NaN/timeout where stock was fine: %s" % (
                   solver, gm, len(ratios), sum(1 for x in ratios if x > 3),

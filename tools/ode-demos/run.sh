@@ -7,7 +7,9 @@
 # Environment: PROJECT (default: the current folder), BUILD (default $PROJECT/build), CACHE
 # (default /tmp/ode-demos-cache: the harness build and the runs), DEMOS (space-separated subset),
 # SOLVERS (default "stock auto"; any name mlcp::ode::Stepper accepts), FRAMES_SCALE (multiplies
-# the frame counts), JOBS (build jobs, default 2), TIMEOUT (seconds per run, default 300).
+# the frame counts), JOBS (build jobs, default 2), TIMEOUT (seconds per run, default 300),
+# CALLGRIND=1 (each run under callgrind, counting the instructions inside the step calls: a
+# measure the machine's load does not move; use FRAMES_SCALE=0.25 or so, callgrind is ~50x slower).
 # Prints the table, writes $CACHE/runs/results.csv; exit 0 only if no library run crashes or
 # produces NaN where the stock run does not.
 set -uo pipefail
@@ -19,6 +21,12 @@ SOLVERS=${SOLVERS:-"stock auto"}
 FRAMES_SCALE=${FRAMES_SCALE:-1}
 JOBS=${JOBS:-2}
 TIMEOUT=${TIMEOUT:-300}
+wrap=()
+if [[ -n ${CALLGRIND:-} ]]; then
+  wrap=(valgrind --tool=callgrind --callgrind-out-file=/dev/null
+        "--toggle-collect=*::step(char const*, dxWorld*, double)")
+  TIMEOUT=$((TIMEOUT * 20))
+fi
 log() { printf '[ode-demos] %s\n' "$*" >&2; }
 mkdir -p "$CACHE"
 
@@ -98,9 +106,10 @@ while read -r demo frames keys why; do
   for solver in $SOLVERS; do
     stem=$runs/$demo.$solver
     (cd "$ode_src/ode/demo" && ODE_DEMO_SOLVER=$solver ODE_DEMO_OUT=$stem.json ODE_DEMO_KEYS=$keys \
-      nice timeout -k 5 "$TIMEOUT" "$hb/$demo" --frames "$frames" >"$stem.stdout" 2>"$stem.stderr" </dev/null)
+      nice timeout -k 5 "$TIMEOUT" "${wrap[@]}" "$hb/$demo" --frames "$frames" >"$stem.stdout" 2>"$stem.stderr" </dev/null)
     rc=$?
-    printf 'rc=%s\nkeys=%s\n' "$rc" "$keys" >"$stem.meta"
+    printf 'rc=%s\nkeys=%s\ninstructions=%s\n' "$rc" "$keys" \
+      "$(sed -n 's/.*Collected : \([0-9]*\).*/\1/p' "$stem.stderr" | tail -1)" >"$stem.meta"
     printf '  %-22s %-8s rc=%-3s %s\n' "$demo" "$solver" "$rc" "$(tail -1 "$stem.stdout" | cut -c1-110)" >&2
   done
 done <<<"$demo_table"

@@ -636,18 +636,26 @@ bool DantzigSolver::Workspace::nextFrictionBounds(FrictionIteration& fi, int it,
   histG.col(fi.stored) = fi.g;
   histF.col(fi.stored) = fi.f;
   ++fi.stored;
-  Vector next = fi.nu + fi.damping * fi.f;
+  Vector& next = andersonNext;
+  next = fi.nu + fi.damping * fi.f;
   if (fi.damping == 1.0 && fi.stored >= 2) {
     const int q = fi.stored - 1;
-    DenseMatrix dF(nf, q), dG(nf, q);
+    DenseMatrix &dF = andersonDF, &dG = andersonDG;
+    dF.resize(nf, q);
+    dG.resize(nf, q);
     for (int j = 0; j < q; ++j) {
       dF.col(j) = histF.col(j + 1) - histF.col(j);
       dG.col(j) = histG.col(j + 1) - histG.col(j);
     }
-    const Vector gamma = dF.colPivHouseholderQr().solve(fi.f);
-    if (gamma.allFinite()) next -= dG * gamma;
+    andersonQr.compute(dF);
+    andersonGamma = andersonQr.solve(fi.f);
+    if (andersonGamma.allFinite()) {
+      andersonStep.noalias() = dG * andersonGamma;  // as a temporary would: the same bits
+      next -= andersonStep;
+    }
   }
-  setFrictionBounds(next.cwiseMax(0.0));
+  next = next.cwiseMax(0.0);
+  setFrictionBounds(next);
   return true;
 }
 

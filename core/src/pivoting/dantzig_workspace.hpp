@@ -79,6 +79,11 @@ struct OrderedProblem {
   std::vector<double> normal;  // friction rows: the normal magnitude their bounds come from
   std::vector<int> frictionRows;
   DenseMatrix histG, histF;  // Anderson history of the friction fixed point (columns)
+  // Anderson's least-squares step (nextFrictionBounds): its differences, their QR, gamma and
+  // the next bounds, kept so that passes of one size allocate nothing.
+  DenseMatrix andersonDF, andersonDG;
+  Eigen::ColPivHouseholderQR<DenseMatrix> andersonQr;
+  Vector andersonGamma, andersonStep, andersonNext;
   double pivTol = 0, epsW = 0, aMax = 0;
   // Rows nothing limits whose w is 0 (a zero Schur pivot: A singular, e.g. redundant joints)
   // stay free at their value; redundant counts them for the message.
