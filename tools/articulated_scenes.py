@@ -64,7 +64,7 @@ def arm_push():
 def legged_base(tilt=0.3):
     """A floating base on four legs (hip and knee revolute about y, limits, braking motors),
     thighs splayed by `tilt` and shins vertical, feet on the ground: the joints carry the load."""
-    thigh, shin, base_z = 0.2, 0.2, 0.0
+    thigh, shin = 0.2, 0.2
     knee_z = shin
     hip_z = knee_z + thigh * math.cos(tilt)
     base_z = hip_z + 0.05

@@ -31,9 +31,9 @@ export MLCP_PYTHON=$py  # `mlcp chart` uses the same interpreter
 # step keeps its shortest time (`mlcp sweep --repeat`): single runs of a few ms moved by 30%
 # between runs on a shared 2-core machine, enough to flip the front between identical solvers.
 scenes=(stack_10 pyramid_15 pendulum_chain hinge_motor_limits mass_ratio_stack sphere_pit)
-# Articulated scenes run also in reduced coordinates (engine bullet-multibody, where the sweep
-# runs Bullet's own solvers and skips the core ones until mlcp::bullet::install serves
-# multibody worlds): the arm pushing boxes and the chain holding its joint limits.
+# Articulated scenes run also in reduced coordinates (engine bullet-multibody: btMultiBody, the
+# core solvers through the multibody drop-in): the arm pushing boxes and the chain holding its
+# joint limits.
 articulated=(arm_push limit_chain)
 iterative=pgs,bullet-si,ode-quick
 iterative_values=5,10,20,50,100
@@ -115,7 +115,7 @@ echo "$((SECONDS - t0)) s"
 
 elapsed=$((SECONDS - start))
 notes+=("Made by tools/report.sh in ${elapsed} s on $(nproc) cores, $(date -u '+%Y-%m-%d %H:%M UTC'), commit $(git -C "$repo" rev-parse --short HEAD 2> /dev/null || echo unknown).")
-notes+=("Sweep: ${scenes[*]} in bullet and ode; ${articulated[*]} (articulated) in bullet, bullet-multibody (reduced coordinates: Bullet's own solvers only) and ode; $steps steps of each scene's time step per run; iterations $iterative_values for $iterative, $pivoting_values for $pivoting; no fallback (--fallback none): each solver alone.")
+notes+=("Sweep: ${scenes[*]} in bullet and ode; ${articulated[*]} (articulated) in bullet, bullet-multibody (reduced coordinates) and ode; $steps steps of each scene's time step per run; iterations $iterative_values for $iterative, $pivoting_values for $pivoting; no fallback (--fallback none): each solver alone.")
 note_args=()
 for n in "${notes[@]}"; do note_args+=(--note "$n"); done
 "$py" "$repo/tools/report.py" "$out" "${note_args[@]}" > /dev/null

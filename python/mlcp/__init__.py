@@ -322,7 +322,7 @@ def run(scene: "str | os.PathLike[str]", engine: str, solver: Optional[str] = No
         capture_dir: "str | os.PathLike[str]" = ".", states: bool = False) -> Run:
     """Steps a scene file (mlcp-scene/1) in an engine ("bullet", "bullet-multibody" or "ode",
     see engines()). "bullet-multibody" builds the scene's articulated bodies as Bullet
-    btMultiBodies (reduced coordinates) and runs Bullet's own solvers ("bullet-si",
+    btMultiBodies (reduced coordinates) and takes the core solvers and Bullet's own ("bullet-si",
     "bullet-mlcp-dantzig", ...); "bullet" and "ode" build them as jointed rigid bodies.
 
     The settings of `mlcp run`, snake_case, with its defaults (`mlcp run --help`); None: the

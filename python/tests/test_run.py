@@ -8,7 +8,8 @@ import pytest
 import mlcp
 from conftest import SCENES, cli, cli_error
 
-# The engines core solvers run in (bullet-multibody takes Bullet's own solvers only so far).
+# The engines the rigid-scene checks below run in (bullet-multibody gives bullet's answers on
+# scenes without articulated bodies).
 ENGINES = [e for e in mlcp.engines() if e != "bullet-multibody"]
 
 

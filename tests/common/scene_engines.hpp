@@ -1,7 +1,7 @@
 // The engine loaders of this build by name ("bullet", "ode"), for the tests that run scene
 // files in every engine (world_test, content_test). MLCP_HAVE_BULLET / MLCP_HAVE_ODE say which
-// loaders the test is linked with. "bullet-multibody" is not among them: it takes Bullet's own
-// solvers only until mlcp::bullet::install() serves multibody worlds (articulation_test runs it).
+// loaders the test is linked with. "bullet-multibody" is not among them: on scenes without
+// articulated bodies it gives bullet's answers; articulation_test runs it.
 #pragma once
 
 #include <functional>
@@ -37,8 +37,15 @@ inline std::vector<std::pair<std::string, SceneLoader>> sceneEngines() {
   return e;
 }
 
-// The loader of that engine, or an empty function when this build has none.
+// The loader of that engine ("bullet-multibody" too), or an empty function when this build has
+// none.
 inline SceneLoader sceneLoader(const std::string& engine) {
+#ifdef MLCP_HAVE_BULLET
+  if (engine == "bullet-multibody")
+    return [](const scene::Scene& s, const scene::RunSettings& run) {
+      return mlcp::bullet::loadWorld(s, run, mlcp::bullet::Coordinates::Reduced);
+    };
+#endif
   for (auto& [name, loader] : sceneEngines())
     if (name == engine) return loader;
   return {};

@@ -81,10 +81,11 @@ std::vector<Case> cases() {
   add("hull_stack", both, {"pgs", "dantzig", "lemke", "auto"}, 60);
   add("stack_1000", both, {"pgs", "auto"}, 2);
   add("boxes_3000", both, {"pgs", "auto"}, 3);
-  // Articulated bodies as jointed rigid bodies (maximal coordinates; articulation_test runs them
-  // in bullet-multibody with Bullet's own solvers).
+  // Articulated bodies as jointed rigid bodies (bullet, ode) and as btMultiBodies
+  // (bullet-multibody, through the multibody drop-in).
   for (const char* scene : {"arm_push", "legged_base", "spherical_chain", "limit_chain"})
-    add(scene, both, {"pgs", "dantzig", "lemke", "ldlt", "auto"}, 60);
+    add(scene, {"bullet", "bullet-multibody", "ode"}, {"pgs", "dantzig", "lemke", "ldlt", "auto"},
+        60);
   return out;
 }
 
@@ -134,7 +135,21 @@ constexpr const char* kChainPgs =
 constexpr const char* kChainLdlt =
     "ldlt refuses bounded rows (limits, motors, contacts) and its pgs fallback misses the 1e-3 "
     "acceptance on the jointed chains (see kChainPgs)";
+constexpr const char* kMultiBodyPgs =
+    "pgs convergence in reduced coordinates (bullet-multibody: no joint rows, the limits, motors "
+    "and contacts on the btMultiBody): at the scene's 50 sweeps 1 (arm_push), 12 (legged_base) "
+    "and 31 (limit_chain) of 60 steps end above the 1e-3 acceptance (60 of 60 in maximal "
+    "coordinates, kChainPgs; a method limit)";
+constexpr const char* kMultiBodyLdlt =
+    "ldlt refuses bounded rows and its pgs fallback misses the 1e-3 acceptance as pgs does (see "
+    "kMultiBodyPgs)";
 const KnownFailure kKnownFailures[] = {
+    {"arm_push", "bullet-multibody", "pgs", kMultiBodyPgs, false},
+    {"arm_push", "bullet-multibody", "ldlt", kMultiBodyLdlt, false},
+    {"legged_base", "bullet-multibody", "pgs", kMultiBodyPgs, false},
+    {"legged_base", "bullet-multibody", "ldlt", kMultiBodyLdlt, false},
+    {"limit_chain", "bullet-multibody", "pgs", kMultiBodyPgs, false},
+    {"limit_chain", "bullet-multibody", "ldlt", kMultiBodyLdlt, false},
     {"arm_push", "bullet", "pgs", kChainPgs, false},
     {"arm_push", "ode", "pgs", kChainPgs, false},
     {"arm_push", "bullet", "ldlt", kChainLdlt, false},
@@ -217,8 +232,10 @@ TEST_P(SceneContent, RunsWithoutNaNAndLeavesNoIslandUnsolved) {
 
 INSTANTIATE_TEST_SUITE_P(Scenes, SceneContent, testing::ValuesIn(cases()),
                          [](const testing::TestParamInfo<Case>& info) {
-                           return std::string(info.param.scene) + "_" + info.param.engine + "_" +
-                                  info.param.solver;
+                           std::string name = std::string(info.param.scene) + "_" +
+                                              info.param.engine + "_" + info.param.solver;
+                           std::replace(name.begin(), name.end(), '-', '_');  // bullet-multibody
+                           return name;
                          });
 
 std::vector<std::string> engines() {

@@ -98,6 +98,7 @@ btTransform jointFrame(const Vec3& anchor, const Vec3& axis, int axisColumn) {
 // The adapter's settings for a core solver run by these run settings.
 Settings coreSettings(const scene::RunSettings& run) {
   Settings settings;
+  settings.solver = run.solver;
   settings.options.maxIterations = run.iterations;
   settings.options.tolerance = run.tolerance;
   settings.warmStart = run.warmStart;

@@ -3,12 +3,13 @@
 // A scene file is data: bodies (plane, box, sphere, capsule, cylinder, convex hull; geometry.hpp),
 // joints (ball, hinge, slider, fixed, cone-twist, 6-dof with springs, universal, hinge-2, gear;
 // joints.hpp), articulated bodies (trees of links; articulation.hpp), materials, gravity, engine
-// settings and solver defaults. Generators ("stack", "pyramid", "grid")
-// keep big regular structures small on disk. loadScene() returns the expanded, validated model
-// below: every generator replaced by its bodies, every default filled in, every name resolved to an
-// index, and the inertia of every body computed from its shape and mass. The engine loaders
-// (Bullet, ODE) build worlds from these structs alone, so both engines see the same numbers;
-// nothing here depends on an engine.
+// settings and solver defaults. Generators ("stack", "pyramid", "grid") keep big regular
+// structures small on disk. loadScene() returns the expanded, validated model below: every
+// generator replaced by its bodies, every articulation by its bodies and link joints (its tree
+// kept in `articulations`), every default filled in, every name resolved to an index, and the
+// inertia of every body computed from its shape and mass (or given, for articulated bodies). The
+// engine loaders (Bullet, its multibody world, ODE) build worlds from these structs alone, so
+// every engine sees the same numbers; nothing here depends on an engine.
 //
 // Conventions (the README has the full list):
 // - SI units: m, kg, s, rad (a file may write orientations in degrees; they arrive here in
