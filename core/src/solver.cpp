@@ -101,11 +101,13 @@ Result Solver::solveInner(Solver& inner, const Problem& problem, const Vector& g
   if (guess.size() != problem.size()) return inner.solveWithGuess(problem, guess, x);
   inner.start_ = guess;
   inner.validated_ = true;
-  const bool timed = inner.timed_;
-  inner.timed_ = false;  // this solve times the whole
-  Result r = inner.runChecked(problem, x, &guess);
-  inner.timed_ = timed;
-  return r;
+  struct Untimed {  // this solve times the whole; restored on every way out
+    bool& timed;
+    const bool was;
+    ~Untimed() { timed = was; }
+  } untimed{inner.timed_, inner.timed_};
+  inner.timed_ = false;
+  return inner.runChecked(problem, x, &guess);
 }
 
 void Solver::keepStartIfBetter(const Problem& problem, const Vector* start, Result& r) {

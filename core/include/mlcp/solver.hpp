@@ -72,9 +72,10 @@ class Solver {
   // with `inner` from `guess` (size n, finite: this solve's start) without validating it again,
   // since this solve has. inner still checks its answer's accuracy against the problem.
   Result solveInner(Solver& inner, const Problem& problem, const Vector& guess, Vector& x);
-  // Says that run() leaves x and result (status, residual, its parts) as its last solveInner
-  // left them, that run's options matching these: that check is the final one and is not
-  // repeated (one residual evaluation a solve, however deep the chain).
+  // Says that run() leaves x and result (status, residual and its parts) as its last
+  // solveInner left them, inner having run with this solver's options (setOptions(options())):
+  // that check is the one this solve would make, so it is not repeated (one residual
+  // evaluation a solve, however deep the chain).
   void keepInnerCheck() { innerChecked_ = true; }
 
  private:
