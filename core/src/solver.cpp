@@ -7,6 +7,7 @@
 #include <new>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include "mlcp/residual.hpp"
 
@@ -96,6 +97,19 @@ Result Solver::solveWithGuess(const Problem& problem, const Vector& guess, Vecto
   return runChecked(problem, x, &guess);
 }
 
+Result Solver::solveInner(Solver& inner, const Problem& problem, const Vector& guess, Vector& x) {
+  if (guess.size() != problem.size()) return inner.solveWithGuess(problem, guess, x);
+  inner.start_ = guess;
+  inner.validated_ = true;
+  struct Untimed {  // this solve times the whole; restored on every way out
+    bool& timed;
+    const bool was;
+    ~Untimed() { timed = was; }
+  } untimed{inner.timed_, inner.timed_};
+  inner.timed_ = false;
+  return inner.runChecked(problem, x, &guess);
+}
+
 void Solver::keepStartIfBetter(const Problem& problem, const Vector* start, Result& r) {
   Vector slack = problem.b;
   Accuracy a;
@@ -144,6 +158,7 @@ void Solver::runGuarded(const Problem& problem, const Vector* start, Result& r) 
   try {
     run(problem, start_, r);
   } catch (const std::bad_alloc&) {
+    innerChecked_ = false;  // the start is returned: measured here
     if (start)
       start_ = *start;
     else
@@ -159,11 +174,15 @@ Result Solver::runChecked(const Problem& problem, Vector& x, const Vector* start
   const double t0 = timed_ ? nowSeconds() : 0.0;
   auto elapsed = [&] { return timed_ ? nowSeconds() - t0 : 0.0; };
   Result r;
-  if (std::string why = problem.validate(); !why.empty()) {
-    r.status = Status::InvalidInput;
-    r.message = why;
-    r.seconds = elapsed();
-    return r;
+  const bool validated = validated_;
+  validated_ = false;
+  if (!validated) {
+    if (std::string why = problem.validate(); !why.empty()) {
+      r.status = Status::InvalidInput;
+      r.message = why;
+      r.seconds = elapsed();
+      return r;
+    }
   }
   r.status = Status::Failed;
   r.solver = name();
@@ -176,10 +195,16 @@ Result Solver::runChecked(const Problem& problem, Vector& x, const Vector* start
     }
   } budget{options_, options_.timeBudget > 0 && !(options_.budgetStart > 0)};
   if (budget.set) options_.budgetStart = t0 > 0 ? t0 : nowSeconds();
+  innerChecked_ = false;
   runGuarded(problem, start, r);
   if (r.status == Status::InvalidInput || r.status == Status::Unsupported) {
     r.seconds = elapsed();
     return r;  // x untouched: nothing was solved
+  }
+  if (std::exchange(innerChecked_, false)) {  // checked by the inner solve, on this problem
+    x.swap(start_);
+    r.seconds = elapsed();
+    return r;
   }
   // Up to 8 rows, Eigen's coefficient-wise product: the blocked kernel's call and set-up cost
   // more than a joint island's 36 multiplications.

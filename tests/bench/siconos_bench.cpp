@@ -1,7 +1,7 @@
 // siconos_bench: our solvers and Siconos numerics' on the same captured engine islands.
 //
 //     siconos_bench [--tol 1e-6] [--max-iter 1000] [--time-limit 60] [--max-dense-rows 6000]
-//                   [--csv OUT.csv] ISLAND.json...
+//                   [--repeat 1] [--csv OUT.csv] ISLAND.json...
 //
 // Each island (mlcp-problem/1 from `mlcp run --capture`) is solved in up to three forms
 // (island_forms.hpp):
@@ -15,9 +15,12 @@
 // Ours: pgs, dantzig, newton, lemke and auto from the registry, tolerance --tol, --max-iter
 // sweeps / Newton steps / friction passes, --time-limit as their time budget. Siconos': as
 // siconos_solvers.hpp says (tolerance matched, each solve in a child process with the same
-// wall-clock limit). Every answer's residual is ours (residual.hpp), computed here; `status` is
-// converged exactly when it meets --tol. Solvers that need A dense (Siconos', our lemke) are
-// skipped above --max-dense-rows rows (relay Lemke: above half of it, it doubles the problem).
+// wall-clock limit). --repeat R: every solve is done R times from zero (ours by the same solver
+// object, its workspaces kept; Siconos' in the same child) and ms is the median, for problems of a
+// few rows whose single solve is below the clock's noise. Every answer's residual is ours
+// (residual.hpp), computed here; `status` is converged exactly when it meets --tol. Solvers that
+// need A dense (Siconos', our lemke) are skipped above --max-dense-rows rows (relay Lemke: above
+// half of it, it doubles the problem).
 //
 // One CSV row per (island, form, solver):
 //   island,form,rows,solver,library,ms,iterations,residual,findex_residual,status,
@@ -26,11 +29,13 @@
 // bounds at x_ref's normals held). Exit 0: every island was read; 2: bad arguments or a file
 // that is not a problem.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <vector>
 
 #include "island_forms.hpp"
 #include "mlcp/io.hpp"
@@ -52,6 +57,7 @@ struct Settings {
   int maxIterations = 1000;
   double seconds = 60;
   int maxDenseRows = 6000;
+  int repeat = 1;
 };
 
 struct Row {
@@ -120,8 +126,15 @@ Row solveOurs(const std::string& name, const Problem& p, const Settings& s, Vect
   solver->options().tolerance = s.tolerance;
   solver->options().maxIterations = s.maxIterations;
   solver->options().timeBudget = s.seconds;
-  const Result r = solver->solve(p, x);
-  row.ms = r.seconds * 1e3;
+  Result r;
+  std::vector<double> ms;
+  for (int k = 0; k < s.repeat; ++k) {  // from zero every time (options().warmStart is off)
+    const double t0 = nowSeconds();
+    r = solver->solve(p, x);
+    ms.push_back((nowSeconds() - t0) * 1e3);
+  }
+  std::nth_element(ms.begin(), ms.begin() + ms.size() / 2, ms.end());
+  row.ms = ms[ms.size() / 2];
   row.iterations = r.iterations;
   row.status = toString(r.status);
   if (x.size() != p.size()) {  // nothing solved (unsupported, invalid input): no answer to measure
@@ -150,8 +163,8 @@ Row solveSiconos(const SiconosSolverInfo& info, const Problem& given, const Prob
     row.note = "dense; rows > the dense limit";
     return row;
   }
-  const SiconosOutcome out =
-      solveWithSiconos(info, given, SiconosLimits{s.tolerance, s.maxIterations, s.seconds});
+  const SiconosOutcome out = solveWithSiconos(
+      info, given, SiconosLimits{s.tolerance, s.maxIterations, s.seconds, s.repeat});
   if (out.end != SiconosOutcome::End::Returned) {
     row.status = out.end == SiconosOutcome::End::TimeLimit ? "time-limit" : "crashed";
     row.ms = out.end == SiconosOutcome::End::TimeLimit ? s.seconds * 1e3 : 0;
@@ -268,6 +281,8 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--max-dense-rows", s.maxDenseRows,
                  "largest problem handed to a dense solver (default 6000)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--repeat", s.repeat, "solves of each problem; ms is their median (default 1)")
       ->check(CLI::PositiveNumber);
   app.add_option("--csv", csvPath, "CSV file to write");
   app.add_option("islands", files, "problem files (mlcp-problem/1)")->required();

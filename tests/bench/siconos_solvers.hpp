@@ -55,6 +55,7 @@ struct SiconosLimits {
   double tolerance = 1e-6;   // our scaled residual's target
   int maxIterations = 1000;  // Newton steps, PGS sweeps
   double seconds = 60;       // wall-clock limit of one solve
+  int repeat = 1;            // solves of the same problem from zero; ms is their median
 };
 
 struct SiconosOutcome {

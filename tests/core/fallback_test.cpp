@@ -152,6 +152,31 @@ TEST(Fallback, NothingConvergesSaysSoAndKeepsTheBestAnswer) {
   EXPECT_EQ(x.size(), 30);
 }
 
+// Answers the start (zeros) and claims Converged: a lying member.
+class ClaimsConverged : public Solver {
+ public:
+  const char* name() const override { return "test-liar"; }
+
+ protected:
+  void run(const Problem&, Vector&, Result& result) override { result.status = Status::Converged; }
+};
+
+// A chain's member is run without a second validation; its answer is still checked against the
+// problem, once, so a false Converged is caught and the next member answers.
+TEST(Fallback, AMemberThatClaimsConvergedIsCheckedAndFallsBack) {
+  FallbackSolver chain = chainWith(std::make_unique<ClaimsConverged>());
+  test::Generator g(9);
+  const Problem p(g.spd(10), -Vector::Ones(10));
+  Vector x;
+  for (int repeat = 0; repeat < 2; ++repeat) {  // the second with the kept workspaces
+    const Result r = chain.solve(p, x);
+    ASSERT_TRUE(r.converged()) << r.message;
+    EXPECT_EQ(r.fallbacks, 1);
+    EXPECT_NE(r.message.find("test-liar: failed"), std::string::npos) << r.message;
+    EXPECT_LE(residual(p, x), 1e-6);
+  }
+}
+
 TEST(Fallback, UnknownMemberIsAClearError) {
   std::string error;
   EXPECT_FALSE(makeSolver("pgs>nosuch", &error));
@@ -173,6 +198,37 @@ TEST(Auto, ChoosesByProblemClass) {
 
   r = solver->solve(Problem(DenseMatrix(0, 0), Vector(0)), x);
   EXPECT_TRUE(r.converged());
+}
+
+// Data from outside enters through Solver::solve, which validates it however deep the chain
+// behind it: a NaN in A is one line of InvalidInput and x is left as it was.
+TEST(Auto, InvalidInputIsRejectedAndLeavesXUntouched) {
+  AutoSolver solver;
+  test::Generator g(10);
+  DenseMatrix A = g.spd(6);
+  A(2, 3) = std::nan("");
+  Vector x = Vector::Constant(6, 7.0);
+  const Result r = solver.solve(Problem(A, -Vector::Ones(6)), x);
+  EXPECT_EQ(r.status, Status::InvalidInput);
+  EXPECT_FALSE(r.message.empty());
+  EXPECT_EQ(r.message.find('\n'), std::string::npos) << r.message;
+  EXPECT_EQ(x, Vector::Constant(6, 7.0));
+}
+
+// auto remembers its last choice's chain; a policy changed between solves is still obeyed.
+TEST(Auto, ARepeatSolveAfterAPolicyChangeTakesTheNewChain) {
+  AutoSolver solver;
+  test::Generator g(11);
+  const Problem p(g.spd(10), -Vector::Ones(10));
+  Vector x;
+  Result r = solver.solve(p, x);
+  ASSERT_TRUE(r.converged()) << r.message;
+  EXPECT_NE(r.message.find("-> dantzig>pgs"), std::string::npos) << r.message;
+  solver.policy.smallContactRows = 0;
+  r = solver.solve(p, x);
+  ASSERT_TRUE(r.converged()) << r.message;
+  EXPECT_NE(r.message.find("-> " + solver.policy.largeIslandSolver + ">pgs"), std::string::npos)
+      << r.message;
 }
 
 }  // namespace

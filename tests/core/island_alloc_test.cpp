@@ -10,6 +10,7 @@
 #include "common/cube_on_ground.hpp"
 #include "common/redundant_joint.hpp"
 #include "mlcp/island/row_solver.hpp"
+#include "mlcp/registry.hpp"
 
 extern "C" void* __libc_malloc(std::size_t);
 namespace {
@@ -63,6 +64,39 @@ TEST(IslandAllocations, SteadyStateSolvesAllocateOnlyTheirMessagesWhateverTheSiz
     EXPECT_LE(large, small);
   }
   EXPECT_LE(allocationsPerSolve("ldlt", joint), 1);
+}
+
+// A dense LCP of n rows, A = I + 0.1 (ones), b alternating in sign (about half the rows active).
+Problem denseLcp(int n) {
+  DenseMatrix A = DenseMatrix::Identity(n, n) + 0.1 * DenseMatrix::Ones(n, n);
+  Vector b(n);
+  for (int i = 0; i < n; ++i) b[i] = i % 2 ? 0.5 : -1.0;
+  return Problem(A, b);
+}
+
+// Allocations per Solver::solve of `p` by `solver` after 20 solves of it.
+double allocationsPerApiSolve(const std::string& solver, const Problem& p) {
+  std::unique_ptr<Solver> s = makeSolver(solver);
+  Vector x;
+  for (int i = 0; i < 20; ++i) s->solve(p, x);
+  const long before = g_allocations;
+  for (int i = 0; i < 100; ++i) {
+    const Result r = s->solve(p, x);
+    EXPECT_EQ(r.status, Status::Converged) << r.message;
+  }
+  return (g_allocations - before) / 100.0;
+}
+
+// The core API on tiny problems (auto's chain of solvers included): the workspaces of every
+// layer are kept, the problem is validated once, and no message stream is made on success.
+TEST(IslandAllocations, RepeatApiSolvesOfATinyLcpAllocateOnlyTheirMessages) {
+  for (const char* solver : {"auto", "dantzig"}) {
+    SCOPED_TRACE(solver);
+    const double small = allocationsPerApiSolve(solver, denseLcp(5));
+    const double large = allocationsPerApiSolve(solver, denseLcp(20));
+    EXPECT_LE(small, 2);
+    EXPECT_LE(large, small);
+  }
 }
 
 }  // namespace

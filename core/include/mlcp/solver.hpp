@@ -68,6 +68,16 @@ class Solver {
   // counts from the same start.
   bool outOfTime() const;
 
+  // For a run() that hands the problem to another solver (auto, fallback chains): solves it
+  // with `inner` from `guess` (size n, finite: this solve's start) without validating it again,
+  // since this solve has. inner still checks its answer's accuracy against the problem.
+  Result solveInner(Solver& inner, const Problem& problem, const Vector& guess, Vector& x);
+  // Says that run() leaves x and result (status, residual and its parts) as its last
+  // solveInner left them, inner having run with this solver's options (setOptions(options())):
+  // that check is the one this solve would make, so it is not repeated (one residual
+  // evaluation a solve, however deep the chain).
+  void keepInnerCheck() { innerChecked_ = true; }
+
  private:
   // Runs the algorithm on start_ (holding the start point, *start or zeros when null) and swaps
   // it into x.
@@ -77,6 +87,8 @@ class Solver {
   void keepStartIfBetter(const Problem& problem, const Vector* start, Result& r);
   Options options_;
   bool timed_ = true;
+  bool validated_ = false;     // the problem was validated by the caller's solve (solveInner)
+  bool innerChecked_ = false;  // run() returned solveInner's checked answer (keepInnerCheck)
   // The iterate and w = A x + b of the accuracy check, kept so repeated solves of one size do
   // not allocate (an engine solves every island every step).
   Vector start_, slack_;

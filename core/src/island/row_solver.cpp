@@ -12,8 +12,11 @@
 #include "mlcp/registry.hpp"
 #include "mlcp/residual.hpp"
 #include "mlcp/solvers/dantzig.hpp"
+#include "short_number.hpp"
 
 namespace mlcp {
+
+using detail::shortNumber;
 
 ProblemClass classify(const RowSystem& rows) {
   return classifyBounds(rows.lo, rows.hi, rows.findex);
@@ -122,12 +125,6 @@ bool equals(const std::string& s, const char (&literal)[N]) {
   return s.size() == N - 1 && std::memcmp(s.data(), literal, N - 1) == 0;
 }
 
-// x as `std::ostream << x` writes it (%g, 6 digits).
-std::string shortNumber(double x) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", x);
-  return text;
-}
 }  // namespace
 
 bool RowSolver::known(const std::string& name) {

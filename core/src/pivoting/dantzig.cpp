@@ -12,6 +12,7 @@
 #include "mlcp/residual.hpp"
 #include "pivoting/dantzig_small.hpp"
 #include "pivoting/dantzig_workspace.hpp"
+#include "short_number.hpp"
 
 namespace mlcp {
 
@@ -304,9 +305,7 @@ Outcome DantzigSolver::Workspace::drive(int i) {
 
 [[gnu::always_inline]] inline Outcome DantzigSolver::Workspace::checkBudget() {
   if (pivots >= pivotLimit) {
-    std::ostringstream os;
-    os << "pivot limit " << pivotLimit << " reached";
-    message = os.str();
+    message = "pivot limit " + std::to_string(pivotLimit) + " reached";
     return Outcome::PivotLimit;
   }
   if (pivots % clockEvery == clockEvery - 1 && deadline != kInf && nowSeconds() > deadline) {
@@ -407,10 +406,9 @@ Outcome DantzigSolver::Workspace::drive(int i) {
     joinN(i, Set::Free);
     return Outcome::Done;
   }
-  std::ostringstream os;
-  os << "row " << perm[i] << ": nothing limits the step (w = " << wi << ", Schur pivot = " << sii
-     << "); the problem has no solution on this path (infeasible, or A is not a P-matrix)";
-  return fail(os.str());
+  return fail("row " + std::to_string(perm[i]) + ": nothing limits the step (w = " +
+              detail::shortNumber(wi) + ", Schur pivot = " + detail::shortNumber(sii) +
+              "); the problem has no solution on this path (infeasible, or A is not a P-matrix)");
 }
 
 // The event that ended the step: i settles (Done), a clamped row leaves C at its bound or a row
@@ -432,9 +430,8 @@ Outcome DantzigSolver::Workspace::drive(int i) {
       x[p] = up ? hi[p] : lo[p];
       w[p] = 0;
       if (!leaveC(step.who)) {
-        std::ostringstream os;
-        os << "row " << perm[p] << " left the clamped set and left a singular block behind";
-        return fail(os.str());
+        return fail("row " + std::to_string(perm[p]) +
+                    " left the clamped set and left a singular block behind");
       }
       joinN(p, up ? Set::AtHi : Set::AtLo);
       break;
@@ -445,10 +442,9 @@ Outcome DantzigSolver::Workspace::drive(int i) {
       leaveN(step.who);
       const double pivot = border(p);
       if (!(std::abs(pivot) > pivTol)) {
-        std::ostringstream os;
-        os << "row " << perm[p] << " must join the clamped set but its pivot is " << pivot
-           << " (singular principal block)";
-        return fail(os.str());
+        return fail("row " + std::to_string(perm[p]) +
+                    " must join the clamped set but its pivot is " + detail::shortNumber(pivot) +
+                    " (singular principal block)");
       }
       joinC(p, pivot);
       break;
@@ -736,9 +732,8 @@ void DantzigSolver::regularise(const Problem& problem, Vector& x, Result& result
   ws.shift = 0;
   ws.regularised = true;
   result.iterations += spent;
-  std::ostringstream os;
-  os << "regularised: A + " << delta << " I " << why << "; " << result.message;
-  result.message = os.str();
+  result.message =
+      "regularised: A + " + detail::shortNumber(delta) + " I " + why + "; " + result.message;
 }
 
 void DantzigSolver::runPivoting(const Problem& problem, Vector& x, Result& result) {

@@ -463,6 +463,7 @@ struct PassContext {
 // A pass that ended without a complementary basis (a ray, the pivot limit, the time budget):
 // true with its status and message set; false when it is solved.
 bool reportUnsolved(const LcpSolution& s, const PassContext& c, Result& result) {
+  if (s.outcome.end == LemkeEnd::Solved) return false;  // no message to build
   std::ostringstream os;
   const std::string where = c.friction ? " in friction iteration " + std::to_string(c.outer) : "";
   const std::string lcp = c.standard ? "the LCP" : "the transformed LCP (see lemke.hpp)";
@@ -700,16 +701,15 @@ void LemkeSolver::pivotPasses(const Problem& problem, const SparseMatrix& A, Vec
     Accuracy acc;
     const Vector best = passAnswer(problem, A, f, s, lo, revised, acc);
     x = best;
-    std::ostringstream os;
     if (!friction || acc.residual <= opt.tolerance) {
-      result.status = Status::Converged;
-      os << "z0 left the basis after " << result.iterations << " pivots";
-      if (friction) os << " (" << outer << " friction iterations)";
-      result.message = os.str();
+      result.status = Status::Converged;  // the message without a stream: a solve's usual end
+      result.message = "z0 left the basis after " + std::to_string(result.iterations) + " pivots";
+      if (friction) result.message += " (" + std::to_string(outer) + " friction iterations)";
       return;
     }
     lastMove = boundsMove(problem, current, best);
     if (!(lastMove > 1e-15)) {
+      std::ostringstream os;
       os << "the friction bounds reached a fixed point with residual " << acc.residual
          << " above the tolerance";
       result.status = Status::Failed;

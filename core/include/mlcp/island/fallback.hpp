@@ -41,6 +41,7 @@ class FallbackSolver : public Solver {
  private:
   std::vector<std::unique_ptr<Solver>> chain_;
   std::string name_;
+  Vector xk_, best_;  // kept across solves: a repeat solve of one size does not allocate
 };
 
 class AutoSolver : public Solver {
@@ -56,10 +57,16 @@ class AutoSolver : public Solver {
   void run(const Problem& problem, Vector& x, Result& result) override;
 
  private:
+  Solver* chainFor(const Choice& choice);
   void continueSingular(const Problem& problem, ProblemClass c, const Choice& choice, Vector& x,
                         Result& result);
   // Chains are kept per choice so that solver workspaces (and ldlt's analysis) are reused.
   std::vector<std::pair<std::string, std::unique_ptr<Solver>>> cache_;
+  Vector out_;  // the chain's answer, kept across solves
+  struct LastChain {
+    std::string first, second, chain;  // the choice's solver and fallback; the chain made
+    Solver* solver = nullptr;          // null: nothing remembered
+  } last_;
 };
 
 }  // namespace mlcp
