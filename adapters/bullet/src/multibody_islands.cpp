@@ -16,7 +16,7 @@ constexpr double kLimitSlop = 1e-3;
 
 int MultiBodyIslands::rigidNode(int solverBody) const {
   if (solverBody < 0 || solverBody >= nb_) return -1;
-  const btRigidBody* rb = (*in_.bodies)[solverBody].m_originalBody;
+  const btRigidBody* rb = (*in_.rigid.bodies)[solverBody].m_originalBody;
   return rb && rb->getInvMass() != 0 ? solverBody : -1;
 }
 
@@ -64,11 +64,11 @@ void MultiBodyIslands::collect(const MultiBodyPools& in) {
       rows_.push_back(row);
     }
   };
-  const int nj = in.joints->size();
-  rigidPool(*in.joints, Kind::Joint, 0);
-  rigidPool(*in.contacts, Kind::Contact, 0);
-  rigidPool(*in.friction, Kind::Friction, nj);
-  rigidPool(*in.rolling, Kind::Friction, nj);
+  const int nj = in.rigid.joints->size();
+  rigidPool(*in.rigid.joints, Kind::Joint, 0);
+  rigidPool(*in.rigid.contacts, Kind::Contact, 0);
+  rigidPool(*in.rigid.friction, Kind::Friction, nj);
+  rigidPool(*in.rigid.rolling, Kind::Friction, nj);
   multiPool(*in.nonContact, Kind::Joint, 0);
   const int normals = static_cast<int>(rows_.size());
   multiPool(*in.normal, Kind::Contact, 0);
@@ -115,7 +115,7 @@ void MultiBodyIslands::number() {
       if (node < 0 || bodyLocal_[node] >= 0) continue;
       if (node < nb_) {
         bodyLocal_[node] = static_cast<int>(isl.system.bodies.size());
-        isl.system.bodies.push_back(inverseMassOf((*in_.bodies)[node]));
+        isl.system.bodies.push_back(inverseMassOf((*in_.rigid.bodies)[node]));
       } else {
         bodyLocal_[node] = static_cast<int>(isl.system.articulated.size());
         isl.system.articulated.push_back(6 + multiBodies_[node - nb_]->getNumDofs());
@@ -130,7 +130,7 @@ void MultiBodyIslands::number() {
 void MultiBodyIslands::build(const MultiBodyPools& pools, const btContactSolverInfo& info,
                              const Settings& settings, Start start) {
   in_ = pools;
-  nb_ = pools.bodies->size();
+  nb_ = pools.rigid.bodies->size();
   collect(pools);
   number();
   for (int k = 0; k < count_; ++k) {
@@ -166,7 +166,7 @@ void MultiBodyIslands::fill(MultiBodyIsland& isl, int r, int local, const btCont
   const Row& row = rows_[r];
   RowSystem& s = isl.system;
   ConstraintRow& cr = s.rows[local];
-  const btAlignedObjectArray<btSolverBody>& bodies = *in_.bodies;
+  const btAlignedObjectArray<btSolverBody>& bodies = *in_.rigid.bodies;
   auto values = [&](const auto& c, double rhs) {
     const double jd = c.m_jacDiagABInv;
     const bool scaled = !btFuzzyZero(jd);
@@ -246,7 +246,7 @@ double MultiBodyIslands::startOf(const Row& row, Start start, double unscale) co
 }
 
 void MultiBodyIslands::writeBack(MultiBodyIsland& isl, const Vector& x) const {
-  btAlignedObjectArray<btSolverBody>& bodies = *in_.bodies;
+  btAlignedObjectArray<btSolverBody>& bodies = *in_.rigid.bodies;
   btMultiBodyJacobianData& data = *in_.data;
   auto rigid = [&](int id, const btVector3& normal, const btVector3& angular, btScalar delta) {
     if (id < 0 || id >= nb_) return;

@@ -34,11 +34,7 @@ namespace mlcp::bullet::detail {
 
 // The pools of one btMultiBodyConstraintSolver group.
 struct MultiBodyPools {
-  btAlignedObjectArray<btSolverBody>* bodies = nullptr;
-  btConstraintArray* joints = nullptr;
-  btConstraintArray* contacts = nullptr;
-  btConstraintArray* friction = nullptr;
-  btConstraintArray* rolling = nullptr;
+  BulletRows rigid;  // the SI base's pools: solver bodies, joints, contacts, friction, rolling
   btMultiBodyConstraintArray* nonContact = nullptr;
   btMultiBodyConstraintArray* normal = nullptr;
   btMultiBodyConstraintArray* lateral = nullptr;

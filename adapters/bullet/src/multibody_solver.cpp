@@ -43,11 +43,9 @@ void MultiBodySolver::buildIslands(const btContactSolverInfo& info, bool siAnswe
                       : s.warmStart         ? Start::CachedImpulse
                                             : Start::Zero;
   detail::MultiBodyPools pools;
-  pools.bodies = &m_tmpSolverBodyPool;
-  pools.joints = &m_tmpSolverNonContactConstraintPool;
-  pools.contacts = &m_tmpSolverContactConstraintPool;
-  pools.friction = &m_tmpSolverContactFrictionConstraintPool;
-  pools.rolling = &m_tmpSolverContactRollingFrictionConstraintPool;
+  pools.rigid = {&m_tmpSolverBodyPool, &m_tmpSolverNonContactConstraintPool,
+                 &m_tmpSolverContactConstraintPool, &m_tmpSolverContactFrictionConstraintPool,
+                 &m_tmpSolverContactRollingFrictionConstraintPool};
   pools.nonContact = &m_multiBodyNonContactConstraints;
   pools.normal = &m_multiBodyNormalContactConstraints;
   pools.lateral = &m_multiBodyFrictionContactConstraints;
